@@ -1,0 +1,3 @@
+//! Wavefront OBJ reader (via tobj) and writer.
+//!
+//! Part of conduit's `formats/` layer: it describes the file and has no dependency on the pipeline.

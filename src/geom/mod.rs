@@ -1,0 +1,16 @@
+//! Shared geometry vocabulary used by every pipeline stage.
+//!
+//! 2D work (layer regions, offsets, booleans) is done in scaled integers where one unit is one
+//! nanometre, so boolean and offset operations are exact; 3D work (meshes, curved and conformal
+//! paths) is done in `f64` millimetres. Convert between the two only through [`scaled`] and
+//! [`unscaled`].
+
+mod point;
+mod polygon;
+mod tolerances;
+mod transform;
+
+pub use point::{Coord, Point2, Point3, Vector3, scaled, unscaled};
+pub use polygon::{ExPolygon, Polygon, Polyline};
+pub use tolerances::{Tolerance, Tolerances};
+pub use transform::{BoundingBox, Transform};

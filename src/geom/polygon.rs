@@ -1,0 +1,87 @@
+//! Closed polygons, polygons with holes and open polylines in scaled integer coordinates.
+
+use super::point::Point2;
+
+/// A closed polygon; the last point connects back to the first (it is not repeated).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Polygon {
+    /// The vertices in order.
+    pub points: Vec<Point2>,
+}
+
+impl Polygon {
+    /// A polygon from its vertices.
+    pub fn new(points: Vec<Point2>) -> Self {
+        Self { points }
+    }
+
+    /// Twice the signed area in square nanometres (positive when counter-clockwise), exact.
+    pub fn signed_area2(&self) -> i128 {
+        let n = self.points.len();
+        (0..n)
+            .map(|i| {
+                let a = self.points[i];
+                let b = self.points[(i + 1) % n];
+                a.x as i128 * b.y as i128 - b.x as i128 * a.y as i128
+            })
+            .sum()
+    }
+
+    /// Signed area in mm² (positive when counter-clockwise).
+    pub fn area_mm2(&self) -> f64 {
+        self.signed_area2() as f64 / 2.0 / 1e12
+    }
+
+    /// Whether the vertices run counter-clockwise.
+    pub fn is_counter_clockwise(&self) -> bool {
+        self.signed_area2() > 0
+    }
+}
+
+/// An outer contour (counter-clockwise) with holes (clockwise).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct ExPolygon {
+    /// The outer boundary.
+    pub contour: Polygon,
+    /// The holes inside it.
+    pub holes: Vec<Polygon>,
+}
+
+impl ExPolygon {
+    /// Net area in mm²: the contour minus the holes.
+    pub fn area_mm2(&self) -> f64 {
+        self.contour.area_mm2().abs() - self.holes.iter().map(|h| h.area_mm2().abs()).sum::<f64>()
+    }
+}
+
+/// An open chain of points.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Polyline {
+    /// The points in order.
+    pub points: Vec<Point2>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn square_with_hole_has_analytic_area() {
+        let sq = |s: f64| {
+            Polygon::new(vec![
+                Point2::from_mm(0.0, 0.0),
+                Point2::from_mm(s, 0.0),
+                Point2::from_mm(s, s),
+                Point2::from_mm(0.0, s),
+            ])
+        };
+        let outer = sq(10.0);
+        assert!(outer.is_counter_clockwise());
+        assert_eq!(outer.area_mm2(), 100.0);
+        let mut hole = sq(2.0);
+        hole.points.reverse();
+        assert!(!hole.is_counter_clockwise());
+        let ex = ExPolygon { contour: outer, holes: vec![hole] };
+        assert_eq!(ex.area_mm2(), 96.0);
+    }
+}

@@ -1,0 +1,1 @@
+//! conduit's integration tests: one binary, one module per area.
