@@ -1,1 +1,9 @@
 //! conduit's integration tests: one binary, one module per area.
+//!
+//! Tests that need the shared corpus (`../shared/corpus` beside the checkout) print
+//! `skipped: corpus not found` and pass when it is absent.
+
+mod cli;
+mod conformance;
+mod roundtrip;
+mod support;

@@ -1,8 +1,18 @@
 //! Reading files into the pipeline's input types and writing meshes back out.
 //!
-//! Place in the pipeline: the first step of every command. Format crates under `formats/` describe
-//! files; this module converts what they return into [`Scene`]s of [`crate::mesh::Mesh`]es in
-//! millimetres.
+//! Place in the pipeline: the first step of every command (and the last of `convert`). Format
+//! crates under `formats/` describe files; this module converts what they return into [`Scene`]s of
+//! [`crate::mesh::Mesh`]es in millimetres, and back.
+
+mod detect;
+mod load;
+mod save;
+
+pub use detect::FileKind;
+pub use load::{
+    Content, LoadError, LoadErrorKind, LoadOptions, LoadedFile, MeshDetails, ThreeMfDetails, load, load_scene,
+};
+pub use save::{MeshFormat, SaveError, SaveErrorKind, placed_meshes, save, to_3mf_model, write_atomically};
 
 use crate::geom::Transform;
 use crate::mesh::Mesh;
@@ -16,7 +26,7 @@ pub struct SceneObject {
     pub mesh: Mesh,
     /// Where the build places it.
     pub transform: Transform,
-    /// The tool (extruder) that prints it, when the file says.
+    /// The tool (extruder) that prints it, when known.
     pub tool: Option<usize>,
 }
 
@@ -25,4 +35,11 @@ pub struct SceneObject {
 pub struct Scene {
     /// The placed objects.
     pub objects: Vec<SceneObject>,
+}
+
+impl Scene {
+    /// Total triangle count over all objects.
+    pub fn triangle_count(&self) -> usize {
+        self.objects.iter().map(|o| o.mesh.triangles.len()).sum()
+    }
 }

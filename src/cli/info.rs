@@ -1,0 +1,222 @@
+//! `conduit info`: what is in each file, as text or JSON.
+
+use super::{Failure, args::InfoArgs};
+use conduit::geom::{BoundingBox, Point3, Tolerances};
+use conduit::mesh::{Mesh, RepairReport, TopologyReport};
+use conduit::scene::{Content, LoadOptions, LoadedFile, MeshDetails, Scene, load};
+use rayon::prelude::*;
+use serde::Serialize;
+use serde_json::{Value, json};
+use std::io::Write;
+
+/// Facts about one mesh object.
+#[derive(Debug, Serialize)]
+struct ObjectInfo {
+    name: String,
+    triangles: usize,
+    vertices: usize,
+    volume_mm3: f64,
+    area_mm2: f64,
+    bbox: Option<BoundingBox>,
+    topology: TopologyReport,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    repair: Option<RepairFindings>,
+}
+
+/// What a trial repair would change, and the result.
+#[derive(Debug, Serialize)]
+struct RepairFindings {
+    #[serde(flatten)]
+    report: RepairReport,
+    closed_after: bool,
+    volume_after_mm3: f64,
+}
+
+pub(crate) fn run(args: InfoArgs) -> Result<(), Failure> {
+    let opts = LoadOptions::default();
+    let reports: Vec<Result<Value, String>> = args
+        .files
+        .par_iter()
+        .map(|path| {
+            load(path, &opts)
+                .map(|file| describe(&file, !args.no_repair))
+                .map_err(|e| format!("{e}"))
+        })
+        .collect();
+    let failed = reports.iter().filter(|r| r.is_err()).count();
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        let array: Vec<Value> = reports
+            .iter()
+            .zip(&args.files)
+            .map(|(r, path)| match r {
+                Ok(v) => v.clone(),
+                Err(e) => json!({ "file": path.display().to_string(), "error": e }),
+            })
+            .collect();
+        serde_json::to_writer_pretty(&mut out, &array).map_err(anyhow::Error::from)?;
+        writeln!(out).map_err(anyhow::Error::from)?;
+    } else {
+        for r in reports.iter().flatten() {
+            write_text(&mut out, r, 0).map_err(anyhow::Error::from)?;
+            writeln!(out).map_err(anyhow::Error::from)?;
+        }
+    }
+    out.flush().map_err(anyhow::Error::from)?;
+    for e in reports.iter().filter_map(|r| r.as_ref().err()) {
+        eprintln!("error: {e}");
+    }
+    if failed > 0 { Err(Failure::Reported) } else { Ok(()) }
+}
+
+/// The JSON description of a loaded file.
+fn describe(file: &LoadedFile, trial_repair: bool) -> Value {
+    let mut v = json!({
+        "file": file.path.display().to_string(),
+        "format": file.kind,
+    });
+    let body = match &file.content {
+        Content::Mesh { scene, details } => describe_scene(scene, details, trial_repair),
+        Content::PointCloud(cloud) => {
+            let pts: Vec<Point3> = cloud.points.iter().map(|p| Point3::new(p[0], p[1], p[2])).collect();
+            json!({
+                "points": cloud.points.len(),
+                "bbox": BoundingBox::from_points(&pts),
+                "normals": cloud.normals.is_some(),
+                "colors": cloud.colors.is_some(),
+            })
+        }
+        Content::Eagle(doc) => describe_eagle(doc),
+        Content::Gcode(summary) => json!({ "gcode": summary }),
+        Content::Design(design) => json!({
+            "width_mm": design.width_mm,
+            "height_mm": design.height_mm,
+            "paths": design.paths.len(),
+            "closed_paths": design.paths.iter().filter(|p| p.closed).count(),
+            "points": design.paths.iter().map(|p| p.points.len()).sum::<usize>(),
+        }),
+    };
+    merge(&mut v, body);
+    if !file.warnings.is_empty() {
+        v["warnings"] = json!(file.warnings);
+    }
+    v
+}
+
+fn merge(into: &mut Value, from: Value) {
+    if let (Value::Object(a), Value::Object(b)) = (into, from) {
+        a.extend(b);
+    }
+}
+
+fn describe_scene(scene: &Scene, details: &MeshDetails, trial_repair: bool) -> Value {
+    let objects: Vec<ObjectInfo> = scene.objects.iter().map(|o| object_info(&o.name, &o.mesh, trial_repair)).collect();
+    let bbox = objects.iter().filter_map(|o| o.bbox).reduce(|a, b| a.union(&b));
+    json!({
+        "details": details,
+        "triangles": scene.triangle_count(),
+        "vertices": scene.objects.iter().map(|o| o.mesh.vertices.len()).sum::<usize>(),
+        "volume_mm3": objects.iter().map(|o| o.volume_mm3).sum::<f64>(),
+        "bbox": bbox,
+        "objects": objects,
+    })
+}
+
+fn object_info(name: &str, mesh: &Mesh, trial_repair: bool) -> ObjectInfo {
+    let repair = trial_repair.then(|| {
+        let mut fixed = mesh.clone();
+        let report = fixed.repair(&Tolerances::default());
+        RepairFindings { report, closed_after: fixed.topology().closed, volume_after_mm3: fixed.signed_volume() }
+    });
+    ObjectInfo {
+        name: name.to_string(),
+        triangles: mesh.triangles.len(),
+        vertices: mesh.vertices.len(),
+        volume_mm3: mesh.signed_volume(),
+        area_mm2: mesh.area(),
+        bbox: mesh.bounding_box(),
+        topology: mesh.topology(),
+        repair,
+    }
+}
+
+fn describe_eagle(doc: &conduit_eagle::Document) -> Value {
+    use conduit_eagle::Document;
+    match doc {
+        Document::Schematic(s) => {
+            let packages: std::collections::BTreeSet<(&str, &str)> = s
+                .parts
+                .iter()
+                .filter_map(|p| p.package.as_ref().map(|k| (k.library.as_str(), k.name.as_str())))
+                .collect();
+            let pins: usize = s.parts.iter().map(|p| p.pin_pads.len()).sum();
+            let pin_pads: usize = s.parts.iter().flat_map(|p| p.pin_pads.values()).map(Vec::len).sum();
+            let multi: usize = s.parts.iter().flat_map(|p| p.pin_pads.values()).filter(|v| v.len() > 1).count();
+            json!({
+                "eagle": "schematic",
+                "version": s.version,
+                "parts": s.parts.len(),
+                "dropped_parts": s.dropped_parts,
+                "packages": packages.len(),
+                "nets": s.nets.len(),
+                "connected_pins": pins,
+                "pin_pad_connections": pin_pads,
+                "pins_on_several_pads": multi,
+            })
+        }
+        Document::Board(b) => {
+            let packages: std::collections::BTreeSet<(&str, &str)> =
+                b.elements.iter().map(|e| (e.package.library.as_str(), e.package.name.as_str())).collect();
+            json!({
+                "eagle": "board",
+                "version": b.version,
+                "elements": b.elements.len(),
+                "bottom_elements": b.elements.iter().filter(|e| e.rotation.mirror).count(),
+                "packages": packages.len(),
+                "pads": b.elements.iter().map(|e| e.package.pads.len()).sum::<usize>(),
+                "nets": b.nets.len(),
+            })
+        }
+        Document::Library => json!({ "eagle": "library" }),
+    }
+}
+
+/// Prints a JSON value as indented `key: value` lines.
+fn write_text(out: &mut impl Write, v: &Value, indent: usize) -> std::io::Result<()> {
+    let pad = "  ".repeat(indent);
+    match v {
+        Value::Object(map) => {
+            for (k, val) in map {
+                match val {
+                    Value::Object(m) if !m.is_empty() => {
+                        writeln!(out, "{pad}{k}:")?;
+                        write_text(out, val, indent + 1)?;
+                    }
+                    Value::Array(a) if a.iter().any(|x| x.is_object()) => {
+                        for (i, item) in a.iter().enumerate() {
+                            writeln!(out, "{pad}{k}[{i}]:")?;
+                            write_text(out, item, indent + 1)?;
+                        }
+                    }
+                    _ => writeln!(out, "{pad}{k}: {}", scalar(val))?,
+                }
+            }
+            Ok(())
+        }
+        other => writeln!(out, "{pad}{}", scalar(other)),
+    }
+}
+
+fn scalar(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        Value::Number(n) => match n.as_f64() {
+            Some(f) if n.is_f64() => format!("{}", (f * 1000.0).round() / 1000.0),
+            _ => n.to_string(),
+        },
+        Value::Array(a) => a.iter().map(scalar).collect::<Vec<_>>().join(", "),
+        Value::Null => "-".into(),
+        other => other.to_string(),
+    }
+}

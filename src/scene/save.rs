@@ -1,0 +1,221 @@
+//! Writing scenes as STL, 3MF or OBJ. Every file is written to a temporary file beside the target
+//! and renamed into place, so a failed run never leaves a partial file.
+
+use super::Scene;
+use crate::mesh::Mesh;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Mesh formats conduit writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum MeshFormat {
+    /// Binary STL (all objects merged; STL has no objects).
+    Stl,
+    /// ASCII STL.
+    StlAscii,
+    /// 3MF with one object and build item per scene object.
+    #[value(name = "3mf")]
+    ThreeMf,
+    /// Wavefront OBJ with one `o` group per object.
+    Obj,
+}
+
+impl MeshFormat {
+    /// The format an output path's extension names.
+    pub fn from_path(path: &Path) -> Option<MeshFormat> {
+        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+            "stl" => Some(MeshFormat::Stl),
+            "3mf" => Some(MeshFormat::ThreeMf),
+            "obj" => Some(MeshFormat::Obj),
+            _ => None,
+        }
+    }
+
+    /// The file extension for this format.
+    pub fn extension(self) -> &'static str {
+        match self {
+            MeshFormat::Stl | MeshFormat::StlAscii => "stl",
+            MeshFormat::ThreeMf => "3mf",
+            MeshFormat::Obj => "obj",
+        }
+    }
+}
+
+/// A file that failed to write.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {kind}", path.display())]
+pub struct SaveError {
+    /// The target file.
+    pub path: PathBuf,
+    /// What went wrong.
+    pub kind: SaveErrorKind,
+}
+
+/// Why a write failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SaveErrorKind {
+    /// Filesystem error.
+    #[error("cannot write: {0}")]
+    Io(#[from] std::io::Error),
+    /// 3MF writer error.
+    #[error("3MF: {0}")]
+    ThreeMf(#[from] conduit_3mf::ThreeMfError),
+    /// A coordinate does not fit the output format (STL stores 32-bit floats).
+    #[error("{0}")]
+    Unrepresentable(String),
+}
+
+/// Writes `path` atomically: `fill` writes into a temporary file in the same folder, which is renamed
+/// over `path` only when `fill` succeeds.
+pub fn write_atomically<F, E>(path: &Path, fill: F) -> Result<(), E>
+where
+    F: FnOnce(&mut std::fs::File) -> Result<(), E>,
+    E: From<std::io::Error>,
+{
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut tmp = tempfile::Builder::new().prefix(".conduit-").suffix(".tmp").tempfile_in(&dir)?;
+    fill(tmp.as_file_mut())?;
+    tmp.as_file_mut().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// The scene's objects with their transforms applied.
+pub fn placed_meshes(scene: &Scene) -> Vec<Mesh> {
+    scene
+        .objects
+        .iter()
+        .map(|o| {
+            let mut m = o.mesh.clone();
+            m.name = o.name.clone();
+            m.transform(&o.transform);
+            m
+        })
+        .collect()
+}
+
+fn f32_triangles(meshes: &[Mesh]) -> Result<Vec<[[f32; 3]; 3]>, SaveErrorKind> {
+    let mut out = Vec::with_capacity(meshes.iter().map(|m| m.triangles.len()).sum());
+    for m in meshes {
+        for tri in m.triangle_corners() {
+            let mut t = [[0f32; 3]; 3];
+            for (dst, p) in t.iter_mut().zip(tri.iter()) {
+                for k in 0..3 {
+                    let v = p[k] as f32;
+                    if !v.is_finite() {
+                        return Err(SaveErrorKind::Unrepresentable(format!(
+                            "coordinate {} of object '{}' does not fit a 32-bit float",
+                            p[k], m.name
+                        )));
+                    }
+                    dst[k] = v;
+                }
+            }
+            out.push(t);
+        }
+    }
+    Ok(out)
+}
+
+/// Builds the 3MF model of a scene: one mesh object and one build item per scene object.
+pub fn to_3mf_model(scene: &Scene) -> conduit_3mf::Model {
+    let mut model = conduit_3mf::Model {
+        unit: conduit_3mf::Unit::Millimeter,
+        language: None,
+        metadata: vec![conduit_3mf::Metadata {
+            name: "Application".into(),
+            value: format!("conduit {}", env!("CARGO_PKG_VERSION")),
+        }],
+        required_extensions: Vec::new(),
+        objects: Vec::new(),
+        base_materials: Vec::new(),
+        color_groups: Vec::new(),
+        build: Vec::new(),
+    };
+    for (i, o) in scene.objects.iter().enumerate() {
+        let id = i as u32 + 1;
+        model.objects.push(conduit_3mf::Object {
+            id,
+            name: Some(o.name.clone()),
+            kind: conduit_3mf::ObjectType::Model,
+            pid: None,
+            pindex: None,
+            content: conduit_3mf::ObjectContent::Mesh(conduit_3mf::Mesh {
+                vertices: o.mesh.vertices.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                triangles: o
+                    .mesh
+                    .triangles
+                    .iter()
+                    .map(|&v| conduit_3mf::Triangle { v, pid: None, p: [None; 3] })
+                    .collect(),
+            }),
+        });
+        model.build.push(conduit_3mf::BuildItem {
+            object_id: id,
+            path: None,
+            transform: (!o.transform.is_identity()).then(|| o.transform.to_3mf()),
+            part_number: None,
+        });
+    }
+    model
+}
+
+/// Writes a scene to `path` in `format`, atomically.
+pub fn save(scene: &Scene, path: &Path, format: MeshFormat) -> Result<(), SaveError> {
+    let err = |kind| SaveError { path: path.to_path_buf(), kind };
+    match format {
+        MeshFormat::Stl | MeshFormat::StlAscii => {
+            let meshes = placed_meshes(scene);
+            let tris = f32_triangles(&meshes).map_err(err)?;
+            let name = stl_name(scene);
+            write_atomically(path, |f| -> Result<(), SaveErrorKind> {
+                let mut w = BufWriter::new(f);
+                if format == MeshFormat::Stl {
+                    conduit_stl::write_binary(&mut w, &name, &tris)?;
+                } else {
+                    conduit_stl::write_ascii(&mut w, &name, &tris)?;
+                }
+                w.flush()?;
+                Ok(())
+            })
+            .map_err(err)
+        }
+        MeshFormat::ThreeMf => {
+            let model = to_3mf_model(scene);
+            write_atomically(path, |f| -> Result<(), SaveErrorKind> {
+                let mut w = BufWriter::new(f);
+                conduit_3mf::write(&mut w, &model)?;
+                w.flush()?;
+                Ok(())
+            })
+            .map_err(err)
+        }
+        MeshFormat::Obj => {
+            let objects: Vec<conduit_obj::ObjObject> = placed_meshes(scene)
+                .into_iter()
+                .map(|m| conduit_obj::ObjObject {
+                    name: m.name.clone(),
+                    vertices: m.vertices.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                    triangles: m.triangles,
+                })
+                .collect();
+            write_atomically(path, |f| -> Result<(), SaveErrorKind> {
+                let mut w = BufWriter::new(f);
+                conduit_obj::write(&mut w, &objects)?;
+                w.flush()?;
+                Ok(())
+            })
+            .map_err(err)
+        }
+    }
+}
+
+fn stl_name(scene: &Scene) -> String {
+    match scene.objects.as_slice() {
+        [one] => one.name.clone(),
+        _ => "conduit".to_string(),
+    }
+}

@@ -1,0 +1,64 @@
+//! Helpers shared by the integration tests: running the binary, finding the corpus, temp dirs.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The project root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The shared corpus, or `None` (after printing a skip line) when it is not beside the checkout.
+pub fn corpus() -> Option<PathBuf> {
+    let dir = root().join("../shared/corpus");
+    if dir.join("MANIFEST.json").is_file() {
+        Some(dir)
+    } else {
+        println!("skipped: corpus not found at {}", dir.display());
+        None
+    }
+}
+
+/// A file of the project's own samples.
+pub fn sample(name: &str) -> PathBuf {
+    root().join("samples").join(name)
+}
+
+/// Runs the conduit binary with `args`.
+pub fn conduit<I, S>(args: I) -> Output
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    Command::new(env!("CARGO_BIN_EXE_conduit")).args(args).output().expect("the conduit binary runs")
+}
+
+/// Stdout of a run as text.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Stderr of a run as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A fresh temporary folder, removed when dropped.
+pub fn temp_dir() -> tempfile::TempDir {
+    tempfile::tempdir().expect("a temp dir can be made")
+}
+
+/// Files in a folder (not recursive), sorted.
+pub fn files_in(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|rd| rd.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// Reads the triangles of a binary or ASCII STL with the project's reader.
+pub fn stl_triangles(path: &Path) -> Vec<[[f32; 3]; 3]> {
+    let bytes = std::fs::read(path).expect("STL readable");
+    conduit_stl::read(&bytes).expect("STL parses").triangles
+}
