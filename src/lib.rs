@@ -19,3 +19,5 @@ pub mod geom;
 pub mod mesh;
 #[cfg(any())] // enabled once the format crates expose their APIs
 pub mod scene;
+pub mod region;
+pub mod slice;

@@ -5,11 +5,15 @@
 //! paths) is done in `f64` millimetres. Convert between the two only through [`scaled`] and
 //! [`unscaled`].
 
+mod clip;
 mod point;
 mod polygon;
 mod tolerances;
 mod transform;
 
+pub use clip::{
+    FillRule, Join, clip_polylines, difference, intersection, offset, polygons_to_expolygons, union,
+};
 pub use point::{Coord, Point2, Point3, Vector3, scaled, unscaled};
 pub use polygon::{ExPolygon, Polygon, Polyline};
 pub use tolerances::{Tolerance, Tolerances};

@@ -4,6 +4,7 @@
 //! Place in the pipeline: `scene` builds meshes from files; `slice` reads them. Coordinates are
 //! `f64` millimetres; source units are converted on read.
 
+mod edges;
 mod indexed;
 pub mod repair;
 pub mod topology;

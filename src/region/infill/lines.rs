@@ -1,0 +1,363 @@
+//! The machinery every line pattern shares: a family of parallel lines on a global lattice,
+//! clipped to the area, ordered to keep travel short, and joined into zig-zags along the boundary.
+//!
+//! **Lattice.** Line `k` of a family with direction `θ` and spacing `S` is the set of points `p`
+//! with `p · n = (k + phase) · S`, where `n` is `d = (cos θ, sin θ)` turned by +90°. The lattice is
+//! anchored at the origin, not at the area, so neighbouring areas (and the same area on other
+//! layers) share lines. A phase of ½ keeps lines off edges that sit on multiples of `S`.
+//!
+//! **Clipping.** The lines are clipped together, as one serpentine path whose hops between
+//! lines lie outside the area, with [`clip_polylines`].
+//!
+//! **Order.** Pieces are chained greedily: after each piece, the nearest free end of any other
+//! piece comes next (ties go to the lower index, so output is deterministic). On a convex area
+//! this is exactly the boustrophedon order.
+//!
+//! **Connection.** Two consecutive pieces on adjacent lines are joined by a straight connector
+//! when it is at most [`CONNECT_LIMIT`] spacings long and stays inside the area (no boundary edge
+//! is crossed by more than [`INSIDE_TOLERANCE_NM`], and its quarter points are inside or on the
+//! boundary). Connectors run along the boundary, so they are printed where the infill meets
+//! the innermost perimeter; they add about one boundary length per family to the extruded length.
+
+use crate::geom::{ExPolygon, Point2, Polygon, Polyline, clip_polylines, scaled};
+
+/// Longest connector, in line spacings (a boundary meeting the lines at 20° needs ~2.9).
+pub const CONNECT_LIMIT: f64 = 3.0;
+
+/// Rounding slack (nm) when deciding whether a connector leaves the area: clipped end points are
+/// rounded to the nanometre, so a connector along an edge can stray a few units either side.
+pub const INSIDE_TOLERANCE_NM: f64 = 100.0;
+
+/// Most lines one family may have (10 m of area at 0.1 mm spacing); finer spacings over larger
+/// areas give no lines rather than exhausting memory.
+pub const MAX_LINES: f64 = 1.0e5;
+
+/// One family of parallel lines.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LineFamily {
+    /// Direction of the lines, radians counter-clockwise from +X.
+    pub angle_rad: f64,
+    /// Distance between neighbouring lines, mm.
+    pub spacing_mm: f64,
+    /// Offset of the lattice from the origin, in spacings (0 ≤ phase < 1).
+    pub phase: f64,
+}
+
+/// A clipped piece and the lattice line it lies on.
+struct Piece {
+    points: Vec<Point2>,
+    line: i64,
+}
+
+/// Lines of `family` inside `area`, ordered and (when `connect`) joined into zig-zags.
+pub fn fill_family(area: &[ExPolygon], family: LineFamily, connect: bool) -> Vec<Polyline> {
+    let s = scaled(family.spacing_mm) as f64;
+    if area.is_empty() || s.is_nan() || s < 1.0 || !family.angle_rad.is_finite() {
+        return Vec::new();
+    }
+    let (d, n) = {
+        let (sin, cos) = family.angle_rad.sin_cos();
+        ((cos, sin), (-sin, cos))
+    };
+    let dot = |p: Point2, v: (f64, f64)| p.x as f64 * v.0 + p.y as f64 * v.1;
+    let (mut n_lo, mut n_hi, mut d_lo, mut d_hi) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in area.iter().map(|e| &e.contour).flat_map(|c| &c.points) {
+        let (pn, pd) = (dot(*p, n), dot(*p, d));
+        (n_lo, n_hi, d_lo, d_hi) = (n_lo.min(pn), n_hi.max(pn), d_lo.min(pd), d_hi.max(pd));
+    }
+    let k_lo = (n_lo / s - family.phase).ceil();
+    let k_hi = (n_hi / s - family.phase).floor();
+    if k_hi < k_lo || k_hi - k_lo > MAX_LINES {
+        return Vec::new();
+    }
+    // Extend past the area so clipping, not rounding, makes the ends.
+    let (t0, t1) = (d_lo - s, d_hi + s);
+    let at = |c: f64, t: f64| {
+        Point2::new(
+            (c * n.0 + t * d.0).round() as i64,
+            (c * n.1 + t * d.1).round() as i64,
+        )
+    };
+    // All lines as one serpentine: line k runs t0 → t1 when k is even, t1 → t0 when odd, and the
+    // hops between lines run outside the area (at t0 or t1), so clipping drops them. One clip of
+    // one path costs O((E + L) log) instead of L clips of O(E log E) each.
+    let serpentine: Vec<Point2> = (k_lo as i64..=k_hi as i64)
+        .flat_map(|k| {
+            let c = (k as f64 + family.phase) * s;
+            let (from, to) = if k.rem_euclid(2) == 0 {
+                (t0, t1)
+            } else {
+                (t1, t0)
+            };
+            [at(c, from), at(c, to)]
+        })
+        .collect();
+    let pieces: Vec<Piece> = clip_polylines(&[Polyline { points: serpentine }], area)
+        .into_iter()
+        .filter(|p| p.points.len() >= 2 && p.points[0] != p.points[p.points.len() - 1])
+        .map(|p| {
+            let line = (dot(p.points[0], n) / s - family.phase).round() as i64;
+            Piece {
+                points: p.points,
+                line,
+            }
+        })
+        .collect();
+    let ordered = order_nearest(pieces);
+    if connect {
+        join_adjacent(ordered, area, CONNECT_LIMIT * s)
+    } else {
+        ordered
+            .into_iter()
+            .map(|p| Polyline { points: p.points })
+            .collect()
+    }
+}
+
+/// Greedy nearest-neighbour chaining of `pieces`, reversing pieces as needed.
+fn order_nearest(pieces: Vec<Piece>) -> Vec<Piece> {
+    let mut free: Vec<Option<Piece>> = pieces.into_iter().map(Some).collect();
+    let mut out: Vec<Piece> = Vec::with_capacity(free.len());
+    let Some(first) = free.first_mut().and_then(Option::take) else {
+        return out;
+    };
+    let mut here = first.points[first.points.len() - 1];
+    out.push(first);
+    while out.len() < free.len() {
+        let mut best: Option<(i128, usize, bool)> = None;
+        for (i, piece) in free.iter().enumerate() {
+            let Some(piece) = piece else { continue };
+            let start = here.distance_squared(piece.points[0]);
+            let end = here.distance_squared(piece.points[piece.points.len() - 1]);
+            let (dist, reverse) = if end < start {
+                (end, true)
+            } else {
+                (start, false)
+            };
+            if best.is_none_or(|(b, _, _)| dist < b) {
+                best = Some((dist, i, reverse));
+            }
+        }
+        let Some((_, i, reverse)) = best else { break };
+        let Some(mut piece) = free[i].take() else {
+            break;
+        };
+        if reverse {
+            piece.points.reverse();
+        }
+        here = piece.points[piece.points.len() - 1];
+        out.push(piece);
+    }
+    out
+}
+
+/// Joins consecutive pieces on adjacent lines whose connector is short and inside `area`.
+fn join_adjacent(pieces: Vec<Piece>, area: &[ExPolygon], max_len_nm: f64) -> Vec<Polyline> {
+    let mut out: Vec<Polyline> = Vec::new();
+    let mut last_line: Option<i64> = None;
+    for piece in pieces {
+        if let (Some(prev), Some(line)) = (out.last_mut(), last_line) {
+            let a = prev.points[prev.points.len() - 1];
+            let b = piece.points[0];
+            let adjacent = (piece.line - line).abs() == 1;
+            let short = (a.distance_squared(b) as f64).sqrt() <= max_len_nm;
+            if adjacent && short && segment_inside(a, b, area) {
+                prev.points.extend(piece.points);
+                last_line = Some(piece.line);
+                continue;
+            }
+        }
+        last_line = Some(piece.line);
+        out.push(Polyline {
+            points: piece.points,
+        });
+    }
+    out
+}
+
+/// Every ring of `area` (contours and holes).
+fn rings(area: &[ExPolygon]) -> impl Iterator<Item = &Polygon> {
+    area.iter()
+        .flat_map(|e| std::iter::once(&e.contour).chain(&e.holes))
+}
+
+/// Distance (nm) from `p` to the segment `a`–`b`.
+fn distance_to_segment(p: Point2, a: Point2, b: Point2) -> f64 {
+    let (dx, dy) = ((b.x - a.x) as f64, (b.y - a.y) as f64);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        (((p.x - a.x) as f64 * dx + (p.y - a.y) as f64 * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    ((a.x as f64 + t * dx - p.x as f64).powi(2) + (a.y as f64 + t * dy - p.y as f64).powi(2)).sqrt()
+}
+
+/// Whether `p` is inside `area` (even–odd over all rings) or within [`INSIDE_TOLERANCE_NM`] of
+/// its boundary.
+pub fn contains(area: &[ExPolygon], p: Point2) -> bool {
+    let mut inside = false;
+    for ring in rings(area) {
+        let pts = &ring.points;
+        for i in 0..pts.len() {
+            let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+            if distance_to_segment(p, a, b) <= INSIDE_TOLERANCE_NM {
+                return true;
+            }
+            if (a.y > p.y) != (b.y > p.y) {
+                // x of the edge at p.y, compared exactly: p is left of the crossing when
+                // (p.x − a.x)·(b.y − a.y) < (b.x − a.x)·(p.y − a.y), sign-adjusted for b.y < a.y.
+                let lhs = (p.x - a.x) as i128 * (b.y - a.y) as i128;
+                let rhs = (b.x - a.x) as i128 * (p.y - a.y) as i128;
+                if (lhs < rhs) == (b.y > a.y) {
+                    inside = !inside;
+                }
+            }
+        }
+    }
+    inside
+}
+
+/// Signed distance (nm) of `p` from the line through `a` and `b` (positive on the left).
+fn side(a: Point2, b: Point2, p: Point2) -> f64 {
+    let len = (a.distance_squared(b) as f64).sqrt();
+    if len == 0.0 {
+        0.0
+    } else {
+        a.cross(b, p) as f64 / len
+    }
+}
+
+/// Whether the segment `a`–`b` stays inside `area`, up to [`INSIDE_TOLERANCE_NM`].
+pub fn segment_inside(a: Point2, b: Point2, area: &[ExPolygon]) -> bool {
+    let tol = INSIDE_TOLERANCE_NM;
+    let (lo_x, hi_x) = (a.x.min(b.x) as f64 - tol, a.x.max(b.x) as f64 + tol);
+    let (lo_y, hi_y) = (a.y.min(b.y) as f64 - tol, a.y.max(b.y) as f64 + tol);
+    for ring in rings(area) {
+        let pts = &ring.points;
+        for i in 0..pts.len() {
+            let (p, q) = (pts[i], pts[(i + 1) % pts.len()]);
+            if (p.x.max(q.x) as f64) < lo_x
+                || (p.x.min(q.x) as f64) > hi_x
+                || (p.y.max(q.y) as f64) < lo_y
+                || (p.y.min(q.y) as f64) > hi_y
+            {
+                continue;
+            }
+            let (sa, sb) = (side(p, q, a), side(p, q, b));
+            let (sp, sq) = (side(a, b, p), side(a, b, q));
+            let proper = |u: f64, v: f64| (u > tol && v < -tol) || (u < -tol && v > tol);
+            if proper(sa, sb) && proper(sp, sq) {
+                return false;
+            }
+        }
+    }
+    [0.25, 0.5, 0.75].iter().all(|&t| {
+        let m = Point2::new(
+            a.x + ((b.x - a.x) as f64 * t).round() as i64,
+            a.y + ((b.y - a.y) as f64 * t).round() as i64,
+        );
+        contains(area, m)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::region::test_util::{polyline_length, rect_island, square_island};
+
+    #[test]
+    fn horizontal_family_over_a_square_is_one_zigzag() {
+        let area = [square_island(0.0, 0.0, 10.0)];
+        let family = LineFamily {
+            angle_rad: 0.0,
+            spacing_mm: 1.0,
+            phase: 0.5,
+        };
+        let loose = fill_family(&area, family, false);
+        assert_eq!(loose.len(), 10);
+        for (i, l) in loose.iter().enumerate() {
+            assert_eq!(l.points.len(), 2);
+            assert_eq!(l.points[0].y, scaled(i as f64 + 0.5));
+            assert!((polyline_length(l) - 10.0).abs() < 1e-6);
+        }
+        // Boustrophedon: every other line runs right to left.
+        assert!(loose[0].points[0].x < loose[0].points[1].x);
+        assert!(loose[1].points[0].x > loose[1].points[1].x);
+        let joined = fill_family(&area, family, true);
+        assert_eq!(joined.len(), 1);
+        assert_eq!(joined[0].points.len(), 20);
+        assert!((polyline_length(&joined[0]) - (100.0 + 9.0)).abs() < 1e-5);
+    }
+
+    #[test]
+    fn connectors_do_not_cross_a_notch() {
+        // A U shape: lines across both arms must not be joined across the notch.
+        let u = crate::geom::ExPolygon {
+            contour: Polygon::new(vec![
+                Point2::from_mm(0.0, 0.0),
+                Point2::from_mm(10.0, 0.0),
+                Point2::from_mm(10.0, 10.0),
+                Point2::from_mm(6.0, 10.0),
+                Point2::from_mm(6.0, 2.0),
+                Point2::from_mm(4.0, 2.0),
+                Point2::from_mm(4.0, 10.0),
+                Point2::from_mm(0.0, 10.0),
+            ]),
+            holes: vec![],
+        };
+        let family = LineFamily {
+            angle_rad: 0.0,
+            spacing_mm: 1.0,
+            phase: 0.5,
+        };
+        let area = [u];
+        for l in fill_family(&area, family, true) {
+            for w in l.points.windows(2) {
+                assert!(segment_inside(w[0], w[1], &area), "{:?} leaves the U", w);
+                let (x0, x1) = (w[0].x.min(w[1].x), w[0].x.max(w[1].x));
+                let y0 = w[0].y.min(w[1].y);
+                // Nothing printed over the notch (4 < x < 6, y > 2).
+                assert!(
+                    !(x0 < scaled(5.0) && x1 > scaled(5.0) && y0 > scaled(2.0)),
+                    "{w:?}"
+                );
+            }
+        }
+        assert!(!segment_inside(
+            Point2::from_mm(3.0, 5.0),
+            Point2::from_mm(7.0, 5.0),
+            &area
+        ));
+        assert!(segment_inside(
+            Point2::from_mm(10.0, 3.0),
+            Point2::from_mm(10.0, 8.0),
+            &area
+        ));
+    }
+
+    #[test]
+    fn tiny_or_invalid_spacing_gives_nothing() {
+        let area = [rect_island(0.0, 0.0, 10.0, 1.0)];
+        for spacing_mm in [0.0, -1.0, f64::NAN, 1e-7] {
+            let f = LineFamily {
+                angle_rad: 0.3,
+                spacing_mm,
+                phase: 0.5,
+            };
+            assert!(fill_family(&area, f, true).is_empty(), "{spacing_mm}");
+        }
+        assert!(
+            fill_family(
+                &[],
+                LineFamily {
+                    angle_rad: 0.0,
+                    spacing_mm: 1.0,
+                    phase: 0.5
+                },
+                true
+            )
+            .is_empty()
+        );
+    }
+}

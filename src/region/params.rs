@@ -1,0 +1,302 @@
+//! Parameters of the regions stage and the extrusion spacing model they imply.
+//!
+//! # Flow model
+//!
+//! An extrusion of width `w` and height `h` is modelled, as in PrusaSlicer's `Flow`, as a rectangle
+//! with two semicircular ends (a rounded rectangle): area `(w − h)·h + π·h²/4`. Two adjacent
+//! extrusions touch along their flat sides and overlap only where the rounded ends would leave a
+//! void, so the distance between their centrelines (the *spacing*) is
+//!
+//! ```text
+//! spacing = w − h·(1 − π/4)
+//! ```
+//!
+//! For `w = 0.45 mm` and `h = 0.2 mm` this is `0.45 − 0.2·0.2146 = 0.40708 mm`. Every distance
+//! between neighbouring loops or lines in this module is such a spacing; the distance from an
+//! island's edge to its external loop's centreline is half the external perimeter *width*, so the
+//! printed outer surface lands on the sliced contour.
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// Which infill pattern sparse infill uses (solid infill is always rectilinear at 100 %).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum InfillPatternKind {
+    /// Parallel lines, direction alternating by 90° layer by layer.
+    #[default]
+    Rectilinear,
+    /// Lines in both directions on every layer.
+    Grid,
+    /// Three line families at 60° forming equilateral triangles on every layer.
+    Triangles,
+}
+
+/// Parameters of perimeter, skin, infill and skirt generation. Lengths in millimetres.
+///
+/// Defaults (what `RegionParams::default()` gives and what a config section may omit) are noted on
+/// each field; they are PrusaSlicer's for a 0.4 mm nozzle at 0.2 mm layers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RegionParams {
+    /// Number of perimeter loops per island, the external one included. Default 2.
+    pub perimeters: usize,
+    /// Extrusion width of the external (outermost) loop, mm. Default 0.45.
+    pub external_perimeter_width: f64,
+    /// Extrusion width of the inner loops, mm. Default 0.45.
+    pub perimeter_width: f64,
+    /// Extrusion width of sparse infill lines, mm. Default 0.45.
+    pub infill_width: f64,
+    /// Extrusion width of solid (top, bottom, internal solid) infill lines, mm. Default 0.45.
+    pub solid_infill_width: f64,
+    /// Number of solid layers under every upward-facing surface. Default 3.
+    pub top_solid_layers: usize,
+    /// Number of solid layers over every downward-facing surface (and at the bed). Default 3.
+    pub bottom_solid_layers: usize,
+    /// Density of sparse infill, 0 (none) to 1 (solid). Lines are `spacing / density` apart.
+    /// Default 0.2.
+    pub infill_density: f64,
+    /// Pattern of sparse infill. Default `rectilinear`.
+    pub infill_pattern: InfillPatternKind,
+    /// Base direction of infill lines, degrees counter-clockwise from +X. Default 45.
+    pub infill_angle_deg: f64,
+    /// How far infill reaches into the innermost perimeter, as a fraction of `perimeter_width`, so
+    /// the two bond. Default 0.25 (solid and sparse infill share it, as in PrusaSlicer).
+    pub infill_overlap: f64,
+    /// How far solid areas are grown into the neighbouring sparse area (mm) so they are anchored
+    /// on the infill around them. Internal solid zones are grown by the perimeter band width on
+    /// top of this, so they reach under the perimeters of a part standing on them (see
+    /// `region::skins`). Default 0.5.
+    pub solid_infill_margin: f64,
+    /// Print the external loop of each island first (better dimensional accuracy, worse
+    /// overhangs). Default false: inner loops first.
+    pub external_perimeters_first: bool,
+    /// Number of skirt loops around the first layer. Default 0 (no skirt).
+    pub skirt_loops: usize,
+    /// Clear gap between the first layer's islands and the inner edge of the skirt, mm. Default 6.
+    pub skirt_distance: f64,
+    /// Nozzle diameter, mm. Default 0.4. Used by [`RegionParams::validate`]: widths below it are
+    /// rejected.
+    pub nozzle_diameter: f64,
+    /// Layer height, mm, used in the spacing formula when no per-layer heights are given.
+    /// Default 0.2.
+    pub layer_height: f64,
+}
+
+impl Default for RegionParams {
+    fn default() -> Self {
+        Self {
+            perimeters: 2,
+            external_perimeter_width: 0.45,
+            perimeter_width: 0.45,
+            infill_width: 0.45,
+            solid_infill_width: 0.45,
+            top_solid_layers: 3,
+            bottom_solid_layers: 3,
+            infill_density: 0.2,
+            infill_pattern: InfillPatternKind::Rectilinear,
+            infill_angle_deg: 45.0,
+            infill_overlap: 0.25,
+            solid_infill_margin: 0.5,
+            external_perimeters_first: false,
+            skirt_loops: 0,
+            skirt_distance: 6.0,
+            nozzle_diameter: 0.4,
+            layer_height: 0.2,
+        }
+    }
+}
+
+/// One problem found by [`RegionParams::validate`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParamError {
+    /// A length that must be finite and positive is not.
+    ///
+    /// How to fix: give a positive number of millimetres.
+    #[error("{field} must be a finite length > 0 mm, got {value}")]
+    NotPositive {
+        /// The field name.
+        field: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// An extrusion is narrower than the nozzle or not wider than the layer is high, so the flow
+    /// model has no meaning.
+    ///
+    /// How to fix: use widths between the nozzle diameter and about 2× it, and above the layer
+    /// height.
+    #[error(
+        "{field} = {width} mm must be ≥ nozzle_diameter ({nozzle}) and > layer height ({height})"
+    )]
+    BadWidth {
+        /// The field name.
+        field: &'static str,
+        /// The width given.
+        width: f64,
+        /// The nozzle diameter.
+        nozzle: f64,
+        /// The layer height.
+        height: f64,
+    },
+    /// A fraction is outside its range.
+    ///
+    /// How to fix: `infill_density` is between 0 and 1, `infill_overlap` between 0 and 1.
+    #[error("{field} must be between 0 and 1, got {value}")]
+    NotAFraction {
+        /// The field name.
+        field: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// An angle is infinite or NaN.
+    ///
+    /// How to fix: give a finite number of degrees.
+    #[error("{field} must be finite, got {value}")]
+    NotFinite {
+        /// The field name.
+        field: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// A length that may be zero is negative or not finite.
+    ///
+    /// How to fix: give zero or a positive number of millimetres.
+    #[error("{field} must be a finite length ≥ 0 mm, got {value}")]
+    Negative {
+        /// The field name.
+        field: &'static str,
+        /// The value given.
+        value: f64,
+    },
+}
+
+/// Distance between the centrelines of two adjacent extrusions of width `width` and height
+/// `height` (mm): `width − height·(1 − π/4)`, the rounded-rectangle model of the module docs.
+pub fn spacing(width: f64, height: f64) -> f64 {
+    width - height * (1.0 - PI / 4.0)
+}
+
+impl RegionParams {
+    /// Every problem with these parameters (empty when they are usable).
+    pub fn validate(&self) -> Vec<ParamError> {
+        let mut errors = Vec::new();
+        for (field, value) in [
+            ("nozzle_diameter", self.nozzle_diameter),
+            ("layer_height", self.layer_height),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                errors.push(ParamError::NotPositive { field, value });
+            }
+        }
+        for (field, width) in [
+            ("external_perimeter_width", self.external_perimeter_width),
+            ("perimeter_width", self.perimeter_width),
+            ("infill_width", self.infill_width),
+            ("solid_infill_width", self.solid_infill_width),
+        ] {
+            if !(width.is_finite() && width >= self.nozzle_diameter && width > self.layer_height) {
+                errors.push(ParamError::BadWidth {
+                    field,
+                    width,
+                    nozzle: self.nozzle_diameter,
+                    height: self.layer_height,
+                });
+            }
+        }
+        for (field, value) in [
+            ("infill_density", self.infill_density),
+            ("infill_overlap", self.infill_overlap),
+        ] {
+            if !(0.0..=1.0).contains(&value) {
+                errors.push(ParamError::NotAFraction { field, value });
+            }
+        }
+        for (field, value) in [
+            ("solid_infill_margin", self.solid_infill_margin),
+            ("skirt_distance", self.skirt_distance),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                errors.push(ParamError::Negative { field, value });
+            }
+        }
+        if !self.infill_angle_deg.is_finite() {
+            errors.push(ParamError::NotFinite {
+                field: "infill_angle_deg",
+                value: self.infill_angle_deg,
+            });
+        }
+        errors
+    }
+
+    /// Spacings for one layer of height `height` (mm).
+    pub fn spacings(&self, height: f64) -> Spacings {
+        Spacings {
+            external_perimeter: spacing(self.external_perimeter_width, height),
+            perimeter: spacing(self.perimeter_width, height),
+            infill: spacing(self.infill_width, height),
+            solid_infill: spacing(self.solid_infill_width, height),
+        }
+    }
+}
+
+/// Centreline spacings (mm) of each extrusion kind for one layer height; see [`spacing`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spacings {
+    /// Spacing of external perimeter extrusions.
+    pub external_perimeter: f64,
+    /// Spacing of inner perimeter extrusions.
+    pub perimeter: f64,
+    /// Spacing of sparse infill extrusions at 100 % density.
+    pub infill: f64,
+    /// Spacing of solid infill lines.
+    pub solid_infill: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spacing_follows_the_rounded_rectangle_model() {
+        // 0.45 − 0.2·(1 − π/4) = 0.45 − 0.0429204 = 0.4070796
+        assert!((spacing(0.45, 0.2) - 0.407_079_6).abs() < 1e-7);
+        // A square-ish bead (width = height) loses exactly the corner voids.
+        assert!((spacing(0.3, 0.3) - 0.3 * PI / 4.0).abs() < 1e-12);
+        let s = RegionParams::default().spacings(0.2);
+        assert_eq!(s.perimeter, s.external_perimeter);
+        assert!((s.solid_infill - 0.407_079_6).abs() < 1e-7);
+    }
+
+    #[test]
+    fn defaults_validate_and_bad_values_are_all_reported() {
+        assert!(RegionParams::default().validate().is_empty());
+        let bad = RegionParams {
+            perimeter_width: 0.3,
+            infill_density: 1.5,
+            layer_height: -0.1,
+            ..RegionParams::default()
+        };
+        let errors = bad.validate();
+        assert_eq!(errors.len(), 3, "{errors:?}");
+        assert!(matches!(
+            errors[0],
+            ParamError::NotPositive {
+                field: "layer_height",
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn params_round_trip_through_json_with_defaults_filled_in() -> Result<(), serde_json::Error> {
+        let p: RegionParams =
+            serde_json::from_str(r#"{"perimeters": 3, "infill_pattern": "grid"}"#)?;
+        assert_eq!(p.perimeters, 3);
+        assert_eq!(p.infill_pattern, InfillPatternKind::Grid);
+        assert_eq!(p.skirt_distance, 6.0);
+        let back: RegionParams = serde_json::from_str(&serde_json::to_string(&p)?)?;
+        assert_eq!(back, p);
+        assert!(serde_json::from_str::<RegionParams>(r#"{"perimetres": 3}"#).is_err());
+        Ok(())
+    }
+}

@@ -1,0 +1,351 @@
+//! Top, bottom and internal solid areas ("skins") and the sparse rest of each layer's infill area.
+//!
+//! Layer `i` has islands `I_i` and infill area `A_i` (from [`super::perimeters`]); there are `N_b`
+//! bottom and `N_t` top solid layers.
+//!
+//! - **bottom zone** `A_i − (I_(i−1) ∩ … ∩ I_(i−N_b))`: infill area that is not over material on
+//!   *every* one of the `N_b` layers below, i.e. lies within `N_b` layers of a downward-facing
+//!   surface. Layers that do not exist count as empty, so layers `0 … N_b−1` are solid entirely.
+//! - **top zone** likewise with `I_(i+1) … I_(i+N_t)`, so the last `N_t` layers are solid.
+//!
+//! Roles: the part of `A_i` outside `I_(i+1)` (exposed to the top) is [`SolidRole::Top`]; the
+//! part outside `I_(i−1)` (over air or the bed) is [`SolidRole::Bottom`], which wins where both
+//! apply (it is printed on nothing and must bridge); the rest of the zones is
+//! [`SolidRole::Internal`].
+//!
+//! **Why islands, not infill areas, as cover.** Comparing infill areas would also count the ring
+//! under the perimeters of the layers above as "uncovered". On a sloped wall that ring is there on
+//! every layer (a 0.1 mm/layer slope gave a 0.8 mm solid ring of ~300 short lines on each layer of
+//! a 150 mm disc), although the perimeters above already make the shell thick enough. With
+//! islands as cover, a wall receding by `δ` per layer gets solid infill only where `N·δ` exceeds
+//! the perimeter band, i.e. where the perimeters alone are thinner than `N` layers.
+//!
+//! **Under a step.** Where a smaller part stands on a larger one, its perimeters stand on the
+//! larger part's top layers. Zones are therefore grown by the perimeter band width
+//! ([`super::perimeters::infill_inset`]) plus `solid_infill_margin`, so solid infill reaches under
+//! the whole perimeter band of the part above and is anchored beyond it. Exposed top and bottom
+//! surfaces are grown by `solid_infill_margin` only. Everything is limited to the infill area.
+//!
+//! **Slivers.** Each difference is first *opened* by a quarter of the solid infill width, so
+//! slivers narrower than half an extrusion give no solid infill. Layers solid throughout (the
+//! first `N_b`, the last `N_t`) are taken whole.
+
+use super::params::RegionParams;
+use super::perimeters::{PERIMETER_JOIN, infill_inset, shrink_opened};
+use crate::geom::{ExPolygon, difference, intersection, offset, union};
+use rayon::prelude::*;
+
+/// What a solid area is for, which decides its speed and cooling downstream.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolidRole {
+    /// Visible upward-facing surface.
+    Top,
+    /// Downward-facing surface over air or on the bed.
+    Bottom,
+    /// Solid layers between a surface and sparse infill.
+    Internal,
+}
+
+/// A layer's infill area split by role. The four parts are disjoint and together make the infill
+/// area (up to the margins explained in the module docs).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SkinAreas {
+    /// Solid areas over air or the bed.
+    pub bottom: Vec<ExPolygon>,
+    /// Solid areas with nothing above.
+    pub top: Vec<ExPolygon>,
+    /// Other solid areas within the top/bottom solid layer counts.
+    pub internal_solid: Vec<ExPolygon>,
+    /// The rest, filled with the sparse pattern.
+    pub sparse: Vec<ExPolygon>,
+}
+
+impl SkinAreas {
+    /// The solid areas with their roles, in print order: bottom, internal, top.
+    pub fn solid(&self) -> [(SolidRole, &[ExPolygon]); 3] {
+        [
+            (SolidRole::Bottom, &self.bottom),
+            (SolidRole::Internal, &self.internal_solid),
+            (SolidRole::Top, &self.top),
+        ]
+    }
+}
+
+/// Intersection of all of `layers`; empty if `layers` is empty.
+fn intersect_all(layers: &[Vec<ExPolygon>]) -> Vec<ExPolygon> {
+    let Some((first, rest)) = layers.split_first() else {
+        return Vec::new();
+    };
+    let mut acc = first.clone();
+    for layer in rest {
+        if acc.is_empty() {
+            break;
+        }
+        acc = intersection(&acc, layer);
+    }
+    acc
+}
+
+/// Skin areas of every layer. `islands[i]` are layer `i`'s sliced islands, `infill[i]` its
+/// infill area and `heights[i]` its height (mm), bottom to top; missing heights count as
+/// `params.layer_height`. Layers are independent given these inputs, so they are computed in
+/// parallel; the result does not depend on the thread count.
+pub fn detect_skins(
+    islands: &[Vec<ExPolygon>],
+    infill: &[Vec<ExPolygon>],
+    heights: &[f64],
+    params: &RegionParams,
+) -> Vec<SkinAreas> {
+    (0..infill.len().min(islands.len()))
+        .into_par_iter()
+        .map(|i| {
+            let height = heights.get(i).copied().unwrap_or(params.layer_height);
+            layer_skins(i, islands, infill, height, params)
+        })
+        .collect()
+}
+
+/// Skin areas of layer `i` (< both lengths), `height` mm high; see [`detect_skins`].
+fn layer_skins(
+    i: usize,
+    islands: &[Vec<ExPolygon>],
+    infill: &[Vec<ExPolygon>],
+    height: f64,
+    params: &RegionParams,
+) -> SkinAreas {
+    let area = &infill[i];
+    if area.is_empty() {
+        return SkinAreas::default();
+    }
+    let last = infill.len().min(islands.len()) - 1;
+    let (nb, nt) = (params.bottom_solid_layers, params.top_solid_layers);
+    let sliver = params.solid_infill_width / 4.0;
+    let margin = params.solid_infill_margin.max(0.0);
+    let band = infill_inset(params, height).max(0.0);
+    // Opened (unless taken whole), grown by `grow`, limited to the infill area.
+    let limit = |raw: Vec<ExPolygon>, whole: bool, grow: f64| -> Vec<ExPolygon> {
+        if whole {
+            return area.clone();
+        }
+        let opened = shrink_opened(&raw, 0.0, sliver);
+        if opened.is_empty() || grow <= 0.0 {
+            return opened;
+        }
+        intersection(&offset(&opened, grow, PERIMETER_JOIN), area)
+    };
+    let empty = || (Vec::new(), false);
+
+    let (exposed_bottom, bottom_whole) = match (nb, i) {
+        (0, _) => empty(),
+        (_, 0) => (Vec::new(), true),
+        _ => (difference(area, &islands[i - 1]), false),
+    };
+    let (exposed_top, top_whole) = match nt {
+        0 => empty(),
+        _ if i == last => (Vec::new(), true),
+        _ => (difference(area, &islands[i + 1]), false),
+    };
+    let (zone_bottom, zone_bottom_whole) = match nb {
+        0 => empty(),
+        _ if i < nb => (Vec::new(), true),
+        _ => (difference(area, &intersect_all(&islands[i - nb..i])), false),
+    };
+    let (zone_top, zone_top_whole) = match nt {
+        0 => empty(),
+        _ if i + nt > last => (Vec::new(), true),
+        _ => (
+            difference(area, &intersect_all(&islands[i + 1..=i + nt])),
+            false,
+        ),
+    };
+
+    let bottom = if bottom_whole || !exposed_bottom.is_empty() {
+        limit(exposed_bottom, bottom_whole, margin)
+    } else {
+        Vec::new()
+    };
+    let mut top = if top_whole || !exposed_top.is_empty() {
+        limit(exposed_top, top_whole, margin)
+    } else {
+        Vec::new()
+    };
+    if !top.is_empty() && !bottom.is_empty() {
+        top = difference(&top, &bottom);
+    }
+    let zone_whole = zone_bottom_whole || zone_top_whole;
+    let zone = if zone_whole {
+        Vec::new()
+    } else {
+        match (zone_bottom.is_empty(), zone_top.is_empty()) {
+            (true, true) => Vec::new(),
+            (false, true) => zone_bottom,
+            (true, false) => zone_top,
+            (false, false) => union(&[zone_bottom, zone_top].concat()),
+        }
+    };
+    let surfaces: Vec<ExPolygon> = [bottom.as_slice(), top.as_slice()].concat();
+    let mut internal_solid = if zone_whole || !zone.is_empty() {
+        limit(zone, zone_whole, band + margin)
+    } else {
+        Vec::new()
+    };
+    if !internal_solid.is_empty() && !surfaces.is_empty() {
+        internal_solid = difference(&internal_solid, &surfaces);
+    }
+    let solid: Vec<ExPolygon> = [surfaces.as_slice(), internal_solid.as_slice()].concat();
+    let sparse = if solid.is_empty() {
+        area.clone()
+    } else {
+        difference(area, &solid)
+    };
+    SkinAreas {
+        bottom,
+        top,
+        internal_solid,
+        sparse,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{Point2, Polygon};
+    use crate::region::perimeters::infill_inset;
+    use crate::region::perimeters::make_perimeters;
+    use crate::region::test_util::{contains, square_island, total_area};
+
+    /// Infill areas and skins of a stack of layers.
+    fn skins_of(stack: &[Vec<ExPolygon>], params: &RegionParams) -> Vec<SkinAreas> {
+        let infill: Vec<Vec<ExPolygon>> = stack
+            .iter()
+            .map(|l| make_perimeters(l, params, 0.2).infill_area)
+            .collect();
+        detect_skins(stack, &infill, &[], params)
+    }
+
+    #[test]
+    fn ten_identical_squares_are_solid_three_at_each_end() {
+        let params = RegionParams::default();
+        let stack = vec![vec![square_island(0.0, 0.0, 20.0)]; 10];
+        let skins = skins_of(&stack, &params);
+        let infill_area = total_area(&make_perimeters(&stack[0], &params, 0.2).infill_area);
+        for (i, s) in skins.iter().enumerate() {
+            let solid = total_area(&s.bottom) + total_area(&s.top) + total_area(&s.internal_solid);
+            let sparse = total_area(&s.sparse);
+            if (3..=6).contains(&i) {
+                assert!(
+                    solid < 1e-9 && (sparse - infill_area).abs() < 1e-6,
+                    "layer {i}: {s:?}"
+                );
+            } else {
+                assert!(
+                    sparse < 1e-9 && (solid - infill_area).abs() < 1e-6,
+                    "layer {i}: {s:?}"
+                );
+            }
+        }
+        assert!((total_area(&skins[0].bottom) - infill_area).abs() < 1e-6);
+        assert!((total_area(&skins[9].top) - infill_area).abs() < 1e-6);
+        for i in [1, 2, 7, 8] {
+            assert!(
+                (total_area(&skins[i].internal_solid) - infill_area).abs() < 1e-6,
+                "{i}"
+            );
+        }
+    }
+
+    #[test]
+    fn step_makes_the_top_of_the_big_part_solid_up_to_under_the_step_edge() {
+        let params = RegionParams::default();
+        // Big 20 mm square for layers 0–5, small 10 mm square (5..15) for layers 6–11.
+        let mut stack = vec![vec![square_island(0.0, 0.0, 20.0)]; 6];
+        stack.extend(vec![vec![square_island(5.0, 5.0, 10.0)]; 6]);
+        let skins = skins_of(&stack, &params);
+        let at = |a: &[ExPolygon], x: f64, y: f64| contains(a, Point2::from_mm(x, y));
+        let solid = |s: &SkinAreas, x, y| {
+            at(&s.top, x, y) || at(&s.internal_solid, x, y) || at(&s.bottom, x, y)
+        };
+        // The last big layer: the uncovered ring is a top surface.
+        assert!(at(&skins[5].top, 2.0, 10.0));
+        // Under the small part's perimeters (0.8 mm inside its edge, past the top margin): solid, but not top.
+        assert!(at(&skins[5].internal_solid, 5.8, 10.0));
+        assert!(!at(&skins[5].top, 5.8, 10.0));
+        // Layers 3 and 4 are within 3 layers of that top surface.
+        for i in [3, 4] {
+            assert!(at(&skins[i].internal_solid, 2.0, 10.0), "layer {i}");
+            assert!(at(&skins[i].internal_solid, 5.8, 10.0), "layer {i}");
+        }
+        // The middle of the small part is sparse all the way from layer 3 to layer 8.
+        for (i, s) in skins.iter().enumerate().take(9).skip(3) {
+            assert!(
+                at(&s.sparse, 10.0, 10.0) && !solid(s, 10.0, 10.0),
+                "layer {i}"
+            );
+        }
+        // The solid ring stops a margin past the small part's infill area.
+        assert!(at(&skins[5].sparse, 7.0, 10.0));
+        // The small part's first layers stand on the solid ring: not solid themselves.
+        assert!(!solid(&skins[6], 10.0, 10.0));
+        assert!(at(&skins[11].top, 10.0, 10.0));
+    }
+
+    #[test]
+    fn zero_solid_layers_leave_everything_sparse_and_single_layer_is_bottom() {
+        let none = RegionParams {
+            top_solid_layers: 0,
+            bottom_solid_layers: 0,
+            ..Default::default()
+        };
+        let stack = vec![vec![square_island(0.0, 0.0, 20.0)]; 4];
+        for s in skins_of(&stack, &none) {
+            assert!(s.bottom.is_empty() && s.top.is_empty() && s.internal_solid.is_empty());
+            assert_eq!(s.sparse.len(), 1);
+        }
+        let one = skins_of(&stack[..1], &RegionParams::default());
+        assert_eq!(one[0].bottom.len(), 1);
+        assert!(one[0].top.is_empty() && one[0].sparse.is_empty());
+    }
+
+    /// Ten layers of a square pyramid frustum whose walls recede by `step` mm per layer.
+    fn frustum(step: f64) -> Vec<Vec<ExPolygon>> {
+        (0..10)
+            .map(|i| {
+                let d = step * i as f64;
+                vec![ExPolygon {
+                    contour: Polygon::new(vec![
+                        Point2::from_mm(d, d),
+                        Point2::from_mm(40.0 - d, d),
+                        Point2::from_mm(40.0 - d, 40.0 - d),
+                        Point2::from_mm(d, 40.0 - d),
+                    ]),
+                    holes: vec![],
+                }]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn steep_walls_get_no_solid_but_shallow_slopes_do() {
+        let params = RegionParams::default();
+        let band = infill_inset(&params, 0.2);
+        // 0.02 and 0.1 mm per layer: three layers recede less than the perimeter band (≈ 0.93 mm).
+        for step in [0.02, 0.1] {
+            assert!(3.0 * step < band);
+            let skins = skins_of(&frustum(step), &params);
+            for (i, s) in skins.iter().enumerate().take(7).skip(3) {
+                let none = s.internal_solid.is_empty() && s.top.is_empty() && s.bottom.is_empty();
+                assert!(none, "step {step}, layer {i}: {s:?}");
+            }
+        }
+        // 0.6 mm per layer: the perimeters alone are thinner than three layers, so the rim of
+        // each middle layer is solid, its centre sparse.
+        let skins = skins_of(&frustum(0.6), &params);
+        let at = |a: &[ExPolygon], x: f64, y: f64| contains(a, Point2::from_mm(x, y));
+        for (i, s) in skins.iter().enumerate().take(7).skip(3) {
+            let rim = 0.6 * i as f64 + band + 0.3;
+            assert!(at(&s.internal_solid, rim, 20.0), "layer {i}");
+            assert!(at(&s.sparse, 20.0, 20.0), "layer {i}");
+        }
+    }
+}
