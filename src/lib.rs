@@ -17,7 +17,6 @@
 
 pub mod geom;
 pub mod mesh;
-#[cfg(any())] // enabled once the format crates expose their APIs
-pub mod scene;
 pub mod region;
+pub mod scene;
 pub mod slice;

@@ -44,21 +44,41 @@ pub(crate) fn run(args: ConvertArgs) -> Result<(), Failure> {
 
 /// Turns the arguments into jobs, rejecting ambiguous or colliding outputs before any work runs.
 fn plan(args: &ConvertArgs) -> Result<Vec<Job>, Failure> {
-    let ascii = |f: MeshFormat| if args.ascii && f == MeshFormat::Stl { MeshFormat::StlAscii } else { f };
+    let ascii = |f: MeshFormat| {
+        if args.ascii && f == MeshFormat::Stl {
+            MeshFormat::StlAscii
+        } else {
+            f
+        }
+    };
     if let Some(out) = &args.output {
         if args.inputs.len() != 1 {
-            return Err(Failure::Usage("-o takes exactly one input; use --to and --out-dir for several".into()));
+            return Err(Failure::Usage(
+                "-o takes exactly one input; use --to and --out-dir for several".into(),
+            ));
         }
         let format = MeshFormat::from_path(out).ok_or_else(|| {
-            Failure::Usage(format!("{}: output extension must be .stl, .3mf or .obj", out.display()))
+            Failure::Usage(format!(
+                "{}: output extension must be .stl, .3mf or .obj",
+                out.display()
+            ))
         })?;
-        return Ok(vec![Job { input: args.inputs[0].clone(), output: out.clone(), format: ascii(format) }]);
+        return Ok(vec![Job {
+            input: args.inputs[0].clone(),
+            output: out.clone(),
+            format: ascii(format),
+        }]);
     }
     let (Some(format), Some(dir)) = (args.to, args.out_dir.as_ref()) else {
-        return Err(Failure::Usage("give -o OUT, or --to FORMAT with --out-dir DIR".into()));
+        return Err(Failure::Usage(
+            "give -o OUT, or --to FORMAT with --out-dir DIR".into(),
+        ));
     };
     if !dir.is_dir() {
-        return Err(Failure::Usage(format!("{}: output folder does not exist", dir.display())));
+        return Err(Failure::Usage(format!(
+            "{}: output folder does not exist",
+            dir.display()
+        )));
     }
     let mut seen: BTreeMap<PathBuf, &Path> = BTreeMap::new();
     let mut jobs = Vec::with_capacity(args.inputs.len());
@@ -75,7 +95,11 @@ fn plan(args: &ConvertArgs) -> Result<Vec<Job>, Failure> {
                 output.display()
             )));
         }
-        jobs.push(Job { input: input.clone(), output, format: ascii(format) });
+        jobs.push(Job {
+            input: input.clone(),
+            output,
+            format: ascii(format),
+        });
     }
     Ok(jobs)
 }

@@ -67,7 +67,11 @@ pub(crate) fn run(args: InfoArgs) -> Result<(), Failure> {
     for e in reports.iter().filter_map(|r| r.as_ref().err()) {
         eprintln!("error: {e}");
     }
-    if failed > 0 { Err(Failure::Reported) } else { Ok(()) }
+    if failed > 0 {
+        Err(Failure::Reported)
+    } else {
+        Ok(())
+    }
 }
 
 /// The JSON description of a loaded file.
@@ -79,7 +83,11 @@ fn describe(file: &LoadedFile, trial_repair: bool) -> Value {
     let body = match &file.content {
         Content::Mesh { scene, details } => describe_scene(scene, details, trial_repair),
         Content::PointCloud(cloud) => {
-            let pts: Vec<Point3> = cloud.points.iter().map(|p| Point3::new(p[0], p[1], p[2])).collect();
+            let pts: Vec<Point3> = cloud
+                .points
+                .iter()
+                .map(|p| Point3::new(p[0], p[1], p[2]))
+                .collect();
             json!({
                 "points": cloud.points.len(),
                 "bbox": BoundingBox::from_points(&pts),
@@ -111,23 +119,38 @@ fn merge(into: &mut Value, from: Value) {
 }
 
 fn describe_scene(scene: &Scene, details: &MeshDetails, trial_repair: bool) -> Value {
-    let objects: Vec<ObjectInfo> = scene.objects.iter().map(|o| object_info(&o.name, &o.mesh, trial_repair)).collect();
-    let bbox = objects.iter().filter_map(|o| o.bbox).reduce(|a, b| a.union(&b));
-    json!({
-        "details": details,
+    let objects: Vec<ObjectInfo> = scene
+        .objects
+        .iter()
+        .map(|o| object_info(&o.name, &o.mesh, trial_repair))
+        .collect();
+    let bbox = objects
+        .iter()
+        .filter_map(|o| o.bbox)
+        .reduce(|a, b| a.union(&b));
+    let mut v = json!({
         "triangles": scene.triangle_count(),
         "vertices": scene.objects.iter().map(|o| o.mesh.vertices.len()).sum::<usize>(),
         "volume_mm3": objects.iter().map(|o| o.volume_mm3).sum::<f64>(),
         "bbox": bbox,
         "objects": objects,
-    })
+    });
+    let details = json!(details);
+    if !details.is_null() {
+        v["details"] = details;
+    }
+    v
 }
 
 fn object_info(name: &str, mesh: &Mesh, trial_repair: bool) -> ObjectInfo {
     let repair = trial_repair.then(|| {
         let mut fixed = mesh.clone();
         let report = fixed.repair(&Tolerances::default());
-        RepairFindings { report, closed_after: fixed.topology().closed, volume_after_mm3: fixed.signed_volume() }
+        RepairFindings {
+            report,
+            closed_after: fixed.topology().closed,
+            volume_after_mm3: fixed.signed_volume(),
+        }
     });
     ObjectInfo {
         name: name.to_string(),
@@ -148,11 +171,25 @@ fn describe_eagle(doc: &conduit_eagle::Document) -> Value {
             let packages: std::collections::BTreeSet<(&str, &str)> = s
                 .parts
                 .iter()
-                .filter_map(|p| p.package.as_ref().map(|k| (k.library.as_str(), k.name.as_str())))
+                .filter_map(|p| {
+                    p.package
+                        .as_ref()
+                        .map(|k| (k.library.as_str(), k.name.as_str()))
+                })
                 .collect();
             let pins: usize = s.parts.iter().map(|p| p.pin_pads.len()).sum();
-            let pin_pads: usize = s.parts.iter().flat_map(|p| p.pin_pads.values()).map(Vec::len).sum();
-            let multi: usize = s.parts.iter().flat_map(|p| p.pin_pads.values()).filter(|v| v.len() > 1).count();
+            let pin_pads: usize = s
+                .parts
+                .iter()
+                .flat_map(|p| p.pin_pads.values())
+                .map(Vec::len)
+                .sum();
+            let multi: usize = s
+                .parts
+                .iter()
+                .flat_map(|p| p.pin_pads.values())
+                .filter(|v| v.len() > 1)
+                .count();
             json!({
                 "eagle": "schematic",
                 "version": s.version,
@@ -166,8 +203,11 @@ fn describe_eagle(doc: &conduit_eagle::Document) -> Value {
             })
         }
         Document::Board(b) => {
-            let packages: std::collections::BTreeSet<(&str, &str)> =
-                b.elements.iter().map(|e| (e.package.library.as_str(), e.package.name.as_str())).collect();
+            let packages: std::collections::BTreeSet<(&str, &str)> = b
+                .elements
+                .iter()
+                .map(|e| (e.package.library.as_str(), e.package.name.as_str()))
+                .collect();
             json!({
                 "eagle": "board",
                 "version": b.version,

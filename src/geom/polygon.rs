@@ -81,7 +81,10 @@ mod tests {
         let mut hole = sq(2.0);
         hole.points.reverse();
         assert!(!hole.is_counter_clockwise());
-        let ex = ExPolygon { contour: outer, holes: vec![hole] };
+        let ex = ExPolygon {
+            contour: outer,
+            holes: vec![hole],
+        };
         assert_eq!(ex.area_mm2(), 96.0);
     }
 }

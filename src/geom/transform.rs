@@ -90,7 +90,10 @@ impl BoundingBox {
     pub fn from_points<'a>(points: impl IntoIterator<Item = &'a Point3>) -> Option<Self> {
         let mut it = points.into_iter();
         let first = it.next()?;
-        let mut bb = BoundingBox { min: [first.x, first.y, first.z], max: [first.x, first.y, first.z] };
+        let mut bb = BoundingBox {
+            min: [first.x, first.y, first.z],
+            max: [first.x, first.y, first.z],
+        };
         for p in it {
             for k in 0..3 {
                 bb.min[k] = bb.min[k].min(p[k]);
@@ -102,7 +105,11 @@ impl BoundingBox {
 
     /// Edge lengths along x, y, z.
     pub fn size(&self) -> Vector3 {
-        Vector3::new(self.max[0] - self.min[0], self.max[1] - self.min[1], self.max[2] - self.min[2])
+        Vector3::new(
+            self.max[0] - self.min[0],
+            self.max[1] - self.min[1],
+            self.max[2] - self.min[2],
+        )
     }
 
     /// The smallest box holding both.

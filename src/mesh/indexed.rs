@@ -22,7 +22,10 @@ impl Mesh {
         I: IntoIterator<Item = [Point3; 3]>,
     {
         let iter = triangles.into_iter();
-        let mut mesh = Mesh { name: name.into(), ..Mesh::default() };
+        let mut mesh = Mesh {
+            name: name.into(),
+            ..Mesh::default()
+        };
         mesh.triangles.reserve(iter.size_hint().0);
         let mut index: HashMap<[u64; 3], u32> = HashMap::with_capacity(iter.size_hint().0 / 2 + 1);
         for tri in iter {
@@ -54,7 +57,9 @@ impl Mesh {
     /// wind counter-clockwise seen from outside. Summed relative to the bounding-box centre so large
     /// offsets from the origin do not cost precision.
     pub fn signed_volume(&self) -> f64 {
-        let Some(bb) = self.bounding_box() else { return 0.0 };
+        let Some(bb) = self.bounding_box() else {
+            return 0.0;
+        };
         let c = Point3::new(
             (bb.min[0] + bb.max[0]) / 2.0,
             (bb.min[1] + bb.max[1]) / 2.0,
@@ -68,7 +73,9 @@ impl Mesh {
 
     /// Surface area in mm².
     pub fn area(&self) -> f64 {
-        self.triangle_corners().map(|[a, b, c]| (b - a).cross(&(c - a)).norm() / 2.0).sum()
+        self.triangle_corners()
+            .map(|[a, b, c]| (b - a).cross(&(c - a)).norm() / 2.0)
+            .sum()
     }
 
     /// The axis-aligned bounding box of the referenced vertices, or `None` for an empty mesh.
@@ -99,7 +106,8 @@ impl Mesh {
     pub fn append(&mut self, other: &Mesh) {
         let base = self.vertices.len() as u32;
         self.vertices.extend_from_slice(&other.vertices);
-        self.triangles.extend(other.triangles.iter().map(|t| t.map(|v| v + base)));
+        self.triangles
+            .extend(other.triangles.iter().map(|t| t.map(|v| v + base)));
     }
 }
 

@@ -61,7 +61,10 @@ impl FileKind {
             Some(FileKind::Svg)
         } else if first_word == "ply" {
             Some(FileKind::Ply)
-        } else if matches!(first_word, "OFF" | "COFF" | "NOFF" | "CNOFF" | "STOFF" | "4OFF") {
+        } else if matches!(
+            first_word,
+            "OFF" | "COFF" | "NOFF" | "CNOFF" | "STOFF" | "4OFF"
+        ) {
             Some(FileKind::Off)
         } else if first_word.eq_ignore_ascii_case("solid") || binary_stl_size_matches(bytes) {
             Some(FileKind::Stl)
@@ -81,7 +84,10 @@ impl FileKind {
 
     /// Whether this kind holds a triangle mesh that `convert` can write out.
     pub fn is_mesh(self) -> bool {
-        matches!(self, FileKind::Stl | FileKind::ThreeMf | FileKind::Obj | FileKind::Off | FileKind::Ply)
+        matches!(
+            self,
+            FileKind::Stl | FileKind::ThreeMf | FileKind::Obj | FileKind::Off | FileKind::Ply
+        )
     }
 }
 
@@ -120,18 +126,33 @@ mod tests {
 
     #[test]
     fn extension_wins_and_is_case_insensitive() {
-        assert_eq!(FileKind::from_extension(Path::new("a/B.STL")), Some(FileKind::Stl));
-        assert_eq!(FileKind::from_extension(Path::new("x.3MF")), Some(FileKind::ThreeMf));
+        assert_eq!(
+            FileKind::from_extension(Path::new("a/B.STL")),
+            Some(FileKind::Stl)
+        );
+        assert_eq!(
+            FileKind::from_extension(Path::new("x.3MF")),
+            Some(FileKind::ThreeMf)
+        );
         assert_eq!(FileKind::from_extension(Path::new("noext")), None);
     }
 
     #[test]
     fn content_sniffing() {
-        assert_eq!(FileKind::sniff(b"solid x\nendsolid x\n"), Some(FileKind::Stl));
-        assert_eq!(FileKind::sniff(b"ply\nformat ascii 1.0\n"), Some(FileKind::Ply));
+        assert_eq!(
+            FileKind::sniff(b"solid x\nendsolid x\n"),
+            Some(FileKind::Stl)
+        );
+        assert_eq!(
+            FileKind::sniff(b"ply\nformat ascii 1.0\n"),
+            Some(FileKind::Ply)
+        );
         assert_eq!(FileKind::sniff(b"OFF\n3 1 0\n"), Some(FileKind::Off));
         assert_eq!(FileKind::sniff(b"PK\x03\x04rest"), Some(FileKind::ThreeMf));
-        assert_eq!(FileKind::sniff(b";LAYER:0\nG1 X1 Y2\nG1 X2\n"), Some(FileKind::Gcode));
+        assert_eq!(
+            FileKind::sniff(b";LAYER:0\nG1 X1 Y2\nG1 X2\n"),
+            Some(FileKind::Gcode)
+        );
         let mut bin = vec![0u8; 84 + 50];
         bin[80] = 1;
         assert_eq!(FileKind::sniff(&bin), Some(FileKind::Stl));

@@ -52,7 +52,9 @@ pub enum LoadErrorKind {
         limit: u64,
     },
     /// Neither the extension nor the content names a format conduit reads.
-    #[error("unrecognised file format (supported: STL, 3MF, OBJ, OFF, PLY, XYZ, EAGLE .sch/.brd, G-code, SVG)")]
+    #[error(
+        "unrecognised file format (supported: STL, 3MF, OBJ, OFF, PLY, XYZ, EAGLE .sch/.brd, G-code, SVG)"
+    )]
     Unrecognised,
     /// STL error.
     #[error("STL: {0}")]
@@ -88,7 +90,7 @@ pub enum LoadErrorKind {
 
 /// Format-specific facts about a mesh file, for `conduit info`.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
-#[serde(tag = "format", rename_all = "lowercase")]
+#[serde(untagged)]
 pub enum MeshDetails {
     /// STL.
     Stl {
@@ -98,7 +100,6 @@ pub enum MeshDetails {
         name: Option<String>,
     },
     /// 3MF.
-    #[serde(rename = "3mf")]
     ThreeMf(ThreeMfDetails),
     /// OBJ.
     Obj,
@@ -164,11 +165,19 @@ pub struct LoadedFile {
 
 /// Reads a file of any supported format.
 pub fn load(path: &Path, opts: &LoadOptions) -> Result<LoadedFile, LoadError> {
-    let err = |kind: LoadErrorKind| LoadError { path: path.to_path_buf(), kind };
+    let err = |kind: LoadErrorKind| LoadError {
+        path: path.to_path_buf(),
+        kind,
+    };
     let bytes = read_bounded(path, opts.max_file_bytes).map_err(err)?;
     let kind = FileKind::detect(path, &bytes).ok_or_else(|| err(LoadErrorKind::Unrecognised))?;
     let (content, warnings) = parse(path, kind, &bytes, opts).map_err(err)?;
-    Ok(LoadedFile { path: path.to_path_buf(), kind, content, warnings })
+    Ok(LoadedFile {
+        path: path.to_path_buf(),
+        kind,
+        content,
+        warnings,
+    })
 }
 
 /// Reads a file that must hold a triangle mesh and returns its scene.
@@ -192,7 +201,9 @@ fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, LoadErrorKind> {
 }
 
 fn stem(path: &Path) -> String {
-    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }
 
 fn point(v: &[f64; 3]) -> Point3 {
@@ -200,7 +211,12 @@ fn point(v: &[f64; 3]) -> Point3 {
 }
 
 fn object(name: String, mesh: Mesh) -> SceneObject {
-    SceneObject { name, mesh, transform: Transform::identity(), tool: None }
+    SceneObject {
+        name,
+        mesh,
+        transform: Transform::identity(),
+        tool: None,
+    }
 }
 
 fn indexed_mesh(name: &str, vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Mesh {
@@ -221,18 +237,29 @@ fn parse(
     let content = match kind {
         FileKind::Stl => {
             let stl = conduit_stl::read(bytes)?;
-            let name = stl.name.clone().filter(|n| !n.is_empty()).unwrap_or_else(|| stem(path));
+            let name = stl
+                .name
+                .clone()
+                .filter(|n| !n.is_empty())
+                .unwrap_or_else(|| stem(path));
             let mesh = Mesh::from_triangle_soup(
                 name.clone(),
-                stl.triangles.iter().map(|t| t.map(|v| Point3::new(v[0] as f64, v[1] as f64, v[2] as f64))),
+                stl.triangles
+                    .iter()
+                    .map(|t| t.map(|v| Point3::new(v[0] as f64, v[1] as f64, v[2] as f64))),
             );
             let encoding = match stl.encoding {
                 conduit_stl::Encoding::Ascii => "ascii",
                 conduit_stl::Encoding::Binary => "binary",
             };
             Content::Mesh {
-                scene: Scene { objects: vec![object(name, mesh)] },
-                details: MeshDetails::Stl { encoding, name: stl.name },
+                scene: Scene {
+                    objects: vec![object(name, mesh)],
+                },
+                details: MeshDetails::Stl {
+                    encoding,
+                    name: stl.name,
+                },
             }
         }
         FileKind::ThreeMf => {
@@ -242,7 +269,11 @@ fn parse(
             let objects = flat
                 .iter()
                 .map(|f| {
-                    let name = if f.name.is_empty() { format!("object {}", f.object_id) } else { f.name.clone() };
+                    let name = if f.name.is_empty() {
+                        format!("object {}", f.object_id)
+                    } else {
+                        f.name.clone()
+                    };
                     object(name.clone(), indexed_mesh(&name, &f.vertices, &f.triangles))
                 })
                 .collect();
@@ -254,10 +285,17 @@ fn parse(
                 build_items: root.build.len(),
                 base_material_groups: root.base_materials.len(),
                 color_groups: root.color_groups.len(),
-                metadata: root.metadata.iter().map(|m| (m.name.clone(), m.value.clone())).collect(),
+                metadata: root
+                    .metadata
+                    .iter()
+                    .map(|m| (m.name.clone(), m.value.clone()))
+                    .collect(),
                 required_extensions: root.required_extensions.clone(),
             };
-            Content::Mesh { scene: Scene { objects }, details: MeshDetails::ThreeMf(details) }
+            Content::Mesh {
+                scene: Scene { objects },
+                details: MeshDetails::ThreeMf(details),
+            }
         }
         FileKind::Obj => {
             let obj = conduit_obj::read(bytes, path.parent())?;
@@ -266,17 +304,29 @@ fn parse(
                 .objects
                 .iter()
                 .map(|o| {
-                    let name = if o.name.is_empty() { stem(path) } else { o.name.clone() };
+                    let name = if o.name.is_empty() {
+                        stem(path)
+                    } else {
+                        o.name.clone()
+                    };
                     object(name.clone(), indexed_mesh(&name, &o.vertices, &o.triangles))
                 })
                 .collect();
-            Content::Mesh { scene: Scene { objects }, details: MeshDetails::Obj }
+            Content::Mesh {
+                scene: Scene { objects },
+                details: MeshDetails::Obj,
+            }
         }
         FileKind::Off => {
             let off = conduit_off::read(bytes)?;
             let name = stem(path);
             let mesh = indexed_mesh(&name, &off.vertices, &off.triangles);
-            Content::Mesh { scene: Scene { objects: vec![object(name, mesh)] }, details: MeshDetails::Off }
+            Content::Mesh {
+                scene: Scene {
+                    objects: vec![object(name, mesh)],
+                },
+                details: MeshDetails::Off,
+            }
         }
         FileKind::Ply => {
             let cloud = conduit_pointcloud::read_ply(bytes)?;
@@ -285,7 +335,12 @@ fn parse(
             } else {
                 let name = stem(path);
                 let mesh = indexed_mesh(&name, &cloud.points, &cloud.triangles);
-                Content::Mesh { scene: Scene { objects: vec![object(name, mesh)] }, details: MeshDetails::Ply }
+                Content::Mesh {
+                    scene: Scene {
+                        objects: vec![object(name, mesh)],
+                    },
+                    details: MeshDetails::Ply,
+                }
             }
         }
         FileKind::Xyz => Content::PointCloud(conduit_pointcloud::read_xyz(bytes)?),

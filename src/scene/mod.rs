@@ -10,9 +10,12 @@ mod save;
 
 pub use detect::FileKind;
 pub use load::{
-    Content, LoadError, LoadErrorKind, LoadOptions, LoadedFile, MeshDetails, ThreeMfDetails, load, load_scene,
+    Content, LoadError, LoadErrorKind, LoadOptions, LoadedFile, MeshDetails, ThreeMfDetails, load,
+    load_scene,
 };
-pub use save::{MeshFormat, SaveError, SaveErrorKind, placed_meshes, save, to_3mf_model, write_atomically};
+pub use save::{
+    MeshFormat, SaveError, SaveErrorKind, placed_meshes, save, to_3mf_model, write_atomically,
+};
 
 use crate::geom::Transform;
 use crate::mesh::Mesh;

@@ -76,7 +76,10 @@ where
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let mut tmp = tempfile::Builder::new().prefix(".conduit-").suffix(".tmp").tempfile_in(&dir)?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".conduit-")
+        .suffix(".tmp")
+        .tempfile_in(&dir)?;
     fill(tmp.as_file_mut())?;
     tmp.as_file_mut().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
@@ -149,7 +152,11 @@ pub fn to_3mf_model(scene: &Scene) -> conduit_3mf::Model {
                     .mesh
                     .triangles
                     .iter()
-                    .map(|&v| conduit_3mf::Triangle { v, pid: None, p: [None; 3] })
+                    .map(|&v| conduit_3mf::Triangle {
+                        v,
+                        pid: None,
+                        p: [None; 3],
+                    })
                     .collect(),
             }),
         });
@@ -165,7 +172,10 @@ pub fn to_3mf_model(scene: &Scene) -> conduit_3mf::Model {
 
 /// Writes a scene to `path` in `format`, atomically.
 pub fn save(scene: &Scene, path: &Path, format: MeshFormat) -> Result<(), SaveError> {
-    let err = |kind| SaveError { path: path.to_path_buf(), kind };
+    let err = |kind| SaveError {
+        path: path.to_path_buf(),
+        kind,
+    };
     match format {
         MeshFormat::Stl | MeshFormat::StlAscii => {
             let meshes = placed_meshes(scene);

@@ -1,0 +1,860 @@
+//! The one configuration of a conduit run: printer, tools and slicing settings, read from a TOML
+//! file (or imported from a PrusaSlicer `.ini`), with a documented default for every key.
+//!
+//! Place in the pipeline: the CLI turns command-line arguments and config files into a validated
+//! [`Config`] before any work starts (`design.md`, "Configuration"); every later stage (slice,
+//! regions, program, emit, check) reads the parts it needs from it and never parses files itself.
+//!
+//! # File format
+//!
+//! ```toml
+//! [printer]            # the machine: bed, flavour, start/end G-code, retraction, travel
+//! flavor = "marlin"
+//!
+//! [tools.0]            # one table per tool, numbered from 0 without gaps
+//! kind = "filament"
+//!
+//! [tools.1]
+//! kind = "paste"
+//!
+//! [slice]              # layer heights, perimeters, infill, widths, speeds per role
+//! layer_height = 0.2
+//! ```
+//!
+//! Every key may be left out and takes its default; `conduit config --defaults` prints them all
+//! with their documentation ([`defaults_toml`]). Unknown keys are errors naming the key, so a
+//! typo never passes silently. Later sections (`[route]`, `[curve]`, `[conform]`, `[jet]`,
+//! `[pnp]`) will be added as fields of [`Config`] next to the three that exist now.
+//!
+//! A `[tools.N]` table, when present, defines the tools: the tool numbers must run `0, 1, …`
+//! without gaps, and every key a table leaves out takes the default *of its kind*
+//! ([`Tool::filament`] or [`Tool::paste`]). Without any `[tools.N]` table the two default tools
+//! of [`Config::default`] are used.
+//!
+//! # Units
+//!
+//! Lengths in millimetres, speeds in mm/s, accelerations in mm/s², temperatures in °C,
+//! fan speeds in percent, densities in g/cm³, volumetric flows in mm³/s.
+
+mod defaults;
+pub mod prusa_ini;
+mod template;
+
+pub use defaults::defaults_toml;
+pub use prusa_ini::from_prusa_pairs;
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use serde::de::{self, MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::region::RegionParams;
+
+/// Everything a conduit run is configured with. See the [module docs](self) for the file format.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Config {
+    /// The machine (`[printer]`).
+    pub printer: Printer,
+    /// The tools, indexed by tool number (`[tools.0]`, `[tools.1]`, …); never empty.
+    #[serde(with = "tools_table")]
+    pub tools: Vec<Tool>,
+    /// Slicing settings (`[slice]`).
+    pub slice: SliceSettings,
+}
+
+/// G-code dialect of the printer's firmware.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Flavor {
+    /// Marlin 1.x / 2.x (also Prusa firmware).
+    #[default]
+    Marlin,
+    /// RepRapFirmware (Duet).
+    #[serde(rename = "reprapfirmware")]
+    RepRapFirmware,
+    /// Klipper.
+    Klipper,
+}
+
+/// The printer (`[printer]`): bed, firmware, custom G-code, retraction, travel and fan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Printer {
+    /// G-code dialect: `"marlin"`, `"reprapfirmware"` or `"klipper"`. Default `"marlin"`.
+    pub flavor: Flavor,
+    /// Printable bed size [X, Y], mm. Default [250, 250].
+    pub bed_size: [f64; 2],
+    /// Coordinates of the bed's front-left corner [X, Y], mm: [0, 0] when the origin is at that
+    /// corner, [-125, -125] for a 250 mm bed with the origin in its centre. Default [0, 0].
+    pub bed_origin: [f64; 2],
+    /// Highest printable Z, mm. Default 250.
+    pub max_height: f64,
+    /// Bed temperature after the first layer, °C (0 = bed heater off). Default 60.
+    pub bed_temperature: f64,
+    /// Bed temperature for the first layer, °C. Default 60.
+    pub first_layer_bed_temperature: f64,
+    /// G-code template written before the print: heats, homes and primes. `{placeholders}` are
+    /// filled from this config (see [`Config::render_template`]).
+    pub start_gcode: String,
+    /// G-code template written after the print: heaters and fan off, lift, home X/Y, motors off.
+    pub end_gcode: String,
+    /// G-code template written before every tool change (`{previous_tool}` and `{next_tool}`
+    /// are available). Default empty.
+    pub before_tool_change_gcode: String,
+    /// G-code template written after every tool change (`{previous_tool}` and `{next_tool}` are
+    /// available). Default empty.
+    pub after_tool_change_gcode: String,
+    /// Filament pulled back before travels, mm (a tool's own `retract_length` overrides it).
+    /// Default 0.8.
+    pub retract_length: f64,
+    /// Speed of the retraction, mm/s of filament. Default 35.
+    pub retract_speed: f64,
+    /// Speed of the un-retraction, mm/s of filament; 0 = the same as `retract_speed`. Default 0.
+    pub deretract_speed: f64,
+    /// Travels shorter than this do not retract, mm. Default 2.
+    pub retract_before_travel: f64,
+    /// Z lift (z-hop) during retracted travels, mm; 0 = none. Default 0.
+    pub retract_lift: f64,
+    /// Speed of non-printing moves, mm/s. Default 130.
+    pub travel_speed: f64,
+    /// Acceleration of the machine, mm/s², used by time estimates. Default 1000.
+    pub max_acceleration: f64,
+    /// Highest speed of any printing move, mm/s; faster role speeds are clamped to it.
+    /// Default 200.
+    pub max_print_speed: f64,
+    /// Write E as relative distances (`M83`) instead of absolute positions (`M82`).
+    /// Default false.
+    pub use_relative_e_distances: bool,
+    /// Lowest part-cooling fan speed when the fan is on, percent. Default 35.
+    pub fan_min_speed: f64,
+    /// Highest part-cooling fan speed, percent. Default 100.
+    pub fan_max_speed: f64,
+    /// Number of bottom layers printed with the fan off. Default 1.
+    pub disable_fan_first_layers: usize,
+    /// Retract with the firmware's `G10`/`G11` instead of E moves. Default false.
+    pub use_firmware_retraction: bool,
+}
+
+/// What a tool deposits and therefore how it is driven.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ToolKind {
+    /// A filament extruder: flow is E distance, computed from the cross-section of the
+    /// extrusion and the filament diameter.
+    #[default]
+    Filament,
+    /// A paste dispenser (pneumatic or screw): switched on and off by G-code snippets, flow is
+    /// time-based (`paste_flow_mm3_s`).
+    Paste,
+}
+
+/// One tool (`[tools.N]`). Keys left out take the default of the tool's `kind`:
+/// [`Tool::filament`] or [`Tool::paste`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Tool {
+    /// Name shown in comments and reports. Default `"PLA"` (filament) / `"conductive paste"`.
+    pub name: String,
+    /// `"filament"` or `"paste"`. Default `"filament"`.
+    pub kind: ToolKind,
+    /// Nozzle (or needle) inner diameter, mm. Default 0.4.
+    pub nozzle_diameter: f64,
+    /// Filament diameter, mm (filament tools). Default 1.75.
+    pub filament_diameter: f64,
+    /// Density of the material, g/cm³, for the weight estimate. Default 1.24 (PLA) / 3.0
+    /// (silver-filled paste).
+    pub filament_density: f64,
+    /// Nozzle temperature after the first layer, °C; 0 = not heated. Default 210 (filament) /
+    /// 0 (paste).
+    pub temperature: f64,
+    /// Nozzle temperature for the first layer, °C; 0 = not heated. Default 210 / 0.
+    pub first_layer_temperature: f64,
+    /// Temperature while the tool is parked during another tool's work, °C; absent = keep
+    /// `temperature`. Default absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub standby_temperature: Option<f64>,
+    /// Offset of this tool's nozzle from tool 0's [X, Y], mm, when the firmware does not apply
+    /// it. Default [0, 0].
+    pub offset: [f64; 2],
+    /// Factor on the computed flow. Default 1.0.
+    pub extrusion_multiplier: f64,
+    /// G-code that starts the paste flow (pressure valve or screw on), paste tools. Default
+    /// `M42 P6 S255` (drive output pin 6 high: wire the dispenser's trigger to a free output
+    /// and set its pin here).
+    pub paste_on_gcode: String,
+    /// G-code that stops the paste flow, paste tools. Default `M42 P6 S0`.
+    pub paste_off_gcode: String,
+    /// Volume dispensed per second while the paste flow is on, mm³/s (paste tools; filament
+    /// tools 0). Default 0.5.
+    pub paste_flow_mm3_s: f64,
+    /// This tool's retraction length, mm, overriding `printer.retract_length`; absent = use the
+    /// printer's. Default absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub retract_length: Option<f64>,
+}
+
+/// Pattern of solid (top and bottom) infill.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SolidPattern {
+    /// Parallel lines alternating 90° per layer (the only solid pattern of the regions stage).
+    #[default]
+    Rectilinear,
+}
+
+/// Slicing settings (`[slice]`): the regions stage's parameters ([`RegionParams`], flattened
+/// into the same table) plus first-layer, solid-fill and speed settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SliceSettings {
+    /// Perimeters, infill, widths, layer height and nozzle diameter of the regions stage: the keys
+    /// `perimeters`, `external_perimeter_width`, `perimeter_width`, `infill_width`,
+    /// `solid_infill_width`, `top_solid_layers`, `bottom_solid_layers`, `infill_density`,
+    /// `infill_pattern`, `infill_angle_deg`, `infill_overlap`, `solid_infill_margin`,
+    /// `external_perimeters_first`, `skirt_loops`, `skirt_distance`, `nozzle_diameter`,
+    /// `layer_height` sit directly in `[slice]`.
+    #[serde(flatten)]
+    pub region: RegionParams,
+    /// Height of the first layer, mm. Default 0.2.
+    pub first_layer_height: f64,
+    /// Extrusion width on the first layer, mm (all roles). Default 0.45.
+    pub first_layer_width: f64,
+    /// Extrusion width of top solid infill, mm. Default 0.45.
+    pub top_solid_infill_width: f64,
+    /// Pattern of top solid infill. Default `"rectilinear"`.
+    pub top_fill_pattern: SolidPattern,
+    /// Pattern of bottom solid infill. Default `"rectilinear"`.
+    pub bottom_fill_pattern: SolidPattern,
+    /// Generate support material. Default false.
+    pub support_material: bool,
+    /// Width of the brim around the first layer, mm; 0 = none. Default 0.
+    pub brim_width: f64,
+    /// Speed of inner perimeters, mm/s. Default 45.
+    pub perimeter_speed: f64,
+    /// Speed of external perimeters, mm/s. Default 25.
+    pub external_perimeter_speed: f64,
+    /// Speed of sparse infill, mm/s. Default 80.
+    pub infill_speed: f64,
+    /// Speed of internal and bottom solid infill, mm/s. Default 40.
+    pub solid_infill_speed: f64,
+    /// Speed of top solid infill, mm/s. Default 30.
+    pub top_solid_infill_speed: f64,
+    /// Speed of every printing move on the first layer, mm/s. Default 20.
+    pub first_layer_speed: f64,
+    /// Speed of skirt and brim, mm/s. Default 30.
+    pub skirt_speed: f64,
+    /// Speed of conductive traces (paste tools), mm/s. Default 10.
+    pub conductive_speed: f64,
+    /// Tool of each scene object: object `i` prints with tool `object_tools[i]`; objects past the
+    /// end of the list use tool 0. Default [] (everything with tool 0).
+    pub object_tools: Vec<usize>,
+}
+
+impl Default for Printer {
+    fn default() -> Self {
+        Self {
+            flavor: Flavor::Marlin,
+            bed_size: [250.0, 250.0],
+            bed_origin: [0.0, 0.0],
+            max_height: 250.0,
+            bed_temperature: 60.0,
+            first_layer_bed_temperature: 60.0,
+            start_gcode: DEFAULT_START_GCODE.to_owned(),
+            end_gcode: DEFAULT_END_GCODE.to_owned(),
+            before_tool_change_gcode: String::new(),
+            after_tool_change_gcode: String::new(),
+            retract_length: 0.8,
+            retract_speed: 35.0,
+            deretract_speed: 0.0,
+            retract_before_travel: 2.0,
+            retract_lift: 0.0,
+            travel_speed: 130.0,
+            max_acceleration: 1000.0,
+            max_print_speed: 200.0,
+            use_relative_e_distances: false,
+            fan_min_speed: 35.0,
+            fan_max_speed: 100.0,
+            disable_fan_first_layers: 1,
+            use_firmware_retraction: false,
+        }
+    }
+}
+
+/// Default `printer.start_gcode`: heat bed and tool 0, home, wait, prime a line along the front
+/// edge of the bed.
+pub const DEFAULT_START_GCODE: &str = "\
+M140 S{first_layer_bed_temperature} ; bed heating
+M104 T0 S{first_layer_temperature[0]} ; tool 0 heating
+G28 ; home all axes
+M190 S{first_layer_bed_temperature} ; wait for the bed
+M109 T0 S{first_layer_temperature[0]} ; wait for tool 0
+G92 E0
+G1 Z0.3 F720
+G1 X5 Y5 F6000
+G1 X60 Y5 E9 F1000 ; prime line
+G92 E0
+";
+
+/// Default `printer.end_gcode`: heaters and fan off, lift by 10 mm, home X/Y, motors off.
+pub const DEFAULT_END_GCODE: &str = "\
+M104 T0 S0 ; tool 0 heater off
+M140 S0 ; bed heater off
+M107 ; fan off
+G91
+G1 Z10 F600 ; lift
+G90
+G28 X Y
+M84 ; motors off
+";
+
+impl Tool {
+    /// The default filament tool: PLA, 1.75 mm, 0.4 mm nozzle, 210 °C.
+    pub fn filament() -> Self {
+        Self {
+            name: "PLA".to_owned(),
+            kind: ToolKind::Filament,
+            nozzle_diameter: 0.4,
+            filament_diameter: 1.75,
+            filament_density: 1.24,
+            temperature: 210.0,
+            first_layer_temperature: 210.0,
+            standby_temperature: None,
+            offset: [0.0, 0.0],
+            extrusion_multiplier: 1.0,
+            paste_on_gcode: String::new(),
+            paste_off_gcode: String::new(),
+            paste_flow_mm3_s: 0.0,
+            retract_length: None,
+        }
+    }
+
+    /// The default paste tool: an unheated conductive-paste dispenser with a 0.4 mm needle,
+    /// switched by output pin 6 (`M42 P6 S255` / `M42 P6 S0`), 0.5 mm³/s.
+    pub fn paste() -> Self {
+        Self {
+            name: "conductive paste".to_owned(),
+            kind: ToolKind::Paste,
+            filament_density: 3.0,
+            temperature: 0.0,
+            first_layer_temperature: 0.0,
+            paste_on_gcode: "M42 P6 S255 ; paste on".to_owned(),
+            paste_off_gcode: "M42 P6 S0 ; paste off".to_owned(),
+            paste_flow_mm3_s: 0.5,
+            ..Self::filament()
+        }
+    }
+
+    /// The default tool of a kind: [`Tool::filament`] or [`Tool::paste`].
+    pub fn of_kind(kind: ToolKind) -> Self {
+        match kind {
+            ToolKind::Filament => Self::filament(),
+            ToolKind::Paste => Self::paste(),
+        }
+    }
+
+    /// Cross-section area of the filament, mm² (π·d²/4).
+    pub fn filament_area(&self) -> f64 {
+        std::f64::consts::PI * self.filament_diameter * self.filament_diameter / 4.0
+    }
+}
+
+impl Default for Tool {
+    /// [`Tool::filament`].
+    fn default() -> Self {
+        Self::filament()
+    }
+}
+
+impl Default for SliceSettings {
+    fn default() -> Self {
+        Self {
+            region: RegionParams::default(),
+            first_layer_height: 0.2,
+            first_layer_width: 0.45,
+            top_solid_infill_width: 0.45,
+            top_fill_pattern: SolidPattern::Rectilinear,
+            bottom_fill_pattern: SolidPattern::Rectilinear,
+            support_material: false,
+            brim_width: 0.0,
+            perimeter_speed: 45.0,
+            external_perimeter_speed: 25.0,
+            infill_speed: 80.0,
+            solid_infill_speed: 40.0,
+            top_solid_infill_speed: 30.0,
+            first_layer_speed: 20.0,
+            skirt_speed: 30.0,
+            conductive_speed: 10.0,
+            object_tools: Vec::new(),
+        }
+    }
+}
+
+impl Default for Config {
+    /// A two-tool printed-electronics printer on a 250 × 250 × 250 mm Marlin machine: tool 0
+    /// prints PLA ([`Tool::filament`]), tool 1 dispenses conductive paste ([`Tool::paste`]).
+    fn default() -> Self {
+        Self {
+            printer: Printer::default(),
+            tools: vec![Tool::filament(), Tool::paste()],
+            slice: SliceSettings::default(),
+        }
+    }
+}
+
+/// Why a configuration could not be read or changed.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The file could not be read.
+    ///
+    /// How to fix: check the path and the file's permissions.
+    #[error("cannot read config {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The file's extension is neither `.toml` nor `.ini`.
+    ///
+    /// How to fix: conduit configs are `.toml`; PrusaSlicer exports (File > Export > Export
+    /// Config) are `.ini`.
+    #[error("{}: unknown config format (expected a .toml conduit config or a PrusaSlicer .ini)", path.display())]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The TOML is malformed, has an unknown key or a value of the wrong type.
+    ///
+    /// How to fix: compare with `conduit config --defaults`, which lists every key.
+    #[error("{}{}: {message}", file_label(path), line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Toml {
+        /// The file, if the TOML came from one.
+        path: Option<PathBuf>,
+        /// 1-based line of the problem, when known.
+        line: Option<usize>,
+        /// What is wrong, naming the key.
+        message: String,
+    },
+    /// A `--set KEY=VALUE` could not be applied.
+    ///
+    /// How to fix: use a dotted key of `conduit config --defaults`, such as
+    /// `slice.layer_height=0.3` or `tools.1.temperature=25`.
+    #[error("--set {key}: {message}")]
+    Set {
+        /// The dotted key.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A line of a PrusaSlicer `.ini` has a value that cannot be read.
+    ///
+    /// How to fix: re-export the profile from PrusaSlicer, or correct the value.
+    #[error("{}{}: {key} = {value:?}: {message}", file_label(path), line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Ini {
+        /// The file, if the settings came from one.
+        path: Option<PathBuf>,
+        /// 1-based line, when the settings came from a file.
+        line: Option<usize>,
+        /// The PrusaSlicer key.
+        key: String,
+        /// The value as written.
+        value: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The configuration reads but is not usable.
+    ///
+    /// How to fix: each problem names its key and the allowed values.
+    #[error("invalid config: {}", problems.join("; "))]
+    Invalid {
+        /// Every problem found.
+        problems: Vec<String>,
+    },
+    /// A G-code template has a placeholder that is not a config key.
+    ///
+    /// How to fix: use `{key}` with a `printer` or `slice` key, `{key[N]}` with a tool key (or an
+    /// array such as `bed_size[0]`), or one of the variables the caller documents.
+    #[error("G-code template: unknown placeholder {{{placeholder}}}")]
+    Template {
+        /// The placeholder's text without braces.
+        placeholder: String,
+    },
+}
+
+fn file_label(path: &Option<PathBuf>) -> String {
+    match path {
+        Some(p) => p.display().to_string(),
+        None => "config".to_owned(),
+    }
+}
+
+impl ConfigError {
+    fn from_toml(err: &toml::de::Error, src: Option<&str>, path: Option<&Path>) -> Self {
+        let line = match (err.span(), src) {
+            (Some(span), Some(src)) => {
+                Some(src[..span.start.min(src.len())].matches('\n').count() + 1)
+            }
+            _ => None,
+        };
+        Self::Toml {
+            path: path.map(Path::to_path_buf),
+            line,
+            message: err.message().trim().to_owned(),
+        }
+    }
+}
+
+/// Loads a config file by extension: `.toml` is a conduit config, `.ini` a PrusaSlicer profile
+/// (see [`prusa_ini`]). Returns the config and warnings (settings that were ignored or
+/// adapted), which the caller should show.
+pub fn load(path: &Path) -> Result<(Config, Vec<String>), ConfigError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let text = || {
+        std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+    };
+    match ext.as_deref() {
+        Some("toml") => {
+            let src = text()?;
+            let config = Config::from_toml_str(&src)
+                .map_err(|e| ConfigError::from_toml(&e, Some(&src), Some(path)))?;
+            let warnings = config.validate()?;
+            Ok((config, warnings))
+        }
+        Some("ini") => {
+            let src = text()?;
+            prusa_ini::from_ini_str(&src).map_err(|e| match e {
+                ConfigError::Ini {
+                    line,
+                    key,
+                    value,
+                    message,
+                    ..
+                } => ConfigError::Ini {
+                    path: Some(path.to_path_buf()),
+                    line,
+                    key,
+                    value,
+                    message,
+                },
+                other => other,
+            })
+        }
+        _ => Err(ConfigError::UnknownFormat {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+impl Config {
+    /// Parses a conduit TOML config (no validation beyond types and key names; see
+    /// [`Config::validate`]).
+    pub fn from_toml_str(src: &str) -> Result<Config, toml::de::Error> {
+        toml::from_str(src)
+    }
+
+    /// Parses and validates a conduit TOML config, with errors carrying the line. Returns the
+    /// config and its warnings.
+    pub fn parse(src: &str) -> Result<(Config, Vec<String>), ConfigError> {
+        let config =
+            Self::from_toml_str(src).map_err(|e| ConfigError::from_toml(&e, Some(src), None))?;
+        let warnings = config.validate()?;
+        Ok((config, warnings))
+    }
+
+    /// The config as a TOML document (every key, tools as `[tools.N]` tables).
+    pub fn to_toml_string(&self) -> String {
+        match toml::to_string(self) {
+            Ok(s) => s,
+            // Every field is a TOML-representable type; failure would be a bug here.
+            Err(e) => panic!("internal error: config does not serialise to TOML: {e}"),
+        }
+    }
+
+    /// Checks what types alone cannot: at least one tool, tool references in range, the
+    /// regions stage's own rules ([`RegionParams::validate`]), positive speeds and heights.
+    /// Returns the warnings (usable but suspicious settings) or every error at once.
+    pub fn validate(&self) -> Result<Vec<String>, ConfigError> {
+        let mut problems = Vec::new();
+        let mut warnings = Vec::new();
+        if self.tools.is_empty() {
+            problems.push("at least one [tools.N] table is needed".to_owned());
+        }
+        for (i, &t) in self.slice.object_tools.iter().enumerate() {
+            if t >= self.tools.len() {
+                problems.push(format!(
+                    "slice.object_tools[{i}] = {t}, but only tools 0..{} exist",
+                    self.tools.len()
+                ));
+            }
+        }
+        problems.extend(
+            self.slice
+                .region
+                .validate()
+                .into_iter()
+                .map(|e| format!("slice.{e}")),
+        );
+        let s = &self.slice;
+        let p = &self.printer;
+        for (key, v) in [
+            ("slice.first_layer_height", s.first_layer_height),
+            ("slice.first_layer_width", s.first_layer_width),
+            ("slice.top_solid_infill_width", s.top_solid_infill_width),
+            ("slice.perimeter_speed", s.perimeter_speed),
+            ("slice.external_perimeter_speed", s.external_perimeter_speed),
+            ("slice.infill_speed", s.infill_speed),
+            ("slice.solid_infill_speed", s.solid_infill_speed),
+            ("slice.top_solid_infill_speed", s.top_solid_infill_speed),
+            ("slice.first_layer_speed", s.first_layer_speed),
+            ("slice.skirt_speed", s.skirt_speed),
+            ("slice.conductive_speed", s.conductive_speed),
+            ("printer.travel_speed", p.travel_speed),
+            ("printer.retract_speed", p.retract_speed),
+            ("printer.max_acceleration", p.max_acceleration),
+            ("printer.max_print_speed", p.max_print_speed),
+            ("printer.max_height", p.max_height),
+            ("printer.bed_size[0]", p.bed_size[0]),
+            ("printer.bed_size[1]", p.bed_size[1]),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                problems.push(format!("{key} must be > 0, got {v}"));
+            }
+        }
+        for (i, t) in self.tools.iter().enumerate() {
+            for (key, v) in [
+                ("nozzle_diameter", t.nozzle_diameter),
+                ("filament_diameter", t.filament_diameter),
+                ("extrusion_multiplier", t.extrusion_multiplier),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    problems.push(format!("tools.{i}.{key} must be > 0, got {v}"));
+                }
+            }
+        }
+        if let Some(t0) = self.tools.first() {
+            if (t0.nozzle_diameter - s.region.nozzle_diameter).abs() > 1e-9 {
+                warnings.push(format!(
+                    "slice.nozzle_diameter = {} differs from tools.0.nozzle_diameter = {}",
+                    s.region.nozzle_diameter, t0.nozzle_diameter
+                ));
+            }
+        }
+        if problems.is_empty() {
+            Ok(warnings)
+        } else {
+            Err(ConfigError::Invalid { problems })
+        }
+    }
+
+    /// The tool that prints scene object `object` (see [`SliceSettings::object_tools`]).
+    pub fn tool_for_object(&self, object: usize) -> usize {
+        self.slice.object_tools.get(object).copied().unwrap_or(0)
+    }
+
+    /// The retraction length of tool `tool`, mm: its own override or the printer's.
+    pub fn retract_length(&self, tool: usize) -> f64 {
+        self.tools
+            .get(tool)
+            .and_then(|t| t.retract_length)
+            .unwrap_or(self.printer.retract_length)
+    }
+
+    /// Un-retraction speed, mm/s: `deretract_speed`, or `retract_speed` when that is 0.
+    pub fn deretract_speed(&self) -> f64 {
+        if self.printer.deretract_speed > 0.0 {
+            self.printer.deretract_speed
+        } else {
+            self.printer.retract_speed
+        }
+    }
+
+    /// Applies one `KEY=VALUE` override, as given to `--set`: `KEY` is a dotted path into the
+    /// TOML tree (`slice.layer_height`, `tools.1.temperature`, `printer.bed_size`), `VALUE` is a
+    /// TOML value (`0.3`, `[200, 200]`, `"klipper"`; a bare word that is not valid TOML is taken
+    /// as a string, so `printer.flavor=klipper` works). Unknown keys and wrong types are errors
+    /// naming the key; the config is unchanged on error.
+    pub fn apply_set(&mut self, key_value: &str) -> Result<(), ConfigError> {
+        let (key, value) = key_value.split_once('=').ok_or_else(|| ConfigError::Set {
+            key: key_value.to_owned(),
+            message: "expected KEY=VALUE".to_owned(),
+        })?;
+        let key = key.trim();
+        let value = value.trim();
+        let set_err = |message: String| ConfigError::Set {
+            key: key.to_owned(),
+            message,
+        };
+        let parsed: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {value}")) {
+            Ok(mut t) => t
+                .remove("v")
+                .ok_or_else(|| set_err("no value".to_owned()))?,
+            Err(_) => toml::Value::String(value.to_owned()),
+        };
+        let mut tree = toml::Value::try_from(&*self)
+            .map_err(|e| set_err(format!("internal error serialising the config: {e}")))?;
+        let parts: Vec<&str> = key.split('.').map(str::trim).collect();
+        if parts.iter().any(|p| p.is_empty()) {
+            return Err(set_err("empty key segment".to_owned()));
+        }
+        let mut node = &mut tree;
+        for (i, part) in parts.iter().enumerate() {
+            let here = parts[..i].join(".");
+            let table = node.as_table_mut().ok_or_else(|| {
+                set_err(format!(
+                    "`{here}` is a value, not a table, so `{part}` cannot be set in it"
+                ))
+            })?;
+            if i + 1 == parts.len() {
+                table.insert((*part).to_owned(), parsed);
+                break;
+            }
+            // A new table may only be a new tool (`tools.2.kind=paste`); any other missing
+            // table is an unknown key.
+            if !table.contains_key(*part) {
+                if here == "tools" {
+                    table.insert((*part).to_owned(), toml::Value::Table(toml::Table::new()));
+                } else {
+                    return Err(set_err(format!(
+                        "unknown key `{}`",
+                        parts[..=i].join(".")
+                    )));
+                }
+            }
+            node = table
+                .get_mut(*part)
+                .ok_or_else(|| set_err("internal error walking the key".to_owned()))?;
+        }
+        let new: Config = tree
+            .try_into()
+            .map_err(|e: toml::de::Error| set_err(e.message().trim().to_owned()))?;
+        *self = new;
+        Ok(())
+    }
+}
+
+impl fmt::Display for Flavor {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Flavor::Marlin => "marlin",
+            Flavor::RepRapFirmware => "reprapfirmware",
+            Flavor::Klipper => "klipper",
+        })
+    }
+}
+
+/// The keys of a `[tools.N]` table, every one optional: what is left out comes from the
+/// kind's default tool.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ToolSpec {
+    name: Option<String>,
+    kind: Option<ToolKind>,
+    nozzle_diameter: Option<f64>,
+    filament_diameter: Option<f64>,
+    filament_density: Option<f64>,
+    temperature: Option<f64>,
+    first_layer_temperature: Option<f64>,
+    standby_temperature: Option<f64>,
+    offset: Option<[f64; 2]>,
+    extrusion_multiplier: Option<f64>,
+    paste_on_gcode: Option<String>,
+    paste_off_gcode: Option<String>,
+    paste_flow_mm3_s: Option<f64>,
+    retract_length: Option<f64>,
+}
+
+impl<'de> Deserialize<'de> for Tool {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let s = ToolSpec::deserialize(deserializer)?;
+        let d = Tool::of_kind(s.kind.unwrap_or_default());
+        Ok(Tool {
+            name: s.name.unwrap_or(d.name),
+            kind: d.kind,
+            nozzle_diameter: s.nozzle_diameter.unwrap_or(d.nozzle_diameter),
+            filament_diameter: s.filament_diameter.unwrap_or(d.filament_diameter),
+            filament_density: s.filament_density.unwrap_or(d.filament_density),
+            temperature: s.temperature.unwrap_or(d.temperature),
+            first_layer_temperature: s
+                .first_layer_temperature
+                .unwrap_or(d.first_layer_temperature),
+            standby_temperature: s.standby_temperature.or(d.standby_temperature),
+            offset: s.offset.unwrap_or(d.offset),
+            extrusion_multiplier: s.extrusion_multiplier.unwrap_or(d.extrusion_multiplier),
+            paste_on_gcode: s.paste_on_gcode.unwrap_or(d.paste_on_gcode),
+            paste_off_gcode: s.paste_off_gcode.unwrap_or(d.paste_off_gcode),
+            paste_flow_mm3_s: s.paste_flow_mm3_s.unwrap_or(d.paste_flow_mm3_s),
+            retract_length: s.retract_length.or(d.retract_length),
+        })
+    }
+}
+
+/// `tools` as `[tools.0]`, `[tools.1]`… tables (an array of tables `[[tools]]` is accepted too).
+mod tools_table {
+    use super::*;
+
+    pub fn serialize<S: Serializer>(tools: &[Tool], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_map(tools.iter().enumerate().map(|(i, t)| (i.to_string(), t)))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Tool>, D::Error> {
+        d.deserialize_any(ToolsVisitor)
+    }
+
+    struct ToolsVisitor;
+
+    impl<'de> Visitor<'de> for ToolsVisitor {
+        type Value = Vec<Tool>;
+
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            f.write_str("[tools.N] tables numbered 0, 1, 2…")
+        }
+
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<Tool>, A::Error> {
+            let mut tools = Vec::new();
+            while let Some(t) = seq.next_element()? {
+                tools.push(t);
+            }
+            if tools.is_empty() {
+                return Err(de::Error::custom("at least one tool is needed"));
+            }
+            Ok(tools)
+        }
+
+        fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Vec<Tool>, A::Error> {
+            let mut tools = BTreeMap::new();
+            while let Some(key) = map.next_key::<String>()? {
+                let n: usize = key.trim().parse().map_err(|_| {
+                    de::Error::custom(format!(
+                        "`tools.{key}`: tools are numbered, as in [tools.0], [tools.1]"
+                    ))
+                })?;
+                let tool: Tool = map.next_value()?;
+                if tools.insert(n, tool).is_some() {
+                    return Err(de::Error::custom(format!("tools.{n} is given twice")));
+                }
+            }
+            if tools.is_empty() {
+                return Err(de::Error::custom("at least one tool is needed"));
+            }
+            if let Some(missing) = (0..tools.len()).find(|i| !tools.contains_key(i)) {
+                return Err(de::Error::custom(format!(
+                    "tools must be numbered 0, 1, 2… without gaps: tools.{missing} is missing \
+                     (tools given: {:?})",
+                    tools.keys().collect::<Vec<_>>()
+                )));
+            }
+            Ok(tools.into_values().collect())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,153 @@
+//! Filling `{placeholders}` in the custom G-code templates of [`Printer`](super::Printer) and
+//! [`Tool`](super::Tool), in the style of PrusaSlicer's.
+//!
+//! Syntax: `{key}` or `{key[N]}`. A key is looked up, in order, in the caller's variables, in
+//! `[printer]`, in `[slice]` and in the tools: `{temperature[1]}` is tool 1's temperature,
+//! `{temperature}` the current tool's; `{bed_size[0]}` indexes an array. PrusaSlicer's legacy
+//! `[key]` form is filled too when `key` is known, and left as written otherwise (square
+//! brackets also appear in ordinary comments). Numbers are written as Rust's shortest
+//! round-trip form (`60`, `0.2`), booleans as `1` / `0`. PrusaSlicer's macro language (`{if}`,
+//! expressions) is not supported: such a placeholder is an unknown-placeholder error.
+
+use super::{Config, ConfigError};
+
+impl Config {
+    /// Fills the placeholders of `template` (see the syntax above) for tool `tool`, with the
+    /// caller's extra variables `vars` (such as `previous_tool`, `next_tool`, `layer_z`) taking
+    /// precedence over config keys.
+    ///
+    /// ```
+    /// let cfg = conduit::config::Config::default();
+    /// let g = cfg.render_template("M190 S{first_layer_bed_temperature}\nM109 S[temperature]", 0, &[])?;
+    /// assert_eq!(g, "M190 S60\nM109 S210");
+    /// # Ok::<(), conduit::config::ConfigError>(())
+    /// ```
+    pub fn render_template(
+        &self,
+        template: &str,
+        tool: usize,
+        vars: &[(&str, String)],
+    ) -> Result<String, ConfigError> {
+        let tree = toml::Value::try_from(self).ok();
+        let lookup = |name: &str| -> Option<String> { self.lookup(tree.as_ref()?, name, tool, vars) };
+        let mut out = String::with_capacity(template.len());
+        let mut rest = template;
+        while let Some(pos) = rest.find(['{', '[']) {
+            out.push_str(&rest[..pos]);
+            let open = rest.as_bytes()[pos];
+            let close = if open == b'{' { '}' } else { ']' };
+            let after = &rest[pos + 1..];
+            // `[key]` with an index inside: `[key[1]]` is not PrusaSlicer syntax; only plain names.
+            let end = match open {
+                b'{' => after.find('}'),
+                _ => after.find([']', '[', '\n', '{']).filter(|&e| after[e..].starts_with(']')),
+            };
+            match end {
+                Some(end) => {
+                    let name = &after[..end];
+                    match lookup(name.trim()) {
+                        Some(v) => out.push_str(&v),
+                        None if open == b'{' => {
+                            return Err(ConfigError::Template {
+                                placeholder: name.to_owned(),
+                            });
+                        }
+                        None => {
+                            out.push('[');
+                            out.push_str(name);
+                            out.push(close);
+                        }
+                    }
+                    rest = &after[end + 1..];
+                }
+                None if open == b'{' => {
+                    return Err(ConfigError::Template {
+                        placeholder: after.lines().next().unwrap_or_default().to_owned(),
+                    });
+                }
+                None => {
+                    out.push('[');
+                    rest = after;
+                }
+            }
+        }
+        out.push_str(rest);
+        Ok(out)
+    }
+
+    fn lookup(
+        &self,
+        tree: &toml::Value,
+        name: &str,
+        tool: usize,
+        vars: &[(&str, String)],
+    ) -> Option<String> {
+        if let Some((_, v)) = vars.iter().find(|(k, _)| *k == name) {
+            return Some(v.clone());
+        }
+        let (key, index) = match name.strip_suffix(']').and_then(|n| n.split_once('[')) {
+            Some((k, i)) => (k.trim(), Some(i.trim().parse::<usize>().ok()?)),
+            None => (name, None),
+        };
+        if key.is_empty() || !key.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
+            return None;
+        }
+        for section in ["printer", "slice"] {
+            if let Some(v) = tree.get(section).and_then(|s| s.get(key)) {
+                return match (v, index) {
+                    (toml::Value::Array(a), Some(i)) => a.get(i).and_then(scalar),
+                    (v, None) => scalar(v),
+                    _ => None,
+                };
+            }
+        }
+        let tools = tree.get("tools")?;
+        let t = index.unwrap_or(tool);
+        let v = tools.get(t.to_string())?.get(key)?;
+        scalar(v)
+    }
+}
+
+fn scalar(v: &toml::Value) -> Option<String> {
+    match v {
+        toml::Value::String(s) => Some(s.clone()),
+        toml::Value::Integer(i) => Some(i.to_string()),
+        toml::Value::Float(f) => Some(f.to_string()),
+        toml::Value::Boolean(b) => Some(if *b { "1" } else { "0" }.to_owned()),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn placeholders_are_filled_from_every_section() -> Result<(), ConfigError> {
+        let cfg = Config::default();
+        let t = "M140 S{first_layer_bed_temperature}\nM104 T1 S{first_layer_temperature[1]}\n\
+                 ; {name} {layer_height} [temperature] {bed_size[0]} {next_tool} [unknown] a[0]";
+        let out = cfg.render_template(t, 0, &[("next_tool", "1".to_owned())])?;
+        assert_eq!(
+            out,
+            "M140 S60\nM104 T1 S0\n; PLA 0.2 210 250 1 [unknown] a[0]"
+        );
+        assert!(matches!(
+            cfg.render_template("{if x}", 0, &[]),
+            Err(ConfigError::Template { placeholder }) if placeholder == "if x"
+        ));
+        assert!(cfg.render_template("{temperature[7]}", 0, &[]).is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn default_start_and_end_gcode_render() -> Result<(), ConfigError> {
+        let cfg = Config::default();
+        let start = cfg.render_template(&cfg.printer.start_gcode, 0, &[])?;
+        assert!(start.contains("M109 T0 S210"), "{start}");
+        assert!(start.contains("M190 S60"), "{start}");
+        let end = cfg.render_template(&cfg.printer.end_gcode, 0, &[])?;
+        assert!(end.contains("M84"));
+        Ok(())
+    }
+}

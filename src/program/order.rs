@@ -1,0 +1,617 @@
+//! Travel ordering: in which order, from which end and from which vertex the paths of one tool
+//! on one layer are printed.
+//!
+//! Two steps, both deterministic (same input, same output; no clocks, no hashing):
+//!
+//! 1. **Nearest neighbour** from the current nozzle position: the next path is the one whose
+//!    nearest possible entry is closest. A closed loop may be entered at any vertex (and ends
+//!    there); an open polyline may be entered at either end (it is then reversed). Ties go to the
+//!    path that comes first in the input.
+//! 2. **Improvement** ([`improve`]): greedy first-improvement 2-opt (reverse a run of paths,
+//!    each of them reversed too) and or-opt (move one path elsewhere, either way round) until no
+//!    move shortens the travel or [`OrderParams::max_evaluations`] candidate moves have been
+//!    tried. The budget is a count, not a time, so the result does not depend on the machine.
+//!    Then each closed loop is re-entered at the vertex that minimises the travel to it plus
+//!    the travel from it to the next path, which can only shorten the total.
+//!
+//! [`order_groups`] keeps paths that belong together (an island's perimeters and its infill)
+//! together: groups are visited nearest-first, each group's `first` paths print in their given
+//! order (a closed loop starts at the vertex chosen by the [`SeamRule`]), then its `rest` in the
+//! order of the two steps above.
+//!
+//! Travel is measured as the straight 3D distance from the end of one path to the start of the
+//! next.
+
+use super::toolpath::Toolpath;
+use crate::geom::Point3;
+
+/// Improvements smaller than this (mm) are not taken, so floating-point noise in the
+/// differences of sums cannot make the improvement loop cycle.
+const MIN_GAIN_MM: f64 = 1e-9;
+
+/// Where a closed loop printed in a fixed order starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SeamRule {
+    /// At the vertex nearest to the nozzle (least travel; the seam wanders between layers).
+    #[default]
+    Nearest,
+    /// At the rearmost vertex (largest Y), the one nearest to the nozzle among equally rear
+    /// ones, so seams line up on the back of the part.
+    Rear,
+}
+
+/// Parameters of travel ordering.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrderParams {
+    /// Where closed loops printed in a fixed order (perimeters, skirt) start.
+    pub seam: SeamRule,
+    /// Most candidate moves the improvement pass evaluates per call of [`order_paths`]; 0 turns
+    /// improvement off. Default 200 000 (a few milliseconds).
+    pub max_evaluations: u64,
+}
+
+impl Default for OrderParams {
+    fn default() -> Self {
+        Self {
+            seam: SeamRule::Nearest,
+            max_evaluations: 200_000,
+        }
+    }
+}
+
+fn dist(a: &Point3, b: &Point3) -> f64 {
+    (a - b).norm()
+}
+
+/// Index of the vertex of `points` nearest to `from` (the first one on ties); 0 when empty.
+pub fn nearest_vertex(points: &[Point3], from: &Point3) -> usize {
+    let mut best = (0, f64::INFINITY);
+    for (i, p) in points.iter().enumerate() {
+        let d = dist(p, from);
+        if d < best.1 {
+            best = (i, d);
+        }
+    }
+    best.0
+}
+
+/// Index of the vertex where a loop starts under `rule`, coming from `from`.
+pub fn seam_vertex(points: &[Point3], from: &Point3, rule: SeamRule) -> usize {
+    match rule {
+        SeamRule::Nearest => nearest_vertex(points, from),
+        SeamRule::Rear => {
+            let max_y = points.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
+            let mut best = (0, f64::INFINITY);
+            for (i, p) in points.iter().enumerate() {
+                let d = dist(p, from);
+                if p.y == max_y && d < best.1 {
+                    best = (i, d);
+                }
+            }
+            best.0
+        }
+    }
+}
+
+/// One path in the sequence being improved: where it is entered and left.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    /// Index into the input.
+    index: usize,
+    /// Entry point.
+    a: Point3,
+    /// Exit point (= `a` for a closed loop).
+    b: Point3,
+    /// Open path printed back to front.
+    reversed: bool,
+    /// Vertex a closed loop is entered at.
+    vertex: usize,
+    closed: bool,
+}
+
+impl Node {
+    fn flip(&mut self) {
+        if !self.closed {
+            std::mem::swap(&mut self.a, &mut self.b);
+            self.reversed = !self.reversed;
+        }
+    }
+}
+
+/// The cheapest way to enter `path` from `from`: (travel, reversed, vertex).
+fn best_entry(path: &Toolpath, from: &Point3) -> (f64, bool, usize) {
+    if path.closed {
+        let v = nearest_vertex(&path.points, from);
+        let d = path.points.get(v).map_or(f64::INFINITY, |p| dist(p, from));
+        return (d, false, v);
+    }
+    match (path.points.first(), path.points.last()) {
+        (Some(s), Some(e)) => {
+            let (ds, de) = (dist(s, from), dist(e, from));
+            if de < ds {
+                (de, true, 0)
+            } else {
+                (ds, false, 0)
+            }
+        }
+        _ => (f64::INFINITY, false, 0),
+    }
+}
+
+fn node_for(index: usize, path: &Toolpath, reversed: bool, vertex: usize) -> Node {
+    let origin = Point3::origin();
+    let first = path.points.first().copied().unwrap_or(origin);
+    let last = path.points.last().copied().unwrap_or(origin);
+    if path.closed {
+        let p = path.points.get(vertex).copied().unwrap_or(first);
+        Node {
+            index,
+            a: p,
+            b: p,
+            reversed: false,
+            vertex,
+            closed: true,
+        }
+    } else {
+        let (a, b) = if reversed {
+            (last, first)
+        } else {
+            (first, last)
+        };
+        Node {
+            index,
+            a,
+            b,
+            reversed,
+            vertex: 0,
+            closed: false,
+        }
+    }
+}
+
+/// Total travel of `seq` starting at `from`, mm.
+fn travel(seq: &[Node], from: &Point3) -> f64 {
+    let mut pos = *from;
+    let mut total = 0.0;
+    for n in seq {
+        total += dist(&pos, &n.a);
+        pos = n.b;
+    }
+    total
+}
+
+/// Total travel (mm) of printing `paths` in the given order and direction starting at `from`:
+/// from the nozzle to the first start, then from each path's end to the next one's start.
+pub fn travel_length(paths: &[Toolpath], from: &Point3) -> f64 {
+    let mut pos = *from;
+    let mut total = 0.0;
+    for p in paths {
+        if let (Some(s), Some(e)) = (p.start(), p.end()) {
+            total += dist(&pos, s);
+            pos = *e;
+        }
+    }
+    total
+}
+
+/// Nearest-neighbour order of `paths` from `from`.
+fn nearest_neighbour(paths: &[Toolpath], from: &Point3) -> Vec<Node> {
+    let mut left: Vec<usize> = (0..paths.len()).collect();
+    let mut seq = Vec::with_capacity(paths.len());
+    let mut pos = *from;
+    while !left.is_empty() {
+        let mut best: Option<(usize, f64, bool, usize)> = None;
+        for (slot, &i) in left.iter().enumerate() {
+            let (d, rev, v) = best_entry(&paths[i], &pos);
+            if best.is_none_or(|b| d < b.1) {
+                best = Some((slot, d, rev, v));
+            }
+        }
+        let Some((slot, _, rev, v)) = best else { break };
+        let i = left.remove(slot);
+        let node = node_for(i, &paths[i], rev, v);
+        pos = node.b;
+        seq.push(node);
+    }
+    seq
+}
+
+/// Exit point before position `i` of `seq` (the start position for `i == 0`).
+fn exit_before(seq: &[Node], i: usize, from: &Point3) -> Point3 {
+    if i == 0 { *from } else { seq[i - 1].b }
+}
+
+/// Greedy 2-opt and or-opt on `seq` (see the module docs); returns the evaluations used.
+fn improve(seq: &mut [Node], from: &Point3, max_evaluations: u64) -> u64 {
+    let n = seq.len();
+    let mut evals: u64 = 0;
+    if n < 2 {
+        return evals;
+    }
+    let entry_after = |seq: &[Node], j: usize| seq.get(j + 1).map(|x| x.a);
+    loop {
+        let mut improved = false;
+        // 2-opt: reverse seq[i..=j].
+        for i in 0..n {
+            for j in i + 1..n {
+                if evals >= max_evaluations {
+                    return evals;
+                }
+                evals += 1;
+                let p = exit_before(seq, i, from);
+                let next = entry_after(seq, j);
+                let old = dist(&p, &seq[i].a) + next.map_or(0.0, |q| dist(&seq[j].b, &q));
+                let new = dist(&p, &seq[j].b) + next.map_or(0.0, |q| dist(&seq[i].a, &q));
+                if new < old - MIN_GAIN_MM {
+                    seq[i..=j].reverse();
+                    seq[i..=j].iter_mut().for_each(Node::flip);
+                    improved = true;
+                }
+            }
+        }
+        // Or-opt: move one path to another place, either way round.
+        for k in 0..n {
+            let p = exit_before(seq, k, from);
+            let next = entry_after(seq, k);
+            let removal_gain = dist(&p, &seq[k].a) + next.map_or(0.0, |q| dist(&seq[k].b, &q))
+                - next.map_or(0.0, |q| dist(&p, &q));
+            let node = seq[k];
+            let mut flipped = node;
+            flipped.flip();
+            // Insert between `before` (exit point) and `after` (entry point) in the sequence
+            // without k; m is the insertion index in that sequence.
+            let mut best: Option<(usize, Node, f64)> = None;
+            for m in 0..n {
+                if m == k {
+                    continue;
+                }
+                if evals >= max_evaluations {
+                    break;
+                }
+                evals += 1;
+                // Neighbours in the sequence without k.
+                let without = |t: usize| if t < k { t } else { t + 1 };
+                let before = if m == 0 { *from } else { seq[without(m - 1)].b };
+                let after = if m < n - 1 {
+                    Some(seq[without(m)].a)
+                } else {
+                    None
+                };
+                for cand in [node, flipped] {
+                    let added = dist(&before, &cand.a) + after.map_or(0.0, |q| dist(&cand.b, &q))
+                        - after.map_or(0.0, |q| dist(&before, &q));
+                    let gain = removal_gain - added;
+                    if gain > MIN_GAIN_MM && best.is_none_or(|b| gain > b.2) {
+                        best = Some((m, cand, gain));
+                    }
+                }
+            }
+            if let Some((m, cand, _)) = best {
+                // Remove k, insert at m of the shortened sequence: a rotation of the range.
+                if m < k {
+                    seq[m..=k].rotate_right(1);
+                    seq[m] = cand;
+                } else {
+                    seq[k..=m].rotate_left(1);
+                    seq[m] = cand;
+                }
+                improved = true;
+            }
+            if evals >= max_evaluations {
+                return evals;
+            }
+        }
+        if !improved {
+            return evals;
+        }
+    }
+}
+
+/// Re-enters each closed loop at the vertex minimising travel in plus travel out.
+fn reseat_loops(seq: &mut [Node], paths: &[Toolpath], from: &Point3) {
+    for i in 0..seq.len() {
+        if !seq[i].closed {
+            continue;
+        }
+        let p = exit_before(seq, i, from);
+        let next = seq.get(i + 1).map(|x| x.a);
+        let pts = &paths[seq[i].index].points;
+        let cost = |v: &Point3| dist(&p, v) + next.map_or(0.0, |q| dist(v, &q));
+        let mut best = (
+            seq[i].vertex,
+            pts.get(seq[i].vertex).map_or(f64::INFINITY, cost),
+        );
+        for (v, pt) in pts.iter().enumerate() {
+            let c = cost(pt);
+            if c < best.1 - MIN_GAIN_MM {
+                best = (v, c);
+            }
+        }
+        seq[i] = node_for(seq[i].index, &paths[seq[i].index], false, best.0);
+    }
+}
+
+/// Applies the order and directions of `seq` to `paths`.
+fn apply(seq: &[Node], paths: Vec<Toolpath>) -> Vec<Toolpath> {
+    let mut slots: Vec<Option<Toolpath>> = paths.into_iter().map(Some).collect();
+    let mut out = Vec::with_capacity(seq.len());
+    for n in seq {
+        if let Some(mut p) = slots[n.index].take() {
+            if p.closed {
+                p.rotate_start(n.vertex);
+            } else if n.reversed {
+                p.reverse();
+            }
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// `paths` in travel order from `from` (see the module docs): every path exactly once, closed
+/// loops possibly starting at another vertex, open paths possibly reversed.
+pub fn order_paths(paths: Vec<Toolpath>, from: &Point3, params: &OrderParams) -> Vec<Toolpath> {
+    let mut seq = nearest_neighbour(&paths, from);
+    if params.max_evaluations > 0 {
+        improve(&mut seq, from, params.max_evaluations);
+        reseat_loops(&mut seq, &paths, from);
+    }
+    debug_assert!(travel(&seq, from).is_finite() || paths.iter().any(|p| p.points.is_empty()));
+    apply(&seq, paths)
+}
+
+/// Paths that print together: `first` in the given order, then `rest` in travel order.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Group {
+    /// Printed first, in this order (e.g. an island's perimeters, inner to outer); closed loops
+    /// start where the [`SeamRule`] says, open paths at their nearer end.
+    pub first: Vec<Toolpath>,
+    /// Printed after `first`, ordered by [`order_paths`] (e.g. the island's infill).
+    pub rest: Vec<Toolpath>,
+}
+
+impl Group {
+    /// Travel from `from` to the nearest place this group can be entered.
+    fn entry_distance(&self, from: &Point3, seam: SeamRule) -> f64 {
+        match self.first.first() {
+            Some(p) if p.closed => {
+                let v = seam_vertex(&p.points, from, seam);
+                p.points.get(v).map_or(f64::INFINITY, |q| dist(q, from))
+            }
+            Some(p) => best_entry(p, from).0,
+            None => self
+                .rest
+                .iter()
+                .map(|p| best_entry(p, from).0)
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+}
+
+/// The paths of `groups`, the groups visited nearest-first from `from` (ties to the earlier
+/// group), each printed as [`Group`] says. Returns the paths and the nozzle position after them.
+pub fn order_groups(
+    groups: Vec<Group>,
+    from: &Point3,
+    params: &OrderParams,
+) -> (Vec<Toolpath>, Point3) {
+    let mut left: Vec<Option<Group>> = groups.into_iter().map(Some).collect();
+    let mut pos = *from;
+    let mut out = Vec::new();
+    loop {
+        let mut best: Option<(usize, f64)> = None;
+        for (i, g) in left.iter().enumerate() {
+            if let Some(g) = g {
+                let d = g.entry_distance(&pos, params.seam);
+                if best.is_none_or(|b| d < b.1) {
+                    best = Some((i, d));
+                }
+            }
+        }
+        let Some(group) = best.and_then(|(i, _)| left[i].take()) else {
+            break;
+        };
+        for mut p in group.first {
+            if p.closed {
+                let v = seam_vertex(&p.points, &pos, params.seam);
+                p.rotate_start(v);
+            } else if best_entry(&p, &pos).1 {
+                p.reverse();
+            }
+            if let Some(e) = p.end() {
+                pos = *e;
+            }
+            out.push(p);
+        }
+        for p in order_paths(group.rest, &pos, params) {
+            if let Some(e) = p.end() {
+                pos = *e;
+            }
+            out.push(p);
+        }
+    }
+    (out, pos)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::program::toolpath::Role;
+
+    fn line(x0: f64, y0: f64, x1: f64, y1: f64) -> Toolpath {
+        Toolpath {
+            points: vec![Point3::new(x0, y0, 0.2), Point3::new(x1, y1, 0.2)],
+            closed: false,
+            role: Role::SparseInfill,
+            tool: 0,
+            width: 0.45,
+            height: 0.2,
+            speed: 80.0,
+            tool_axis: None,
+        }
+    }
+
+    fn square_loop(x0: f64, y0: f64, side: f64) -> Toolpath {
+        Toolpath {
+            points: vec![
+                Point3::new(x0, y0, 0.2),
+                Point3::new(x0 + side, y0, 0.2),
+                Point3::new(x0 + side, y0 + side, 0.2),
+                Point3::new(x0, y0 + side, 0.2),
+            ],
+            closed: true,
+            role: Role::Perimeter,
+            ..line(0.0, 0.0, 0.0, 0.0)
+        }
+    }
+
+    /// A deterministic shuffle (64-bit LCG, Knuth's constants).
+    fn shuffle<T>(v: &mut [T], seed: u64) {
+        let mut s = seed;
+        for i in (1..v.len()).rev() {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            let j = ((s >> 33) % (i as u64 + 1)) as usize;
+            v.swap(i, j);
+        }
+    }
+
+    /// Short segments on a 12 × 12 grid, some horizontal, some vertical, some flipped.
+    fn grid_segments() -> Vec<Toolpath> {
+        let mut v = Vec::new();
+        for i in 0..12 {
+            for j in 0..12 {
+                let (x, y) = (f64::from(i) * 5.0, f64::from(j) * 5.0);
+                v.push(match (i + j) % 3 {
+                    0 => line(x, y, x + 2.0, y),
+                    1 => line(x, y + 2.0, x, y),
+                    _ => line(x + 1.0, y + 1.0, x + 2.5, y + 2.5),
+                });
+            }
+        }
+        shuffle(&mut v, 42);
+        v
+    }
+
+    /// A canonical key of a path regardless of direction, for multiset comparison.
+    fn key(p: &Toolpath) -> Vec<(i64, i64)> {
+        let mut k: Vec<(i64, i64)> = p
+            .points
+            .iter()
+            .map(|q| ((q.x * 1e6).round() as i64, (q.y * 1e6).round() as i64))
+            .collect();
+        k.sort_unstable();
+        k
+    }
+
+    #[test]
+    fn ordering_reduces_travel_and_keeps_every_path_once() {
+        let input = grid_segments();
+        let from = Point3::new(0.0, 0.0, 0.2);
+        let before = travel_length(&input, &from);
+        let nn_only = order_paths(
+            input.clone(),
+            &from,
+            &OrderParams {
+                max_evaluations: 0,
+                ..Default::default()
+            },
+        );
+        let ordered = order_paths(input.clone(), &from, &OrderParams::default());
+        let (nn, after) = (
+            travel_length(&nn_only, &from),
+            travel_length(&ordered, &from),
+        );
+        assert!(
+            nn < before / 3.0,
+            "nearest neighbour {nn} vs input {before}"
+        );
+        assert!(after <= nn, "improved {after} vs nearest neighbour {nn}");
+        let mut a: Vec<_> = input.iter().map(key).collect();
+        let mut b: Vec<_> = ordered.iter().map(key).collect();
+        a.sort();
+        b.sort();
+        assert_eq!(a, b, "a path was lost or duplicated");
+        // Lengths (extrusion) unchanged.
+        let len = |v: &[Toolpath]| v.iter().map(Toolpath::length).sum::<f64>();
+        assert!((len(&input) - len(&ordered)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn improvement_fixes_a_bad_nearest_neighbour_tour() {
+        // Nearest neighbour from the origin walks right along the row, then must come all the
+        // way back for the far-left segment; 2-opt / or-opt repairs that.
+        let mut input: Vec<Toolpath> = (1..=10)
+            .map(|i| line(f64::from(i), 0.0, f64::from(i) + 0.5, 0.0))
+            .collect();
+        input.push(line(-3.0, 0.0, -2.5, 0.0));
+        let from = Point3::new(0.0, 0.0, 0.2);
+        let nn = travel_length(
+            &order_paths(
+                input.clone(),
+                &from,
+                &OrderParams {
+                    max_evaluations: 0,
+                    ..Default::default()
+                },
+            ),
+            &from,
+        );
+        let improved = travel_length(&order_paths(input, &from, &OrderParams::default()), &from);
+        assert!(improved < nn - 1.0, "{improved} vs {nn}");
+    }
+
+    #[test]
+    fn ordering_is_deterministic() {
+        let input = grid_segments();
+        let from = Point3::new(3.0, 7.0, 0.2);
+        let a = order_paths(input.clone(), &from, &OrderParams::default());
+        let b = order_paths(input, &from, &OrderParams::default());
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn loops_start_at_the_nearest_vertex_or_the_rear() {
+        let from = Point3::new(11.0, -1.0, 0.2);
+        let ordered = order_paths(
+            vec![square_loop(0.0, 0.0, 10.0)],
+            &from,
+            &OrderParams::default(),
+        );
+        assert_eq!(ordered[0].points[0], Point3::new(10.0, 0.0, 0.2));
+        let groups = vec![Group {
+            first: vec![square_loop(0.0, 0.0, 10.0)],
+            rest: vec![],
+        }];
+        let rear = OrderParams {
+            seam: SeamRule::Rear,
+            ..Default::default()
+        };
+        let (paths, end) = order_groups(groups, &from, &rear);
+        assert_eq!(paths[0].points[0], Point3::new(10.0, 10.0, 0.2));
+        assert_eq!(end, Point3::new(10.0, 10.0, 0.2));
+    }
+
+    #[test]
+    fn groups_stay_together_and_visit_nearest_first() {
+        let island = |x: f64| Group {
+            first: vec![square_loop(x, 0.0, 10.0), square_loop(x + 1.0, 1.0, 8.0)],
+            rest: vec![
+                line(x + 2.0, 5.0, x + 8.0, 5.0),
+                line(x + 2.0, 3.0, x + 8.0, 3.0),
+            ],
+        };
+        let groups = vec![island(100.0), island(0.0), island(50.0)];
+        let (paths, _) = order_groups(groups, &Point3::new(0.0, 0.0, 0.2), &OrderParams::default());
+        assert_eq!(paths.len(), 12);
+        let xs: Vec<i64> = paths
+            .iter()
+            .map(|p| (p.points[0].x / 50.0).floor() as i64)
+            .collect();
+        assert_eq!(xs, [0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2]);
+        // Within each group the loops come first, in their given order.
+        assert!(paths[0].closed && paths[1].closed && !paths[2].closed && !paths[3].closed);
+        assert!((paths[0].points.iter().map(|p| p.x).fold(f64::MAX, f64::min) - 0.0).abs() < 1e-12);
+    }
+}

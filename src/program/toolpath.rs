@@ -1,0 +1,325 @@
+//! The Program's vocabulary: [`Toolpath`]s with a [`Role`], [`Event`]s, and [`Layer`]s of both in
+//! print order.
+
+use crate::geom::{Point3, Vector3};
+
+/// What an extrusion is for. Decides speed, cooling and the `;TYPE:` comment of G-code output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Role {
+    /// The outermost loop of an island or hole (the visible wall).
+    ExternalPerimeter,
+    /// An inner perimeter loop.
+    Perimeter,
+    /// Internal solid infill (solid layers between a surface and sparse infill).
+    SolidInfill,
+    /// Solid infill of an upward-facing (visible) surface.
+    TopSolidInfill,
+    /// Solid infill of a downward-facing surface (on the bed or over air).
+    BottomSolidInfill,
+    /// Sparse infill.
+    SparseInfill,
+    /// Skirt (or brim) loops around the first layer.
+    Skirt,
+    /// Planar scaffold under curved layers.
+    Scaffold,
+    /// Buffer layer between the scaffold and curved layers.
+    Buffer,
+    /// A conductive trace (paste or ink tool).
+    ConductiveTrace,
+    /// A conductive drop (a dot of paste on a pad).
+    ConductiveDrop,
+    /// Anything else (custom G-code, imported paths).
+    Custom,
+}
+
+impl Role {
+    /// Every role, in declaration order.
+    pub const ALL: [Role; 12] = [
+        Role::ExternalPerimeter,
+        Role::Perimeter,
+        Role::SolidInfill,
+        Role::TopSolidInfill,
+        Role::BottomSolidInfill,
+        Role::SparseInfill,
+        Role::Skirt,
+        Role::Scaffold,
+        Role::Buffer,
+        Role::ConductiveTrace,
+        Role::ConductiveDrop,
+        Role::Custom,
+    ];
+
+    /// The name written after `;TYPE:` in G-code.
+    ///
+    /// PrusaSlicer's names (`ExtrusionEntity.cpp`, `ExtrusionEntity::role_to_string`) where
+    /// PrusaSlicer has the role, so its G-code viewer and post-processors understand the
+    /// output: bottom solid infill is `Solid infill` as in PrusaSlicer, which has no separate
+    /// bottom role (it calls bottom infill over air `Bridge infill`, which conduit does not
+    /// detect). The conduit-only roles use names in the same style: `Scaffold`, `Buffer`,
+    /// `Conductive trace`, `Conductive drop`.
+    pub fn type_name(self) -> &'static str {
+        match self {
+            Role::ExternalPerimeter => "External perimeter",
+            Role::Perimeter => "Perimeter",
+            Role::SolidInfill | Role::BottomSolidInfill => "Solid infill",
+            Role::TopSolidInfill => "Top solid infill",
+            Role::SparseInfill => "Internal infill",
+            Role::Skirt => "Skirt/Brim",
+            Role::Scaffold => "Scaffold",
+            Role::Buffer => "Buffer",
+            Role::ConductiveTrace => "Conductive trace",
+            Role::ConductiveDrop => "Conductive drop",
+            Role::Custom => "Custom",
+        }
+    }
+
+    /// The role named `name` in a `;TYPE:` comment (the inverse of [`Role::type_name`], with
+    /// `Solid infill` read as [`Role::SolidInfill`]); `None` for names conduit has no role for.
+    pub fn from_type_name(name: &str) -> Option<Role> {
+        Role::ALL
+            .into_iter()
+            .filter(|r| *r != Role::BottomSolidInfill)
+            .find(|r| r.type_name() == name)
+    }
+
+    /// Whether the role deposits conductive material.
+    pub fn is_conductive(self) -> bool {
+        matches!(self, Role::ConductiveTrace | Role::ConductiveDrop)
+    }
+}
+
+/// One continuous extrusion: the nozzle moves through `points` while depositing.
+///
+/// Points are always 3D (planar paths keep z constant), in millimetres, in the machine frame
+/// *before* per-tool offsets (the writer applies those).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Toolpath {
+    /// The centreline. For a closed path the last point connects back to the first, which is not
+    /// repeated.
+    pub points: Vec<Point3>,
+    /// Whether the path is a loop (the move from the last point back to the first is part of
+    /// the extrusion).
+    pub closed: bool,
+    /// What the extrusion is for.
+    pub role: Role,
+    /// Tool index (0 = plastic, 1 = conductive paste, ...).
+    pub tool: usize,
+    /// Extrusion width, mm.
+    pub width: f64,
+    /// Extrusion height (layer height for planar paths), mm.
+    pub height: f64,
+    /// Feed rate while extruding, mm/s.
+    pub speed: f64,
+    /// Tool direction per point (unit vectors, for 5/6-axis output); `None` for 3-axis paths.
+    /// When present it has one entry per point.
+    pub tool_axis: Option<Vec<Vector3>>,
+}
+
+impl Toolpath {
+    /// Length of the extrusion, mm, including the closing segment of a closed path.
+    pub fn length(&self) -> f64 {
+        let open: f64 = self.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        match (self.closed, self.points.first(), self.points.last()) {
+            (true, Some(first), Some(last)) if self.points.len() > 2 => {
+                open + (first - last).norm()
+            }
+            _ => open,
+        }
+    }
+
+    /// The point where the extrusion starts.
+    pub fn start(&self) -> Option<&Point3> {
+        self.points.first()
+    }
+
+    /// The point where the extrusion ends: the start again for a closed path.
+    pub fn end(&self) -> Option<&Point3> {
+        if self.closed {
+            self.points.first()
+        } else {
+            self.points.last()
+        }
+    }
+
+    /// Reverses the direction of travel (points and tool axes together).
+    pub fn reverse(&mut self) {
+        self.points.reverse();
+        if let Some(axis) = &mut self.tool_axis {
+            axis.reverse();
+        }
+    }
+
+    /// Makes a closed path start at its point `index` (points and tool axes rotate together).
+    /// Does nothing for an open path or an index out of range.
+    pub fn rotate_start(&mut self, index: usize) {
+        if !self.closed || index >= self.points.len() {
+            return;
+        }
+        self.points.rotate_left(index);
+        if let Some(axis) = &mut self.tool_axis
+            && index < axis.len()
+        {
+            axis.rotate_left(index);
+        }
+    }
+}
+
+/// Something that happens between extrusions.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Event {
+    /// Switch to another tool; the following paths use it.
+    ToolChange {
+        /// The new tool's index.
+        tool: usize,
+    },
+    /// Pick part `part` and place it at the given pose (machine frame, before tool offsets).
+    PickAndPlace {
+        /// Part name (reference designator, e.g. `R1`).
+        part: String,
+        /// X of the part centre, mm.
+        x: f64,
+        /// Y of the part centre, mm.
+        y: f64,
+        /// Z of the part's seating plane, mm.
+        z: f64,
+        /// Rotation about +Z, degrees counter-clockwise.
+        rotation_deg: f64,
+    },
+    /// Pause so an operator can insert a part by hand.
+    ManualInsertPause {
+        /// Part name.
+        part: String,
+        /// Message shown to the operator.
+        message: String,
+    },
+    /// A comment carried into the machine program.
+    Comment(String),
+    /// Wait in place.
+    Dwell {
+        /// Duration, seconds.
+        seconds: f64,
+    },
+}
+
+/// One entry of a layer, in print order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LayerItem {
+    /// An extrusion.
+    Path(Toolpath),
+    /// An event.
+    Event(Event),
+}
+
+/// One layer of the Program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layer {
+    /// 0 for the first layer, counting up.
+    pub index: usize,
+    /// Nominal print height (top of the layer, where the nozzle is), mm.
+    pub z: f64,
+    /// Layer thickness, mm.
+    pub height: f64,
+    /// Paths and events in print order.
+    pub items: Vec<LayerItem>,
+}
+
+impl Layer {
+    /// The layer's toolpaths in print order.
+    pub fn paths(&self) -> impl Iterator<Item = &Toolpath> {
+        self.items.iter().filter_map(|i| match i {
+            LayerItem::Path(p) => Some(p),
+            LayerItem::Event(_) => None,
+        })
+    }
+}
+
+/// Ordered layers of toolpaths and events: what every machine-program writer consumes.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Program {
+    /// Layers, bottom to top.
+    pub layers: Vec<Layer>,
+}
+
+impl Program {
+    /// Every toolpath in print order.
+    pub fn paths(&self) -> impl Iterator<Item = &Toolpath> {
+        self.layers.iter().flat_map(Layer::paths)
+    }
+
+    /// The tools that extrude, ascending, without repeats.
+    pub fn tools_used(&self) -> Vec<usize> {
+        let mut tools: Vec<usize> = self.paths().map(|p| p.tool).collect();
+        tools.sort_unstable();
+        tools.dedup();
+        tools
+    }
+
+    /// The tool of the first extrusion, if any.
+    pub fn first_tool(&self) -> Option<usize> {
+        self.paths().next().map(|p| p.tool)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(closed: bool) -> Toolpath {
+        Toolpath {
+            points: vec![
+                Point3::new(0.0, 0.0, 0.2),
+                Point3::new(10.0, 0.0, 0.2),
+                Point3::new(10.0, 10.0, 0.2),
+                Point3::new(0.0, 10.0, 0.2),
+            ],
+            closed,
+            role: Role::Perimeter,
+            tool: 0,
+            width: 0.45,
+            height: 0.2,
+            speed: 60.0,
+            tool_axis: Some(
+                (0..4)
+                    .map(|i| Vector3::new(f64::from(i), 0.0, 1.0))
+                    .collect(),
+            ),
+        }
+    }
+
+    #[test]
+    fn length_counts_the_closing_segment_of_loops_only() {
+        assert_eq!(square(true).length(), 40.0);
+        assert_eq!(square(false).length(), 30.0);
+        assert_eq!(square(true).end(), square(true).start());
+    }
+
+    #[test]
+    fn rotate_and_reverse_keep_tool_axes_with_their_points() {
+        let mut p = square(true);
+        p.rotate_start(2);
+        assert_eq!(p.points[0], Point3::new(10.0, 10.0, 0.2));
+        assert_eq!(p.tool_axis.as_ref().map(|a| a[0].x), Some(2.0));
+        p.reverse();
+        assert_eq!(p.points[0], Point3::new(10.0, 0.0, 0.2));
+        assert_eq!(p.tool_axis.as_ref().map(|a| a[0].x), Some(1.0));
+        let mut open = square(false);
+        open.rotate_start(2);
+        assert_eq!(open, square(false));
+    }
+
+    #[test]
+    fn type_names_are_prusaslicer_names_and_round_trip() {
+        assert_eq!(Role::SparseInfill.type_name(), "Internal infill");
+        assert_eq!(Role::Skirt.type_name(), "Skirt/Brim");
+        for role in Role::ALL {
+            let back = Role::from_type_name(role.type_name());
+            let want = if role == Role::BottomSolidInfill {
+                Role::SolidInfill
+            } else {
+                role
+            };
+            assert_eq!(back, Some(want));
+        }
+        assert_eq!(Role::from_type_name("Wipe tower"), None);
+    }
+}
