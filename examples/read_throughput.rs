@@ -24,13 +24,19 @@ fn main() {
         let mb = bytes.len() as f64 / 1e6;
         let kind = FileKind::detect(&path, &bytes);
         let parse = time(|| match kind {
-            Some(FileKind::Stl) => conduit_stl::read(&bytes).map(|s| s.triangles.len()).unwrap_or(0),
+            Some(FileKind::Stl) => conduit_stl::read(&bytes)
+                .map(|s| s.triangles.len())
+                .unwrap_or(0),
             Some(FileKind::ThreeMf) => conduit_3mf::read(&bytes, &conduit_3mf::Limits::default())
                 .map(|p| p.models.len())
                 .unwrap_or(0),
             _ => 0,
         });
-        let full = time(|| load(&path, &LoadOptions::default()).map(|f| f.warnings.len()).unwrap_or(0));
+        let full = time(|| {
+            load(&path, &LoadOptions::default())
+                .map(|f| f.warnings.len())
+                .unwrap_or(0)
+        });
         println!(
             "{}: {:.1} MB, parse {:.0} MB/s, full load (read + parse + index) {:.0} MB/s",
             path.display(),

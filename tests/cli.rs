@@ -5,7 +5,11 @@ use serde_json::Value;
 
 #[test]
 fn help_is_available_for_every_command() {
-    for args in [vec!["--help"], vec!["info", "--help"], vec!["convert", "--help"]] {
+    for args in [
+        vec!["--help"],
+        vec!["info", "--help"],
+        vec!["convert", "--help"],
+    ] {
         let o = conduit(&args);
         assert_eq!(o.status.code(), Some(0), "{args:?}");
         assert!(stdout(&o).contains("Usage"), "{args:?}");
@@ -17,17 +21,37 @@ fn usage_errors_exit_2() {
     assert_eq!(conduit(["info"]).status.code(), Some(2));
     assert_eq!(conduit(["frobnicate"]).status.code(), Some(2));
     let cube = sample("cube_20mm.stl");
-    let two = conduit(["convert".as_ref(), cube.as_os_str(), cube.as_os_str(), "-o".as_ref(), "x.stl".as_ref()]);
+    let two = conduit([
+        "convert".as_ref(),
+        cube.as_os_str(),
+        cube.as_os_str(),
+        "-o".as_ref(),
+        "x.stl".as_ref(),
+    ]);
     assert_eq!(two.status.code(), Some(2), "{}", stderr(&two));
-    let ext = conduit(["convert".as_ref(), cube.as_os_str(), "-o".as_ref(), "x.step".as_ref()]);
+    let ext = conduit([
+        "convert".as_ref(),
+        cube.as_os_str(),
+        "-o".as_ref(),
+        "x.step".as_ref(),
+    ]);
     assert_eq!(ext.status.code(), Some(2));
-    let no_dir = conduit(["convert".as_ref(), cube.as_os_str(), "--to".as_ref(), "3mf".as_ref()]);
+    let no_dir = conduit([
+        "convert".as_ref(),
+        cube.as_os_str(),
+        "--to".as_ref(),
+        "3mf".as_ref(),
+    ]);
     assert_eq!(no_dir.status.code(), Some(2));
 }
 
 #[test]
 fn info_json_reports_analytic_cube_values() {
-    let o = conduit(["info".as_ref(), "--json".as_ref(), sample("cube_20mm.stl").as_os_str()]);
+    let o = conduit([
+        "info".as_ref(),
+        "--json".as_ref(),
+        sample("cube_20mm.stl").as_os_str(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: Value = serde_json::from_str(&stdout(&o)).expect("JSON");
     let f = &v[0];
@@ -46,10 +70,17 @@ fn info_json_reports_analytic_cube_values() {
 
 #[test]
 fn info_text_lists_each_file() {
-    let o = conduit(["info".as_ref(), sample("cube_20mm.stl").as_os_str(), sample("l_bracket.obj").as_os_str()]);
+    let o = conduit([
+        "info".as_ref(),
+        sample("cube_20mm.stl").as_os_str(),
+        sample("l_bracket.obj").as_os_str(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);
-    assert!(text.contains("cube_20mm.stl") && text.contains("l_bracket.obj"), "{text}");
+    assert!(
+        text.contains("cube_20mm.stl") && text.contains("l_bracket.obj"),
+        "{text}"
+    );
     assert!(text.contains("volume_mm3: 6500"), "{text}");
 }
 
@@ -61,13 +92,25 @@ fn bad_input_exits_1_naming_the_file_and_good_files_still_report() {
     let mut bytes = vec![0u8; 84 + 50];
     bytes[80..84].copy_from_slice(&1000u32.to_le_bytes());
     std::fs::write(&bad, &bytes).expect("write");
-    let o = conduit(["info".as_ref(), "--json".as_ref(), sample("cube_20mm.stl").as_os_str(), bad.as_os_str()]);
+    let o = conduit([
+        "info".as_ref(),
+        "--json".as_ref(),
+        sample("cube_20mm.stl").as_os_str(),
+        bad.as_os_str(),
+    ]);
     assert_eq!(o.status.code(), Some(1));
     let err = stderr(&o);
-    assert!(err.starts_with("error: ") && err.contains("broken.stl"), "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("broken.stl"),
+        "{err}"
+    );
     let v: Value = serde_json::from_str(&stdout(&o)).expect("JSON");
     assert_eq!(v[0]["triangles"], 12);
-    assert!(v[1]["error"].as_str().is_some_and(|e| e.contains("broken.stl")));
+    assert!(
+        v[1]["error"]
+            .as_str()
+            .is_some_and(|e| e.contains("broken.stl"))
+    );
     let missing = conduit(["info", "/nonexistent/file.stl"]);
     assert_eq!(missing.status.code(), Some(1));
     assert!(stderr(&missing).contains("/nonexistent/file.stl"));
@@ -79,12 +122,26 @@ fn failed_convert_leaves_no_partial_file_and_keeps_the_old_one() {
     let bad = dir.path().join("bad.obj");
     std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 9\n").expect("write");
     let out = dir.path().join("out.stl");
-    let o = conduit(["convert".as_ref(), bad.as_os_str(), "-o".as_ref(), out.as_os_str()]);
+    let o = conduit([
+        "convert".as_ref(),
+        bad.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("bad.obj"));
-    assert_eq!(files_in(dir.path()), vec![bad.clone()], "no output and no temp file left");
+    assert_eq!(
+        files_in(dir.path()),
+        vec![bad.clone()],
+        "no output and no temp file left"
+    );
     std::fs::write(&out, b"previous").expect("write");
-    let o = conduit(["convert".as_ref(), bad.as_os_str(), "-o".as_ref(), out.as_os_str()]);
+    let o = conduit([
+        "convert".as_ref(),
+        bad.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
     assert_eq!(o.status.code(), Some(1));
     assert_eq!(std::fs::read(&out).expect("read"), b"previous");
 }
@@ -95,16 +152,31 @@ fn batch_convert_writes_one_file_per_input_and_refuses_collisions() {
     let inputs = [sample("cube_20mm.stl"), sample("l_bracket.obj")];
     let mut args: Vec<std::ffi::OsString> = vec!["convert".into()];
     args.extend(inputs.iter().map(|p| p.clone().into_os_string()));
-    args.extend(["--to".into(), "obj".into(), "--out-dir".into(), dir.path().as_os_str().to_owned()]);
+    args.extend([
+        "--to".into(),
+        "obj".into(),
+        "--out-dir".into(),
+        dir.path().as_os_str().to_owned(),
+    ]);
     let o = conduit(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    let names: Vec<String> =
-        files_in(dir.path()).iter().filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned())).collect();
+    let names: Vec<String> = files_in(dir.path())
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
     assert_eq!(names, ["cube_20mm.obj", "l_bracket.obj"]);
     // Same stem twice → usage error before any work.
     let mut args: Vec<std::ffi::OsString> = vec!["convert".into()];
-    args.extend([sample("cube_20mm.stl").into_os_string(), dir.path().join("cube_20mm.obj").into_os_string()]);
-    args.extend(["--to".into(), "stl".into(), "--out-dir".into(), dir.path().as_os_str().to_owned()]);
+    args.extend([
+        sample("cube_20mm.stl").into_os_string(),
+        dir.path().join("cube_20mm.obj").into_os_string(),
+    ]);
+    args.extend([
+        "--to".into(),
+        "stl".into(),
+        "--out-dir".into(),
+        dir.path().as_os_str().to_owned(),
+    ]);
     assert_eq!(conduit(&args).status.code(), Some(2));
 }
 
@@ -115,9 +187,18 @@ fn convert_output_is_deterministic() {
         let a = dir.path().join(format!("a.{fmt}"));
         let b = dir.path().join(format!("b.{fmt}"));
         for out in [&a, &b] {
-            let o = conduit(["convert".as_ref(), sample("l_bracket.obj").as_os_str(), "-o".as_ref(), out.as_os_str()]);
+            let o = conduit([
+                "convert".as_ref(),
+                sample("l_bracket.obj").as_os_str(),
+                "-o".as_ref(),
+                out.as_os_str(),
+            ]);
             assert!(o.status.success(), "{}", stderr(&o));
         }
-        assert_eq!(std::fs::read(&a).expect("read"), std::fs::read(&b).expect("read"), "{fmt}");
+        assert_eq!(
+            std::fs::read(&a).expect("read"),
+            std::fs::read(&b).expect("read"),
+            "{fmt}"
+        );
     }
 }

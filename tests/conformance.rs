@@ -22,7 +22,10 @@ fn cases() -> Option<Vec<Case>> {
         .filter_map(|e| {
             let outcome = e["outcome"].as_str()?.to_string();
             let staged = e["staged"].as_str()?;
-            (outcome != "companion").then(|| Case { path: dir.join(staged), outcome })
+            (outcome != "companion").then(|| Case {
+                path: dir.join(staged),
+                outcome,
+            })
         })
         .collect();
     cases.sort_by(|a, b| a.path.cmp(&b.path));
@@ -53,13 +56,20 @@ fn info_meets_every_manifest_outcome() {
                         ("load", 0) | ("either", 0) => None,
                         ("reject", 1) | ("either", 1) => {
                             let lines: Vec<&str> = err.lines().collect();
-                            if lines.len() != 1 || !lines[0].starts_with("error: ") || !lines[0].contains(&name) {
-                                Some(format!("message should be one line naming the file, got {err:?}"))
+                            if lines.len() != 1
+                                || !lines[0].starts_with("error: ")
+                                || !lines[0].contains(&name)
+                            {
+                                Some(format!(
+                                    "message should be one line naming the file, got {err:?}"
+                                ))
                             } else {
                                 None
                             }
                         }
-                        (expected, code) => Some(format!("expected {expected}, exit {code}: {}", err.trim())),
+                        (expected, code) => {
+                            Some(format!("expected {expected}, exit {code}: {}", err.trim()))
+                        }
                     };
                     let slot = match code {
                         0 => 0,
@@ -75,7 +85,15 @@ fn info_meets_every_manifest_outcome() {
         }
     });
     let [loaded, rejected, other] = *counts.lock().expect("lock");
-    println!("corpus: {} files, {loaded} loaded, {rejected} rejected, {other} other exits", cases.len());
+    println!(
+        "corpus: {} files, {loaded} loaded, {rejected} rejected, {other} other exits",
+        cases.len()
+    );
     let failures = failures.into_inner().expect("lock");
-    assert!(failures.is_empty(), "{} corpus files off their expected outcome:\n{}", failures.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} corpus files off their expected outcome:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }

@@ -8,22 +8,50 @@ use conduit::scene::{LoadOptions, MeshFormat, Scene, SceneObject, load_scene, sa
 use std::path::Path;
 
 fn bits(tris: &[[[f32; 3]; 3]]) -> Vec<[[u32; 3]; 3]> {
-    tris.iter().map(|t| t.map(|v| v.map(f32::to_bits))).collect()
+    tris.iter()
+        .map(|t| t.map(|v| v.map(f32::to_bits)))
+        .collect()
 }
 
 fn stl_to_3mf_to_stl_is_bit_exact(input: &Path) {
     let dir = temp_dir();
     let mid = dir.path().join("mid.3mf");
     let back = dir.path().join("back.stl");
-    let a = conduit(["convert".as_ref(), input.as_os_str(), "-o".as_ref(), mid.as_os_str()]);
+    let a = conduit([
+        "convert".as_ref(),
+        input.as_os_str(),
+        "-o".as_ref(),
+        mid.as_os_str(),
+    ]);
     assert!(a.status.success(), "{}: {}", input.display(), stderr(&a));
-    let b = conduit(["convert".as_ref(), mid.as_os_str(), "-o".as_ref(), back.as_os_str()]);
+    let b = conduit([
+        "convert".as_ref(),
+        mid.as_os_str(),
+        "-o".as_ref(),
+        back.as_os_str(),
+    ]);
     assert!(b.status.success(), "{}: {}", input.display(), stderr(&b));
     let original = stl_triangles(input);
     let returned = stl_triangles(&back);
-    assert_eq!(original.len(), returned.len(), "{}: triangle count", input.display());
-    assert!(bits(&original) == bits(&returned), "{}: coordinates changed", input.display());
-    let vol = |p: &Path| load_scene(p, &LoadOptions::default()).expect("loads").0.objects[0].mesh.signed_volume();
+    assert_eq!(
+        original.len(),
+        returned.len(),
+        "{}: triangle count",
+        input.display()
+    );
+    assert!(
+        bits(&original) == bits(&returned),
+        "{}: coordinates changed",
+        input.display()
+    );
+    let vol = |p: &Path| {
+        load_scene(p, &LoadOptions::default())
+            .expect("loads")
+            .0
+            .objects[0]
+            .mesh
+            .signed_volume()
+    };
     assert_eq!(vol(input), vol(&back), "{}: volume", input.display());
 }
 
@@ -35,8 +63,12 @@ fn sample_cube_round_trips_through_3mf_bit_exactly() {
 #[test]
 fn bench_models_round_trip_through_3mf_bit_exactly() {
     let Some(dir) = corpus() else { return };
-    for name in ["20mm_cube.stl", "3DBenchy.stl", "voron2_a_drive_frame_lower.stl", "voron2_exhaust_filter_housing.stl"]
-    {
+    for name in [
+        "20mm_cube.stl",
+        "3DBenchy.stl",
+        "voron2_a_drive_frame_lower.stl",
+        "voron2_exhaust_filter_housing.stl",
+    ] {
         stl_to_3mf_to_stl_is_bit_exact(&dir.join("bench-models").join(name));
     }
 }
@@ -46,7 +78,12 @@ fn obj_to_stl_keeps_triangles_and_volume() {
     let dir = temp_dir();
     let out = dir.path().join("bracket.stl");
     let input = sample("l_bracket.obj");
-    let r = conduit(["convert".as_ref(), input.as_os_str(), "-o".as_ref(), out.as_os_str()]);
+    let r = conduit([
+        "convert".as_ref(),
+        input.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
     assert!(r.status.success(), "{}", stderr(&r));
     let (obj, _) = load_scene(&input, &LoadOptions::default()).expect("obj loads");
     let tris = stl_triangles(&out);
@@ -93,7 +130,9 @@ fn two_object_scene() -> Scene {
             tool: None,
         }
     };
-    Scene { objects: vec![cube("small", 0.1, 0.0), cube("large", 12.5, 30.0)] }
+    Scene {
+        objects: vec![cube("small", 0.1, 0.0), cube("large", 12.5, 30.0)],
+    }
 }
 
 #[test]
@@ -108,7 +147,10 @@ fn threemf_write_then_read_gives_the_same_scene() {
     // Same input, same bytes.
     let again = dir.path().join("again.3mf");
     save(&back, &again, MeshFormat::ThreeMf).expect("3MF written");
-    assert_eq!(std::fs::read(&path).expect("read"), std::fs::read(&again).expect("read"));
+    assert_eq!(
+        std::fs::read(&path).expect("read"),
+        std::fs::read(&again).expect("read")
+    );
 }
 
 #[test]
@@ -135,10 +177,15 @@ fn threemf_build_transforms_are_applied_on_read() {
 #[test]
 fn corpus_3mf_files_survive_write_and_read() {
     let Some(dir) = corpus() else { return };
-    let files = ["3mf-samples/examples/core/cube_gears.3mf", "3mf-samples/examples/core/torus.3mf", "lib3mf/Tests/TestFiles/Reader/Globo.3mf"];
+    let files = [
+        "3mf-samples/examples/core/cube_gears.3mf",
+        "3mf-samples/examples/core/torus.3mf",
+        "lib3mf/Tests/TestFiles/Reader/Globo.3mf",
+    ];
     let out = temp_dir();
     for f in files {
-        let (scene, _) = load_scene(&dir.join(f), &LoadOptions::default()).expect("corpus 3MF loads");
+        let (scene, _) =
+            load_scene(&dir.join(f), &LoadOptions::default()).expect("corpus 3MF loads");
         let path = out.path().join("x.3mf");
         save(&scene, &path, MeshFormat::ThreeMf).expect("written");
         let (back, _) = load_scene(&path, &LoadOptions::default()).expect("read back");
@@ -174,12 +221,21 @@ fn written_3mf_loads_in_lib3mf_without_warnings() {
     let mut written = Vec::new();
     for (i, f) in inputs.iter().enumerate() {
         let target = out.path().join(format!("out{i}.3mf"));
-        let r = conduit(["convert".as_ref(), dir.join(f).as_os_str(), "-o".as_ref(), target.as_os_str()]);
+        let r = conduit([
+            "convert".as_ref(),
+            dir.join(f).as_os_str(),
+            "-o".as_ref(),
+            target.as_os_str(),
+        ]);
         assert!(r.status.success(), "{f}: {}", stderr(&r));
         written.push(target);
     }
     let check = crate::support::root().join("bench/lib3mf_check.py");
-    let r = std::process::Command::new("python3").arg(check).args(&written).output().expect("python runs");
+    let r = std::process::Command::new("python3")
+        .arg(check)
+        .args(&written)
+        .output()
+        .expect("python runs");
     assert!(
         r.status.success(),
         "lib3mf rejected or warned:\n{}{}",

@@ -30,7 +30,10 @@ where
     I: IntoIterator<Item = S>,
     S: AsRef<std::ffi::OsStr>,
 {
-    Command::new(env!("CARGO_BIN_EXE_conduit")).args(args).output().expect("the conduit binary runs")
+    Command::new(env!("CARGO_BIN_EXE_conduit"))
+        .args(args)
+        .output()
+        .expect("the conduit binary runs")
 }
 
 /// Stdout of a run as text.
