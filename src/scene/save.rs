@@ -146,19 +146,7 @@ pub fn to_3mf_model(scene: &Scene) -> conduit_3mf::Model {
             kind: conduit_3mf::ObjectType::Model,
             pid: None,
             pindex: None,
-            content: conduit_3mf::ObjectContent::Mesh(conduit_3mf::Mesh {
-                vertices: o.mesh.vertices.iter().map(|p| [p.x, p.y, p.z]).collect(),
-                triangles: o
-                    .mesh
-                    .triangles
-                    .iter()
-                    .map(|&v| conduit_3mf::Triangle {
-                        v,
-                        pid: None,
-                        p: [None; 3],
-                    })
-                    .collect(),
-            }),
+            content: conduit_3mf::ObjectContent::Mesh(threemf_mesh(&o.mesh)),
         });
         model.build.push(conduit_3mf::BuildItem {
             object_id: id,
@@ -168,6 +156,29 @@ pub fn to_3mf_model(scene: &Scene) -> conduit_3mf::Model {
         });
     }
     model
+}
+
+/// The 3MF mesh of an indexed mesh. 3MF requires the three vertex indices of a triangle to be
+/// distinct; a triangle that collapsed onto a repeated index when the soup was welded (STL files
+/// carry such slivers) gets its own copies of the repeated vertex, so every triangle and every
+/// coordinate survives the trip unchanged.
+fn threemf_mesh(mesh: &Mesh) -> conduit_3mf::Mesh {
+    let mut vertices: Vec<[f64; 3]> = mesh.vertices.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let triangles = mesh
+        .triangles
+        .iter()
+        .map(|&[a, b, c]| {
+            let mut v = [a, b, c];
+            for i in 1..3 {
+                if v[..i].contains(&v[i]) {
+                    vertices.push(vertices[v[i] as usize]);
+                    v[i] = (vertices.len() - 1) as u32;
+                }
+            }
+            conduit_3mf::Triangle { v, pid: None, p: [None; 3] }
+        })
+        .collect();
+    conduit_3mf::Mesh { vertices, triangles }
 }
 
 /// Writes a scene to `path` in `format`, atomically.
