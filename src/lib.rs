@@ -17,6 +17,7 @@
 
 pub mod geom;
 pub mod mesh;
+pub mod program;
 pub mod region;
 pub mod scene;
 pub mod slice;

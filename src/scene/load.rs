@@ -33,8 +33,9 @@ impl Default for LoadOptions {
 pub struct LoadError {
     /// The file.
     pub path: PathBuf,
-    /// What went wrong.
-    pub kind: LoadErrorKind,
+    /// What went wrong (boxed: format errors carry rich context and errors should stay cheap to
+    /// return).
+    pub kind: Box<LoadErrorKind>,
 }
 
 /// Why a file failed to load.
@@ -61,7 +62,7 @@ pub enum LoadErrorKind {
     Stl(#[from] conduit_stl::StlError),
     /// 3MF error.
     #[error("3MF: {0}")]
-    ThreeMf(#[from] conduit_3mf::ThreeMfError),
+    ThreeMf(Box<conduit_3mf::ThreeMfError>),
     /// OBJ error.
     #[error("OBJ: {0}")]
     Obj(#[from] conduit_obj::ObjError),
@@ -167,7 +168,7 @@ pub struct LoadedFile {
 pub fn load(path: &Path, opts: &LoadOptions) -> Result<LoadedFile, LoadError> {
     let err = |kind: LoadErrorKind| LoadError {
         path: path.to_path_buf(),
-        kind,
+        kind: Box::new(kind),
     };
     let bytes = read_bounded(path, opts.max_file_bytes).map_err(err)?;
     let kind = FileKind::detect(path, &bytes).ok_or_else(|| err(LoadErrorKind::Unrecognised))?;
@@ -187,7 +188,10 @@ pub fn load_scene(path: &Path, opts: &LoadOptions) -> Result<(Scene, Vec<String>
         Content::Mesh { scene, .. } => Ok((scene, file.warnings)),
         _ => Err(LoadError {
             path: path.to_path_buf(),
-            kind: LoadErrorKind::NotAMesh(format!("a {:?} file holds no triangle mesh", file.kind)),
+            kind: Box::new(LoadErrorKind::NotAMesh(format!(
+                "a {:?} file holds no triangle mesh",
+                file.kind
+            ))),
         }),
     }
 }
@@ -349,4 +353,10 @@ fn parse(
         FileKind::Svg => Content::Design(conduit_svg::read(bytes, opts.svg_tolerance_mm)?),
     };
     Ok((content, warnings))
+}
+
+impl From<conduit_3mf::ThreeMfError> for LoadErrorKind {
+    fn from(e: conduit_3mf::ThreeMfError) -> Self {
+        LoadErrorKind::ThreeMf(Box::new(e))
+    }
 }

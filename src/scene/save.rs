@@ -59,7 +59,7 @@ pub enum SaveErrorKind {
     Io(#[from] std::io::Error),
     /// 3MF writer error.
     #[error("3MF: {0}")]
-    ThreeMf(#[from] conduit_3mf::ThreeMfError),
+    ThreeMf(Box<conduit_3mf::ThreeMfError>),
     /// A coordinate does not fit the output format (STL stores 32-bit floats).
     #[error("{0}")]
     Unrepresentable(String),
@@ -175,10 +175,17 @@ fn threemf_mesh(mesh: &Mesh) -> conduit_3mf::Mesh {
                     v[i] = (vertices.len() - 1) as u32;
                 }
             }
-            conduit_3mf::Triangle { v, pid: None, p: [None; 3] }
+            conduit_3mf::Triangle {
+                v,
+                pid: None,
+                p: [None; 3],
+            }
         })
         .collect();
-    conduit_3mf::Mesh { vertices, triangles }
+    conduit_3mf::Mesh {
+        vertices,
+        triangles,
+    }
 }
 
 /// Writes a scene to `path` in `format`, atomically.
@@ -238,5 +245,11 @@ fn stl_name(scene: &Scene) -> String {
     match scene.objects.as_slice() {
         [one] => one.name.clone(),
         _ => "conduit".to_string(),
+    }
+}
+
+impl From<conduit_3mf::ThreeMfError> for SaveErrorKind {
+    fn from(e: conduit_3mf::ThreeMfError) -> Self {
+        SaveErrorKind::ThreeMf(Box::new(e))
     }
 }

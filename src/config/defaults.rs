@@ -1,0 +1,319 @@
+//! The default configuration as a commented TOML document (`conduit config --defaults`).
+
+use super::Config;
+
+/// One documented key: its section (`tools` stands for every `[tools.N]`), name, doc line, and
+/// for keys that are absent by default an example value written commented out.
+struct KeyDoc {
+    section: &'static str,
+    key: &'static str,
+    doc: &'static str,
+    example: Option<&'static str>,
+}
+
+const fn k(section: &'static str, key: &'static str, doc: &'static str) -> KeyDoc {
+    KeyDoc {
+        section,
+        key,
+        doc,
+        example: None,
+    }
+}
+
+const fn opt(
+    section: &'static str,
+    key: &'static str,
+    doc: &'static str,
+    example: &'static str,
+) -> KeyDoc {
+    KeyDoc {
+        section,
+        key,
+        doc,
+        example: Some(example),
+    }
+}
+
+const SECTION_DOCS: &[(&str, &str)] = &[
+    ("printer", "The machine: bed, firmware, custom G-code, retraction, travel, fan."),
+    (
+        "tools",
+        "One table per tool, numbered from 0 without gaps. Keys left out take the default of the \
+         tool's kind\n(\"filament\" or \"paste\"), not of the table shown here.",
+    ),
+    (
+        "slice",
+        "Slicing: layer heights, perimeters, infill, extrusion widths, speeds per role.",
+    ),
+];
+
+const KEYS: &[KeyDoc] = &[
+    k("printer", "flavor", "G-code dialect: \"marlin\", \"reprapfirmware\" or \"klipper\"."),
+    k("printer", "bed_size", "Printable bed size [X, Y], mm."),
+    k(
+        "printer",
+        "bed_origin",
+        "Coordinates of the bed's front-left corner [X, Y], mm ([-125, -125] for a 250 mm bed \
+         with the origin in its centre).",
+    ),
+    k("printer", "max_height", "Highest printable Z, mm."),
+    k("printer", "bed_temperature", "Bed temperature after the first layer, °C (0 = off)."),
+    k("printer", "first_layer_bed_temperature", "Bed temperature for the first layer, °C."),
+    k(
+        "printer",
+        "start_gcode",
+        "Written before the print. Placeholders: {key} for a printer or slice key, {key[N]} for \
+         tool N's key or an array element;\n\
+         {key} with a tool key means the current tool. PrusaSlicer's [key] works too.",
+    ),
+    k("printer", "end_gcode", "Written after the print."),
+    k(
+        "printer",
+        "before_tool_change_gcode",
+        "Written before every tool change; {previous_tool} and {next_tool} are available.",
+    ),
+    k(
+        "printer",
+        "after_tool_change_gcode",
+        "Written after every tool change; {previous_tool} and {next_tool} are available.",
+    ),
+    k(
+        "printer",
+        "retract_length",
+        "Filament pulled back before travels, mm (a tool's retract_length overrides it).",
+    ),
+    k("printer", "retract_speed", "Retraction speed, mm/s of filament."),
+    k("printer", "deretract_speed", "Un-retraction speed, mm/s; 0 = retract_speed."),
+    k("printer", "retract_before_travel", "Travels shorter than this do not retract, mm."),
+    k("printer", "retract_lift", "Z lift during retracted travels, mm; 0 = none."),
+    k("printer", "travel_speed", "Speed of non-printing moves, mm/s."),
+    k("printer", "max_acceleration", "Machine acceleration for time estimates, mm/s²."),
+    k(
+        "printer",
+        "max_print_speed",
+        "Highest speed of any printing move, mm/s; faster role speeds are clamped.",
+    ),
+    k(
+        "printer",
+        "use_relative_e_distances",
+        "Relative E (M83) instead of absolute E (M82).",
+    ),
+    k("printer", "fan_min_speed", "Lowest part-cooling fan speed when on, %."),
+    k("printer", "fan_max_speed", "Highest part-cooling fan speed, %."),
+    k("printer", "disable_fan_first_layers", "Number of bottom layers printed with the fan off."),
+    k("printer", "use_firmware_retraction", "Retract with G10/G11 instead of E moves."),
+    k("tools", "name", "Name shown in comments and reports."),
+    k(
+        "tools",
+        "kind",
+        "\"filament\" (E-driven extruder) or \"paste\" (dispenser switched by paste_on_gcode / \
+         paste_off_gcode, time-based flow).",
+    ),
+    k("tools", "nozzle_diameter", "Nozzle or needle inner diameter, mm."),
+    k("tools", "filament_diameter", "Filament diameter, mm (filament tools)."),
+    k("tools", "filament_density", "Material density for the weight estimate, g/cm³."),
+    k("tools", "temperature", "Nozzle temperature after the first layer, °C; 0 = not heated."),
+    k("tools", "first_layer_temperature", "Nozzle temperature for the first layer, °C."),
+    opt(
+        "tools",
+        "standby_temperature",
+        "Temperature while parked during another tool's work, °C; absent = keep temperature.",
+        "150.0",
+    ),
+    k(
+        "tools",
+        "offset",
+        "Nozzle offset from tool 0 [X, Y], mm, when the firmware does not apply it.",
+    ),
+    k("tools", "extrusion_multiplier", "Factor on the computed flow."),
+    k(
+        "tools",
+        "paste_on_gcode",
+        "G-code that starts the paste flow (paste tools). The default drives output pin 6 high:\n\
+         set P to the pin wired to your dispenser's valve or screw driver (Klipper: SET_PIN).",
+    ),
+    k("tools", "paste_off_gcode", "G-code that stops the paste flow (paste tools)."),
+    k("tools", "paste_flow_mm3_s", "Volume dispensed per second while on, mm³/s (paste tools)."),
+    opt(
+        "tools",
+        "retract_length",
+        "This tool's retraction, mm; absent = printer.retract_length.",
+        "1.0",
+    ),
+    k("slice", "layer_height", "Layer height, mm."),
+    k("slice", "first_layer_height", "Height of the first layer, mm."),
+    k(
+        "slice",
+        "nozzle_diameter",
+        "Nozzle diameter the widths are checked against, mm (keep equal to tools.0.nozzle_diameter).",
+    ),
+    k("slice", "perimeters", "Perimeter loops per island, the external one included."),
+    k(
+        "slice",
+        "external_perimeters_first",
+        "Print the external loop first (better accuracy, worse overhangs).",
+    ),
+    k("slice", "top_solid_layers", "Solid layers under every top surface."),
+    k("slice", "bottom_solid_layers", "Solid layers over every bottom surface and the bed."),
+    k("slice", "infill_density", "Sparse infill density, 0 (none) to 1 (solid)."),
+    k(
+        "slice",
+        "infill_pattern",
+        "Sparse infill pattern: \"rectilinear\", \"grid\" or \"triangles\".",
+    ),
+    k("slice", "infill_angle_deg", "Base infill direction, degrees counter-clockwise from +X."),
+    k(
+        "slice",
+        "infill_overlap",
+        "How far infill reaches into the innermost perimeter, fraction of perimeter_width.",
+    ),
+    k(
+        "slice",
+        "solid_infill_margin",
+        "How far solid areas grow into the neighbouring sparse area, mm.",
+    ),
+    k("slice", "top_fill_pattern", "Top solid infill pattern: \"rectilinear\"."),
+    k("slice", "bottom_fill_pattern", "Bottom solid infill pattern: \"rectilinear\"."),
+    k("slice", "external_perimeter_width", "Extrusion width of the external loop, mm."),
+    k("slice", "perimeter_width", "Extrusion width of inner loops, mm."),
+    k("slice", "infill_width", "Extrusion width of sparse infill, mm."),
+    k("slice", "solid_infill_width", "Extrusion width of solid infill, mm."),
+    k("slice", "top_solid_infill_width", "Extrusion width of top solid infill, mm."),
+    k("slice", "first_layer_width", "Extrusion width on the first layer (all roles), mm."),
+    k("slice", "skirt_loops", "Skirt loops around the first layer; 0 = no skirt."),
+    k("slice", "skirt_distance", "Gap between the objects and the skirt, mm."),
+    k("slice", "brim_width", "Brim width around the first layer, mm; 0 = none."),
+    k("slice", "support_material", "Generate support material."),
+    k("slice", "perimeter_speed", "Speed of inner perimeters, mm/s."),
+    k("slice", "external_perimeter_speed", "Speed of external perimeters, mm/s."),
+    k("slice", "infill_speed", "Speed of sparse infill, mm/s."),
+    k("slice", "solid_infill_speed", "Speed of internal and bottom solid infill, mm/s."),
+    k("slice", "top_solid_infill_speed", "Speed of top solid infill, mm/s."),
+    k("slice", "first_layer_speed", "Speed of every printing move on the first layer, mm/s."),
+    k("slice", "skirt_speed", "Speed of skirt and brim, mm/s."),
+    k("slice", "conductive_speed", "Speed of conductive traces (paste tools), mm/s."),
+    k(
+        "slice",
+        "object_tools",
+        "Tool of each scene object: object i prints with object_tools[i]; objects past the end \
+         use tool 0.",
+    ),
+];
+
+/// The default configuration ([`Config::default`]) as a TOML document with every key, its
+/// documentation and unit as comments. Parsing it gives `Config::default()` back exactly.
+pub fn defaults_toml() -> String {
+    let mut out = String::from(
+        "# conduit configuration: every key with its default value.\n\
+         # Units: lengths mm, speeds mm/s, accelerations mm/s², temperatures °C, fan %.\n\
+         # Any key may be left out; unknown keys are errors.\n",
+    );
+    let tree = match toml::Value::try_from(Config::default()) {
+        Ok(t) => t,
+        Err(e) => panic!("internal error: default config does not serialise: {e}"),
+    };
+    for &(section, section_doc) in SECTION_DOCS {
+        let Some(value) = tree.get(section) else {
+            continue;
+        };
+        let tables: Vec<(String, &toml::Value)> = if section == "tools" {
+            value
+                .as_table()
+                .map(|t| t.iter().map(|(n, v)| (format!("tools.{n}"), v)).collect())
+                .unwrap_or_default()
+        } else {
+            vec![(section.to_owned(), value)]
+        };
+        for (i, (header, table)) in tables.iter().enumerate() {
+            out.push('\n');
+            if i == 0 {
+                push_comment(&mut out, section_doc);
+            }
+            out.push_str(&format!("[{header}]\n"));
+            for doc in KEYS.iter().filter(|d| d.section == section) {
+                push_comment(&mut out, doc.doc);
+                match (table.get(doc.key), doc.example) {
+                    (Some(v), _) => out.push_str(&format!("{} = {}\n", doc.key, format_value(v))),
+                    (None, Some(example)) => out.push_str(&format!("# {} = {example}\n", doc.key)),
+                    (None, None) => {}
+                }
+            }
+        }
+    }
+    out
+}
+
+fn push_comment(out: &mut String, text: &str) {
+    for line in text.lines() {
+        out.push_str("# ");
+        out.push_str(line.trim());
+        out.push('\n');
+    }
+}
+
+/// One value as TOML; strings with newlines as multi-line literal strings for readability.
+fn format_value(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) if s.contains('\n') && !s.contains("'''") && !s.contains('\r') => {
+            format!("'''\n{s}'''")
+        }
+        other => other.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_toml_loads_back_to_the_default_config() -> Result<(), toml::de::Error> {
+        let text = defaults_toml();
+        let back = Config::from_toml_str(&text)?;
+        assert_eq!(back, Config::default());
+        assert!(text.contains("[tools.1]\n"));
+        assert!(text.contains("# standby_temperature = 150.0\n"));
+        Ok(())
+    }
+
+    #[test]
+    fn every_key_is_documented_once_and_every_doc_is_a_key() {
+        let tree = match toml::Value::try_from(Config::default()) {
+            Ok(t) => t,
+            Err(e) => panic!("{e}"),
+        };
+        let mut serialised = std::collections::BTreeSet::new();
+        for (section, value) in tree.as_table().into_iter().flatten() {
+            let tables: Vec<&toml::Value> = if section == "tools" {
+                value.as_table().into_iter().flat_map(|t| t.values()).collect()
+            } else {
+                vec![value]
+            };
+            for t in tables {
+                for key in t.as_table().into_iter().flat_map(|t| t.keys()) {
+                    serialised.insert((section.clone(), key.clone()));
+                }
+            }
+        }
+        let mut documented = std::collections::BTreeSet::new();
+        for d in KEYS {
+            assert!(
+                documented.insert((d.section.to_owned(), d.key.to_owned())),
+                "{}.{} documented twice",
+                d.section,
+                d.key
+            );
+        }
+        let optional: std::collections::BTreeSet<_> = KEYS
+            .iter()
+            .filter(|d| d.example.is_some())
+            .map(|d| (d.section.to_owned(), d.key.to_owned()))
+            .collect();
+        let undocumented: Vec<_> = serialised.difference(&documented).collect();
+        assert!(undocumented.is_empty(), "undocumented keys: {undocumented:?}");
+        let unknown: Vec<_> = documented
+            .difference(&serialised)
+            .filter(|k| !optional.contains(*k))
+            .collect();
+        assert!(unknown.is_empty(), "documented keys that do not exist: {unknown:?}");
+    }
+}

@@ -1,0 +1,715 @@
+//! Import of PrusaSlicer (and Slic3r) settings: a `.ini` profile export, or the `key = value`
+//! pairs of the `SLIC3R_<KEY>` environment a post-processing script is called with.
+//!
+//! Place in the pipeline: an alternative front door to [`Config`]. The CLI loads a `.ini` with
+//! [`super::load`]; the post-processing mode builds the config of the host slicer's print with
+//! [`from_slic3r_env`]. Both end in [`from_prusa_pairs`].
+//!
+//! # Mapping
+//!
+//! Keys start from [`Config::default`] and overwrite what PrusaSlicer states:
+//!
+//! - printer: `bed_shape` (polygon; its bounding box gives `bed_size` and `bed_origin`),
+//!   `max_print_height`, `gcode_flavor` (`marlin`, `marlin2`, `reprapfirmware`, `klipper`;
+//!   others become marlin with a warning), `start_gcode`, `end_gcode` (`\n` escapes undone),
+//!   `bed_temperature`, `first_layer_bed_temperature`, `retract_length`, `retract_speed`,
+//!   `deretract_speed`, `retract_before_travel`, `retract_lift`, `travel_speed`,
+//!   `max_print_speed`, `machine_max_acceleration_extruding` (or `default_acceleration`),
+//!   `use_relative_e_distances`, `use_firmware_retraction`, `min_fan_speed`, `max_fan_speed`,
+//!   `disable_fan_first_layers`;
+//! - tools: the comma-separated lists give one value per extruder: `nozzle_diameter`,
+//!   `filament_diameter`, `filament_density`, `filament_type` (the tool's name), `temperature`,
+//!   `first_layer_temperature`, `idle_temperature`, `extrusion_multiplier`, `extruder_offset`,
+//!   per-extruder `retract_length` (the first is the printer's, others that differ become tool
+//!   overrides). PrusaSlicer's extruders become filament tools `0..n`; conduit's default paste
+//!   tool ([`super::Tool::paste`]) is appended as tool `n` so that a plastic-only profile can
+//!   still drive the conductive tool.
+//! - slice: `layer_height`, `first_layer_height` (mm, or % of `layer_height`), `perimeters`,
+//!   `top_solid_layers`, `bottom_solid_layers`, `fill_density` (`20%` → 0.2), `fill_pattern`,
+//!   `top_fill_pattern` / `bottom_fill_pattern` (Slic3r: `top_infill_pattern`, …), `fill_angle`,
+//!   `infill_overlap`, `external_perimeters_first`, `support_material`, `skirts`,
+//!   `skirt_distance`, `brim_width`, `perimeter_generator` (classic; arachne gives a warning
+//!   that classic perimeters are printed), the speeds (a `%` speed is relative to its
+//!   PrusaSlicer parent: external perimeter → perimeter, solid infill → infill, top solid →
+//!   solid infill, first layer → perimeter, support → perimeter), `support_material_speed` (→
+//!   `skirt_speed`, as PrusaSlicer prints skirts at support speed);
+//! - widths: `extrusion_width` and `first_layer_`, `perimeter_`, `external_perimeter_`,
+//!   `infill_`, `solid_infill_`, `top_infill_extrusion_width`. A value is mm or `%` of the first
+//!   nozzle diameter. 0 falls back to `extrusion_width`, and when that is 0 too to PrusaSlicer's
+//!   automatic width (`Flow::auto_extrusion_width`): 1.125 × nozzle for perimeters and
+//!   (solid) infill, 1 × nozzle for top solid infill. A first-layer width of 0 means each role's
+//!   own width; conduit has one first-layer width and takes the perimeter width.
+//!
+//! Every other key is listed, once, in a warning as ignored.
+
+use std::collections::BTreeMap;
+use std::collections::BTreeSet;
+
+use super::{Config, ConfigError, Flavor, SolidPattern, Tool};
+use crate::region::InfillPatternKind;
+
+/// Reads a PrusaSlicer `.ini` (`key = value` lines, `#` comments, `[section]` headers of a
+/// config bundle are skipped). Errors carry the line number.
+pub fn from_ini_str(src: &str) -> Result<(Config, Vec<String>), ConfigError> {
+    let mut pairs = Vec::new();
+    for (i, raw) in src.lines().enumerate() {
+        let line = raw.trim();
+        if line.is_empty() || line.starts_with('#') || line.starts_with(';') {
+            continue;
+        }
+        if line.starts_with('[') && line.ends_with(']') {
+            continue;
+        }
+        let Some((key, value)) = line.split_once('=') else {
+            return Err(ConfigError::Ini {
+                path: None,
+                line: Some(i + 1),
+                key: line.to_owned(),
+                value: String::new(),
+                message: "expected `key = value`".to_owned(),
+            });
+        };
+        pairs.push((key.trim().to_owned(), value.trim().to_owned(), Some(i + 1)));
+    }
+    convert(pairs)
+}
+
+/// Builds a config from PrusaSlicer `key`/`value` pairs (keys as in the `.ini`, values as
+/// written there). Later pairs override earlier ones. Returns the config and the warnings.
+pub fn from_prusa_pairs(
+    pairs: impl IntoIterator<Item = (String, String)>,
+) -> Result<(Config, Vec<String>), ConfigError> {
+    convert(pairs.into_iter().map(|(k, v)| (k, v, None)).collect())
+}
+
+/// Builds a config from the environment of a PrusaSlicer post-processing call: variables named
+/// `SLIC3R_<KEY>` (upper-case key) carry each setting. Other variables are skipped. Pass
+/// `std::env::vars()`.
+pub fn from_slic3r_env(
+    vars: impl IntoIterator<Item = (String, String)>,
+) -> Result<(Config, Vec<String>), ConfigError> {
+    from_prusa_pairs(vars.into_iter().filter_map(|(k, v)| {
+        k.strip_prefix("SLIC3R_")
+            .map(|key| (key.to_ascii_lowercase(), v))
+    }))
+}
+
+struct Pairs {
+    values: BTreeMap<String, (String, Option<usize>)>,
+    used: BTreeSet<String>,
+}
+
+impl Pairs {
+    fn raw(&mut self, key: &str) -> Option<&str> {
+        let (v, _) = self.values.get(key)?;
+        self.used.insert(key.to_owned());
+        Some(v.as_str())
+    }
+
+    fn err(&self, key: &str, message: impl Into<String>) -> ConfigError {
+        let (value, line) = self.values.get(key).cloned().unwrap_or_default();
+        ConfigError::Ini {
+            path: None,
+            line,
+            key: key.to_owned(),
+            value,
+            message: message.into(),
+        }
+    }
+
+    /// A plain number (the first item of a list).
+    fn num(&mut self, key: &str) -> Result<Option<f64>, ConfigError> {
+        Ok(self.list(key)?.first().copied())
+    }
+
+    /// A comma-separated list of numbers.
+    fn list(&mut self, key: &str) -> Result<Vec<f64>, ConfigError> {
+        let Some(raw) = self.raw(key).map(str::to_owned) else {
+            return Ok(Vec::new());
+        };
+        raw.split(',')
+            .map(|s| {
+                s.trim()
+                    .parse::<f64>()
+                    .map_err(|_| self.err(key, "expected a number (or a comma-separated list)"))
+            })
+            .collect()
+    }
+
+    /// A comma-separated list of strings (PrusaSlicer quotes list items that need it).
+    fn strings(&mut self, key: &str) -> Vec<String> {
+        self.raw(key)
+            .map(|raw| {
+                raw.split(';')
+                    .flat_map(|s| s.split(','))
+                    .map(|s| s.trim().trim_matches('"').to_owned())
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    /// An integer count.
+    fn count(&mut self, key: &str) -> Result<Option<usize>, ConfigError> {
+        match self.num(key)? {
+            Some(v) if v >= 0.0 && v.fract() == 0.0 => Ok(Some(v as usize)),
+            Some(_) => Err(self.err(key, "expected a whole number ≥ 0")),
+            None => Ok(None),
+        }
+    }
+
+    /// A boolean (`0`/`1`, `true`/`false`), the first of a list.
+    fn flag(&mut self, key: &str) -> Result<Option<bool>, ConfigError> {
+        let Some(raw) = self.raw(key).map(str::to_owned) else {
+            return Ok(None);
+        };
+        match raw.split(',').next().map(str::trim) {
+            Some("1" | "true") => Ok(Some(true)),
+            Some("0" | "false") => Ok(Some(false)),
+            _ => Err(self.err(key, "expected 0 or 1")),
+        }
+    }
+
+    /// A number or a percentage of `base`.
+    fn abs_or_percent(&mut self, key: &str, base: f64) -> Result<Option<f64>, ConfigError> {
+        let Some(raw) = self.raw(key).map(str::to_owned) else {
+            return Ok(None);
+        };
+        let first = raw.split(',').next().unwrap_or_default().trim();
+        let parsed = match first.strip_suffix('%') {
+            Some(p) => p.trim().parse::<f64>().map(|p| p / 100.0 * base),
+            None => first.parse::<f64>(),
+        };
+        parsed
+            .map(Some)
+            .map_err(|_| self.err(key, "expected a number or a percentage"))
+    }
+
+    /// A G-code string, with PrusaSlicer's C-style escapes undone.
+    fn gcode(&mut self, key: &str) -> Option<String> {
+        let raw = self.raw(key)?;
+        let raw = raw
+            .strip_prefix('"')
+            .and_then(|r| r.strip_suffix('"'))
+            .unwrap_or(raw);
+        Some(unescape(raw))
+    }
+}
+
+/// Undoes PrusaSlicer's `escape_string_cstyle`: `\n`, `\r`, `\t`, and `\x` → `x`.
+fn unescape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut chars = s.chars();
+    while let Some(c) = chars.next() {
+        if c != '\\' {
+            out.push(c);
+            continue;
+        }
+        match chars.next() {
+            Some('n') => out.push('\n'),
+            Some('r') => out.push('\r'),
+            Some('t') => out.push('\t'),
+            Some(other) => out.push(other),
+            None => out.push('\\'),
+        }
+    }
+    out
+}
+
+/// Keys read elsewhere that give no warning when present.
+const ACCEPTED: &[&str] = &["printer_technology", "perimeter_generator"];
+
+/// Lists whose length tells the number of extruders.
+const PER_EXTRUDER: &[&str] = &[
+    "nozzle_diameter",
+    "filament_diameter",
+    "temperature",
+    "first_layer_temperature",
+    "extruder_offset",
+    "extrusion_multiplier",
+    "filament_density",
+    "retract_length",
+];
+
+fn convert(list: Vec<(String, String, Option<usize>)>) -> Result<(Config, Vec<String>), ConfigError> {
+    let mut p = Pairs {
+        values: list.into_iter().map(|(k, v, l)| (k, (v, l))).collect(),
+        used: BTreeSet::new(),
+    };
+    let mut cfg = Config::default();
+    let mut warnings = Vec::new();
+
+    if let Some(tech) = p.raw("printer_technology").map(str::to_owned) {
+        if !tech.eq_ignore_ascii_case("FFF") {
+            return Err(p.err(
+                "printer_technology",
+                "conduit drives FFF (filament) printers only",
+            ));
+        }
+    }
+
+    // Tools: one per extruder.
+    let n_tools = PER_EXTRUDER
+        .iter()
+        .filter_map(|k| p.values.get(*k))
+        .map(|(v, _)| v.split(',').count())
+        .max()
+        .unwrap_or(1)
+        .max(1);
+    let mut tools = vec![Tool::filament(); n_tools];
+    macro_rules! per_tool {
+        ($key:literal, $field:ident) => {
+            let values = p.list($key)?;
+            for (t, v) in tools.iter_mut().zip(values.iter().chain(std::iter::repeat(
+                values.last().unwrap_or(&Tool::filament().$field),
+            ))) {
+                t.$field = *v;
+            }
+        };
+    }
+    per_tool!("nozzle_diameter", nozzle_diameter);
+    per_tool!("filament_diameter", filament_diameter);
+    per_tool!("filament_density", filament_density);
+    per_tool!("temperature", temperature);
+    per_tool!("first_layer_temperature", first_layer_temperature);
+    per_tool!("extrusion_multiplier", extrusion_multiplier);
+    for (t, name) in tools.iter_mut().zip(p.strings("filament_type")) {
+        if !name.is_empty() {
+            t.name = name;
+        }
+    }
+    if let Some(raw) = p.raw("idle_temperature").map(str::to_owned) {
+        for (t, v) in tools.iter_mut().zip(raw.split(',')) {
+            let v = v.trim();
+            if v != "nil" && !v.is_empty() {
+                t.standby_temperature = Some(
+                    v.parse()
+                        .map_err(|_| p.err("idle_temperature", "expected a number or nil"))?,
+                );
+            }
+        }
+    }
+    if let Some(raw) = p.raw("extruder_offset").map(str::to_owned) {
+        for (t, xy) in tools.iter_mut().zip(raw.split(',')) {
+            t.offset = parse_xy(xy).ok_or_else(|| p.err("extruder_offset", "expected XxY"))?;
+        }
+    }
+    let retract = p.list("retract_length")?;
+    if let Some(&first) = retract.first() {
+        cfg.printer.retract_length = first;
+        for (t, &r) in tools.iter_mut().zip(&retract) {
+            if r != first {
+                t.retract_length = Some(r);
+            }
+        }
+    }
+    let nozzle = tools[0].nozzle_diameter;
+    cfg.tools = tools;
+    cfg.tools.push(Tool::paste());
+
+    // Printer.
+    let pr = &mut cfg.printer;
+    if let Some(raw) = p.raw("bed_shape").map(str::to_owned) {
+        let points: Option<Vec<[f64; 2]>> = raw.split(',').map(parse_xy).collect();
+        let points = points
+            .filter(|pts| pts.len() >= 3)
+            .ok_or_else(|| p.err("bed_shape", "expected a polygon `XxY,XxY,XxY,…`"))?;
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for q in &points {
+            for a in 0..2 {
+                lo[a] = lo[a].min(q[a]);
+                hi[a] = hi[a].max(q[a]);
+            }
+        }
+        pr.bed_origin = lo;
+        pr.bed_size = [hi[0] - lo[0], hi[1] - lo[1]];
+    }
+    if let Some(v) = p.num("max_print_height")? {
+        pr.max_height = v;
+    }
+    if let Some(f) = p.raw("gcode_flavor").map(str::to_owned) {
+        pr.flavor = match f.trim() {
+            "marlin" | "marlin2" | "marlinlegacy" => Flavor::Marlin,
+            "reprapfirmware" => Flavor::RepRapFirmware,
+            "klipper" => Flavor::Klipper,
+            other => {
+                warnings.push(format!(
+                    "gcode_flavor = {other}: not supported, G-code is written for marlin"
+                ));
+                Flavor::Marlin
+            }
+        };
+    }
+    for (key, field) in [
+        ("start_gcode", &mut pr.start_gcode),
+        ("end_gcode", &mut pr.end_gcode),
+    ] {
+        if let Some(g) = p.gcode(key) {
+            if has_macros(&g) {
+                warnings.push(format!(
+                    "{key} uses PrusaSlicer macros ({{if …}} or expressions) that conduit cannot \
+                     fill; edit printer.{key}"
+                ));
+            }
+            *field = g;
+        }
+    }
+    for (key, field) in [
+        ("bed_temperature", &mut pr.bed_temperature),
+        ("first_layer_bed_temperature", &mut pr.first_layer_bed_temperature),
+        ("retract_speed", &mut pr.retract_speed),
+        ("deretract_speed", &mut pr.deretract_speed),
+        ("retract_before_travel", &mut pr.retract_before_travel),
+        ("retract_lift", &mut pr.retract_lift),
+        ("travel_speed", &mut pr.travel_speed),
+        ("max_print_speed", &mut pr.max_print_speed),
+        ("min_fan_speed", &mut pr.fan_min_speed),
+        ("max_fan_speed", &mut pr.fan_max_speed),
+    ] {
+        if let Some(v) = p.num(key)? {
+            *field = v;
+        }
+    }
+    let accel = p.num("machine_max_acceleration_extruding")?;
+    let default_accel = p.num("default_acceleration")?;
+    if let Some(a) = accel.filter(|a| *a > 0.0).or(default_accel.filter(|a| *a > 0.0)) {
+        pr.max_acceleration = a;
+    }
+    if let Some(v) = p.count("disable_fan_first_layers")? {
+        pr.disable_fan_first_layers = v;
+    }
+    if let Some(v) = p.flag("use_relative_e_distances")? {
+        pr.use_relative_e_distances = v;
+    }
+    if let Some(v) = p.flag("use_firmware_retraction")? {
+        pr.use_firmware_retraction = v;
+    }
+
+    // Slicing.
+    let s = &mut cfg.slice;
+    s.region.nozzle_diameter = nozzle;
+    if let Some(v) = p.num("layer_height")? {
+        s.region.layer_height = v;
+    }
+    if let Some(v) = p.abs_or_percent("first_layer_height", s.region.layer_height)? {
+        s.first_layer_height = v;
+    }
+    for (key, field) in [
+        ("perimeters", &mut s.region.perimeters),
+        ("top_solid_layers", &mut s.region.top_solid_layers),
+        ("bottom_solid_layers", &mut s.region.bottom_solid_layers),
+        ("skirts", &mut s.region.skirt_loops),
+    ] {
+        if let Some(v) = p.count(key)? {
+            *field = v;
+        }
+    }
+    if let Some(raw) = p.raw("fill_density").map(str::to_owned) {
+        let raw = raw.trim();
+        let d = match raw.strip_suffix('%') {
+            Some(pc) => pc.trim().parse::<f64>().map(|v| v / 100.0),
+            None => raw.parse::<f64>().map(|v| if v > 1.0 { v / 100.0 } else { v }),
+        };
+        s.region.infill_density = d.map_err(|_| p.err("fill_density", "expected a percentage"))?;
+    }
+    if let Some(pat) = p.raw("fill_pattern").map(str::to_owned) {
+        s.region.infill_pattern = match pat.trim() {
+            "rectilinear" => InfillPatternKind::Rectilinear,
+            "grid" => InfillPatternKind::Grid,
+            "triangles" => InfillPatternKind::Triangles,
+            other => {
+                warnings.push(format!(
+                    "fill_pattern = {other}: not available, rectilinear infill is printed"
+                ));
+                InfillPatternKind::Rectilinear
+            }
+        };
+    }
+    for (keys, field) in [
+        (["top_fill_pattern", "top_infill_pattern"], &mut s.top_fill_pattern),
+        (["bottom_fill_pattern", "bottom_infill_pattern"], &mut s.bottom_fill_pattern),
+    ] {
+        for key in keys {
+            if let Some(pat) = p.raw(key).map(str::to_owned) {
+                if pat.trim() != "rectilinear" {
+                    warnings.push(format!(
+                        "{key} = {}: not available, rectilinear solid infill is printed",
+                        pat.trim()
+                    ));
+                }
+                *field = SolidPattern::Rectilinear;
+            }
+        }
+    }
+    if let Some(v) = p.num("fill_angle")? {
+        s.region.infill_angle_deg = v;
+    }
+    let perimeter_width_guess = s.region.perimeter_width;
+    if let Some(v) = p.abs_or_percent("infill_overlap", perimeter_width_guess)? {
+        // PrusaSlicer: mm, or % of the perimeter extrusion width; conduit: a fraction of it.
+        s.region.infill_overlap = v / perimeter_width_guess;
+    }
+    if let Some(v) = p.flag("external_perimeters_first")? {
+        s.region.external_perimeters_first = v;
+    }
+    if let Some(v) = p.flag("support_material")? {
+        s.support_material = v;
+    }
+    if let Some(v) = p.num("skirt_distance")? {
+        s.region.skirt_distance = v;
+    }
+    if let Some(v) = p.num("brim_width")? {
+        s.brim_width = v;
+    }
+    if let Some(g) = p.raw("perimeter_generator").map(str::to_owned) {
+        if g.trim() != "classic" {
+            warnings.push(format!(
+                "perimeter_generator = {}: conduit prints classic perimeters",
+                g.trim()
+            ));
+        }
+    }
+
+    // Widths: role key, automatic factor (× nozzle), field.
+    let generic = p
+        .abs_or_percent("extrusion_width", nozzle)?
+        .filter(|w| *w > 0.0);
+    let width = |p: &mut Pairs, key: &str, auto: f64| -> Result<Option<f64>, ConfigError> {
+        let given = p.abs_or_percent(key, nozzle)?;
+        Ok(match given {
+            Some(w) if w > 0.0 => Some(w),
+            Some(_) => Some(generic.unwrap_or(auto * nozzle)),
+            None => generic,
+        })
+    };
+    for (key, auto, field) in [
+        ("perimeter_extrusion_width", 1.125, &mut s.region.perimeter_width),
+        (
+            "external_perimeter_extrusion_width",
+            1.125,
+            &mut s.region.external_perimeter_width,
+        ),
+        ("infill_extrusion_width", 1.125, &mut s.region.infill_width),
+        ("solid_infill_extrusion_width", 1.125, &mut s.region.solid_infill_width),
+        ("top_infill_extrusion_width", 1.0, &mut s.top_solid_infill_width),
+    ] {
+        if let Some(w) = width(&mut p, key, auto)? {
+            *field = w;
+        }
+    }
+    match p.abs_or_percent("first_layer_extrusion_width", nozzle)? {
+        Some(w) if w > 0.0 => s.first_layer_width = w,
+        _ => s.first_layer_width = s.region.perimeter_width,
+    }
+
+    // Speeds; a percentage is of the parent PrusaSlicer uses.
+    if let Some(v) = p.num("perimeter_speed")? {
+        s.perimeter_speed = v;
+    }
+    if let Some(v) = p.abs_or_percent("external_perimeter_speed", s.perimeter_speed)? {
+        s.external_perimeter_speed = v;
+    }
+    if let Some(v) = p.num("infill_speed")? {
+        s.infill_speed = v;
+    }
+    if let Some(v) = p.abs_or_percent("solid_infill_speed", s.infill_speed)? {
+        s.solid_infill_speed = v;
+    }
+    if let Some(v) = p.abs_or_percent("top_solid_infill_speed", s.solid_infill_speed)? {
+        s.top_solid_infill_speed = v;
+    }
+    if let Some(v) = p.abs_or_percent("first_layer_speed", s.perimeter_speed)? {
+        s.first_layer_speed = v;
+    }
+    if let Some(v) = p.abs_or_percent("support_material_speed", s.perimeter_speed)? {
+        s.skirt_speed = v;
+    }
+
+    for key in ACCEPTED {
+        p.used.insert((*key).to_owned());
+    }
+    let ignored: Vec<&str> = p
+        .values
+        .keys()
+        .filter(|k| !p.used.contains(*k))
+        .map(String::as_str)
+        .collect();
+    if !ignored.is_empty() {
+        warnings.push(format!(
+            "ignored PrusaSlicer settings (no conduit equivalent): {}",
+            ignored.join(", ")
+        ));
+    }
+    let more = cfg.validate()?;
+    warnings.extend(more);
+    Ok((cfg, warnings))
+}
+
+/// `250x125` → [250, 125].
+fn parse_xy(s: &str) -> Option<[f64; 2]> {
+    let (x, y) = s.trim().split_once(['x', 'X'])?;
+    Some([x.trim().parse().ok()?, y.trim().parse().ok()?])
+}
+
+/// True when a template has `{…}` that is not a plain `{key}` / `{key[N]}` placeholder.
+fn has_macros(g: &str) -> bool {
+    g.split('{').skip(1).any(|part| {
+        let inner = part.split('}').next().unwrap_or_default();
+        let name = inner
+            .strip_suffix(']')
+            .and_then(|n| n.split_once('['))
+            .map_or(inner, |(k, _)| k);
+        !part.contains('}') || !name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BENCH_INI: &str = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/bench/configs/prusaslicer.ini"
+    );
+
+    #[test]
+    fn bench_profile_lands_in_every_field() -> Result<(), ConfigError> {
+        let path = std::path::Path::new(BENCH_INI);
+        if !path.exists() {
+            println!("skipped: corpus not found");
+            return Ok(());
+        }
+        let (cfg, warnings) = super::super::load(path)?;
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let (p, s, t) = (&cfg.printer, &cfg.slice, &cfg.tools[0]);
+        assert_eq!(p.bed_size, [250.0, 250.0]);
+        assert_eq!(p.bed_origin, [0.0, 0.0]);
+        assert_eq!(p.max_height, 250.0);
+        assert_eq!(p.flavor, Flavor::Marlin);
+        assert_eq!(t.nozzle_diameter, 0.4);
+        assert_eq!(s.region.nozzle_diameter, 0.4);
+        assert_eq!(t.filament_diameter, 1.75);
+        assert_eq!(t.temperature, 210.0);
+        assert_eq!(t.first_layer_temperature, 210.0);
+        assert_eq!(p.bed_temperature, 60.0);
+        assert_eq!(p.first_layer_bed_temperature, 60.0);
+        assert_eq!(s.region.layer_height, 0.2);
+        assert_eq!(s.first_layer_height, 0.2);
+        assert_eq!(s.first_layer_width, 0.45);
+        assert_eq!(s.region.perimeter_width, 0.45);
+        assert_eq!(s.region.external_perimeter_width, 0.45);
+        assert_eq!(s.region.infill_width, 0.45);
+        assert_eq!(s.region.solid_infill_width, 0.45);
+        assert_eq!(s.top_solid_infill_width, 0.45);
+        assert_eq!(s.region.perimeters, 2);
+        assert_eq!(s.region.top_solid_layers, 3);
+        assert_eq!(s.region.bottom_solid_layers, 3);
+        assert!((s.region.infill_density - 0.2).abs() < 1e-12);
+        assert_eq!(s.region.infill_pattern, InfillPatternKind::Rectilinear);
+        assert_eq!(s.top_fill_pattern, SolidPattern::Rectilinear);
+        assert_eq!(s.bottom_fill_pattern, SolidPattern::Rectilinear);
+        assert!(!s.support_material);
+        assert_eq!(s.region.skirt_loops, 0);
+        assert_eq!(s.brim_width, 0.0);
+        // One filament extruder from the profile, plus conduit's paste tool.
+        assert_eq!(cfg.tools.len(), 2);
+        assert_eq!(cfg.tools[1], Tool::paste());
+        Ok(())
+    }
+
+    #[test]
+    fn arachne_profile_warns_that_classic_is_used() -> Result<(), ConfigError> {
+        let path = BENCH_INI.replace("prusaslicer.ini", "prusaslicer-arachne.ini");
+        let path = std::path::Path::new(&path);
+        if !path.exists() {
+            println!("skipped: corpus not found");
+            return Ok(());
+        }
+        let (_, warnings) = super::super::load(path)?;
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(warnings[0].contains("arachne"));
+        Ok(())
+    }
+
+    #[test]
+    fn percentages_auto_widths_lists_and_escapes() -> Result<(), ConfigError> {
+        let ini = "\
+bed_shape = -100x-90,100x-90,100x90,-100x90
+nozzle_diameter = 0.6,0.4
+temperature = 215,240
+filament_type = PETG;FLEX
+extruder_offset = 0x0,20x-5
+retract_length = 0.8,2
+extrusion_width = 0
+perimeter_extrusion_width = 120%
+external_perimeter_extrusion_width = 0
+top_infill_extrusion_width = 0
+first_layer_extrusion_width = 0
+perimeter_speed = 60
+external_perimeter_speed = 50%
+infill_speed = 100
+solid_infill_speed = 40%
+top_solid_infill_speed = 50%
+first_layer_speed = 30
+fill_density = 15%
+fill_pattern = gyroid
+top_fill_pattern = monotonic
+start_gcode = G28 ; home\\nM109 S[first_layer_temperature]\\n{if x}
+gcode_flavor = klipper
+use_relative_e_distances = 1
+wipe = 1
+gcode_comments = 0
+";
+        let (cfg, warnings) = from_ini_str(ini)?;
+        assert_eq!(cfg.printer.bed_origin, [-100.0, -90.0]);
+        assert_eq!(cfg.printer.bed_size, [200.0, 180.0]);
+        assert_eq!(cfg.printer.flavor, Flavor::Klipper);
+        assert!(cfg.printer.use_relative_e_distances);
+        assert_eq!(cfg.tools.len(), 3);
+        assert_eq!(cfg.tools[1].nozzle_diameter, 0.4);
+        assert_eq!(cfg.tools[1].temperature, 240.0);
+        assert_eq!(cfg.tools[1].name, "FLEX");
+        assert_eq!(cfg.tools[1].offset, [20.0, -5.0]);
+        assert_eq!(cfg.tools[1].retract_length, Some(2.0));
+        assert_eq!(cfg.tools[0].retract_length, None);
+        assert_eq!(cfg.printer.retract_length, 0.8);
+        let s = &cfg.slice;
+        assert!((s.region.perimeter_width - 0.72).abs() < 1e-12);
+        assert!((s.region.external_perimeter_width - 0.675).abs() < 1e-12);
+        assert!((s.top_solid_infill_width - 0.6).abs() < 1e-12);
+        assert_eq!(s.first_layer_width, s.region.perimeter_width);
+        assert_eq!(s.external_perimeter_speed, 30.0);
+        assert_eq!(s.solid_infill_speed, 40.0);
+        assert_eq!(s.top_solid_infill_speed, 20.0);
+        assert_eq!(s.first_layer_speed, 30.0);
+        assert!((s.region.infill_density - 0.15).abs() < 1e-12);
+        assert_eq!(
+            cfg.printer.start_gcode,
+            "G28 ; home\nM109 S[first_layer_temperature]\n{if x}"
+        );
+        let all = warnings.join("\n");
+        assert!(all.contains("gyroid") && all.contains("monotonic"), "{all}");
+        assert!(all.contains("start_gcode uses PrusaSlicer macros"), "{all}");
+        assert!(all.contains("ignored PrusaSlicer settings (no conduit equivalent): gcode_comments, wipe"), "{all}");
+        Ok(())
+    }
+
+    #[test]
+    fn slic3r_env_and_bad_values() -> Result<(), ConfigError> {
+        let env = vec![
+            ("SLIC3R_LAYER_HEIGHT".to_owned(), "0.3".to_owned()),
+            ("SLIC3R_FIRST_LAYER_HEIGHT".to_owned(), "150%".to_owned()),
+            ("HOME".to_owned(), "/root".to_owned()),
+        ];
+        let (cfg, warnings) = from_slic3r_env(env)?;
+        assert_eq!(cfg.slice.region.layer_height, 0.3);
+        assert!((cfg.slice.first_layer_height - 0.45).abs() < 1e-12);
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let err = from_ini_str("# c\n\nperimeters = two\n").err();
+        assert!(
+            matches!(&err, Some(ConfigError::Ini { line: Some(3), key, .. }) if key == "perimeters"),
+            "{err:?}"
+        );
+        assert!(from_ini_str("printer_technology = SLA").is_err());
+        Ok(())
+    }
+}

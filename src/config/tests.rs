@@ -1,0 +1,194 @@
+//! Tests of the TOML config: defaults, kind-dependent tool defaults, errors naming keys, `--set`.
+
+use super::*;
+
+fn parse(src: &str) -> Result<Config, ConfigError> {
+    Config::parse(src).map(|(c, _)| c)
+}
+
+#[test]
+fn empty_file_is_the_default_two_tool_printer() -> Result<(), ConfigError> {
+    let cfg = parse("")?;
+    assert_eq!(cfg, Config::default());
+    assert_eq!(cfg.tools.len(), 2);
+    assert_eq!(cfg.tools[0].kind, ToolKind::Filament);
+    assert_eq!(cfg.tools[1].kind, ToolKind::Paste);
+    assert_eq!(cfg.slice.region.layer_height, 0.2);
+    assert_eq!(cfg.slice.perimeter_speed, 45.0);
+    assert_eq!(cfg.printer.bed_size, [250.0, 250.0]);
+    assert!(Config::default().validate()?.is_empty());
+    Ok(())
+}
+
+#[test]
+fn tool_tables_take_the_defaults_of_their_kind() -> Result<(), ConfigError> {
+    let cfg = parse(
+        "[tools.0]\nname = \"PETG\"\ntemperature = 240\n\n\
+         [tools.1]\nkind = \"paste\"\nnozzle_diameter = 0.25\n\n\
+         [tools.2]\nstandby_temperature = 170\n",
+    )?;
+    assert_eq!(cfg.tools.len(), 3);
+    assert_eq!(cfg.tools[0].name, "PETG");
+    assert_eq!(cfg.tools[0].temperature, 240.0);
+    assert_eq!(cfg.tools[0].first_layer_temperature, 210.0);
+    assert_eq!(
+        cfg.tools[1],
+        Tool {
+            nozzle_diameter: 0.25,
+            ..Tool::paste()
+        }
+    );
+    assert_eq!(cfg.tools[2].standby_temperature, Some(170.0));
+    assert_eq!(cfg.tools[2].kind, ToolKind::Filament);
+    // An array of tables works too.
+    let cfg = parse("[[tools]]\nkind = \"paste\"\n")?;
+    assert_eq!(cfg.tools, vec![Tool::paste()]);
+    Ok(())
+}
+
+#[test]
+fn slice_keys_of_the_regions_stage_sit_in_the_slice_table() -> Result<(), ConfigError> {
+    let cfg = parse(
+        "[slice]\nlayer_height = 0.3\nperimeters = 3\ninfill_pattern = \"grid\"\n\
+         first_layer_height = 0.25\nconductive_speed = 8\nobject_tools = [0, 1]\n",
+    )?;
+    assert_eq!(cfg.slice.region.layer_height, 0.3);
+    assert_eq!(cfg.slice.region.perimeters, 3);
+    assert_eq!(
+        cfg.slice.region.infill_pattern,
+        crate::region::InfillPatternKind::Grid
+    );
+    assert_eq!(cfg.slice.first_layer_height, 0.25);
+    assert_eq!(cfg.slice.conductive_speed, 8.0);
+    assert_eq!(cfg.tool_for_object(1), 1);
+    assert_eq!(cfg.tool_for_object(5), 0);
+    Ok(())
+}
+
+#[test]
+fn typos_are_errors_naming_the_key_and_line() {
+    for (src, key, line) in [
+        ("[printer]\nflavor = \"marlin\"\nbed_sise = [1, 2]\n", "bed_sise", 3),
+        ("\n[slice]\nperimetres = 3\n", "perimetres", 3),
+        ("[tools.0]\n\ntemprature = 200\n", "temprature", 3),
+        ("[printr]\n", "printr", 1),
+    ] {
+        match parse(src) {
+            Err(ConfigError::Toml {
+                line: Some(l),
+                message,
+                ..
+            }) => {
+                assert!(message.contains(key), "{message}");
+                assert_eq!(l, line, "{src:?}: {message}");
+            }
+            other => panic!("{src:?} gave {other:?}"),
+        }
+    }
+    let err = parse("[printer]\nflavor = \"sprinter\"\n").err();
+    assert!(format!("{err:?}").contains("sprinter"), "{err:?}");
+}
+
+#[test]
+fn tool_numbers_must_not_have_gaps() {
+    let err = parse("[tools.1]\ntemperature = 25\n").err();
+    let text = err.map(|e| e.to_string()).unwrap_or_default();
+    assert!(text.contains("tools.0 is missing"), "{text}");
+    let err = parse("[tools.a]\n").err();
+    assert!(err.is_some());
+}
+
+#[test]
+fn validation_reports_every_problem() {
+    let err = parse("[slice]\nlayer_height = -1\nobject_tools = [3]\nperimeter_speed = 0\n").err();
+    match err {
+        Some(ConfigError::Invalid { problems }) => {
+            assert_eq!(problems.len(), 3, "{problems:?}");
+            assert!(problems.iter().any(|p| p.contains("object_tools[0] = 3")));
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn set_edits_any_key_by_dotted_path() -> Result<(), ConfigError> {
+    let mut cfg = Config::default();
+    cfg.apply_set("slice.layer_height=0.3")?;
+    cfg.apply_set("tools.1.temperature=25")?;
+    cfg.apply_set("printer.flavor=klipper")?;
+    cfg.apply_set("printer.bed_size = [200, 210.5]")?;
+    cfg.apply_set("tools.0.standby_temperature=150")?;
+    cfg.apply_set("tools.2.kind=paste")?;
+    cfg.apply_set("printer.start_gcode=\"G28\"")?;
+    assert_eq!(cfg.slice.region.layer_height, 0.3);
+    assert_eq!(cfg.tools[1].temperature, 25.0);
+    assert_eq!(cfg.printer.flavor, Flavor::Klipper);
+    assert_eq!(cfg.printer.bed_size, [200.0, 210.5]);
+    assert_eq!(cfg.tools[0].standby_temperature, Some(150.0));
+    assert_eq!(cfg.tools[2], Tool::paste());
+    assert_eq!(cfg.printer.start_gcode, "G28");
+    let before = cfg.clone();
+    for bad in [
+        "slice.layer_hieght=0.3",
+        "tools.1.temprature=3",
+        "route.grid=1",
+        "slice.layer_height",
+        "slice.layer_height=thick",
+        "tools.5.temperature=200",
+        "slice.layer_height.x=1",
+    ] {
+        match cfg.apply_set(bad) {
+            Err(ConfigError::Set { key, message }) => {
+                assert!(bad.starts_with(&key), "{bad}: {key}");
+                if bad.contains("hieght") || bad.contains("temprature") {
+                    let wrong = bad.split(['.', '=']).nth(if bad.starts_with("tools") { 2 } else { 1 });
+                    assert!(message.contains(wrong.unwrap_or("?")), "{bad}: {message}");
+                }
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+    assert_eq!(cfg, before);
+    Ok(())
+}
+
+#[test]
+fn config_round_trips_through_toml() -> Result<(), ConfigError> {
+    let mut cfg = Config::default();
+    cfg.tools[0].retract_length = Some(1.5);
+    cfg.slice.object_tools = vec![1, 0];
+    let back = parse(&cfg.to_toml_string())?;
+    assert_eq!(back, cfg);
+    Ok(())
+}
+
+#[test]
+fn load_picks_the_format_by_extension() -> Result<(), Box<dyn std::error::Error>> {
+    let dir = tempfile::tempdir()?;
+    let toml_path = dir.path().join("c.toml");
+    std::fs::write(&toml_path, "[slice]\nlayer_height = 0.1\n")?;
+    let (cfg, warnings) = load(&toml_path)?;
+    assert_eq!(cfg.slice.region.layer_height, 0.1);
+    assert!(warnings.is_empty());
+    let ini_path = dir.path().join("p.ini");
+    std::fs::write(&ini_path, "layer_height = 0.15\nbogus = 1\n")?;
+    let (cfg, warnings) = load(&ini_path)?;
+    assert_eq!(cfg.slice.region.layer_height, 0.15);
+    assert_eq!(
+        warnings,
+        vec!["ignored PrusaSlicer settings (no conduit equivalent): bogus".to_owned()]
+    );
+    std::fs::write(&ini_path, "layer_height = 0.15\nperimeters = x\n")?;
+    let err = load(&ini_path).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(err.contains("p.ini:2: perimeters"), "{err}");
+    let bad = dir.path().join("c.json");
+    assert!(matches!(
+        load(&bad),
+        Err(ConfigError::UnknownFormat { .. })
+    ));
+    let bad_toml = dir.path().join("bad.toml");
+    std::fs::write(&bad_toml, "[slice]\n\nlayer_height = \"x\"\n")?;
+    let err = load(&bad_toml).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(err.contains("bad.toml:3"), "{err}");
+    Ok(())
+}

@@ -1,0 +1,602 @@
+//! From regions to a [`Program`]: toolpaths with roles, widths, heights and speeds, in print
+//! order, with tool changes between tools.
+//!
+//! # What [`build_program`] does
+//!
+//! - **Layers.** The layers of all objects are merged by print height (`LayerZ::top`, compared
+//!   on the nanometre grid): objects sliced with the same schedule merge layer index by layer
+//!   index, and objects with different schedules interleave in z order instead of being printed
+//!   at the wrong height. Program layer `k` is the `k`-th distinct height; its `height` is the
+//!   largest of its objects' layer heights (each toolpath keeps its own).
+//! - **Tools.** On each layer the paths of one tool print together, so a layer has at most one
+//!   change per tool used on it: the tool left active by the previous layer goes first, then the
+//!   others in ascending order (a two-tool print alternates `T0 T1 | T1 T0 | T0 T1 …`, one
+//!   change per layer). An [`Event::ToolChange`] is inserted wherever the tool differs from the
+//!   previous path's; the program's first tool is implied ([`Program::first_tool`]), not an
+//!   event.
+//! - **Order within a tool.** The skirt first (outermost loop first, as the regions stage
+//!   gives it), then the islands nearest-first; each island prints its perimeter loops in the
+//!   regions stage's order (inner to outer by default) and then its solid and sparse infill in
+//!   travel order ([`super::order`]). Infill lines belong to the island whose outer loop
+//!   contains their first point (the smallest such loop); lines outside every loop (islands too
+//!   thin for perimeters) form one more group per object.
+//! - **Seams.** A perimeter or skirt loop starts at the vertex chosen by
+//!   [`OrderParams::seam`]: by default the vertex nearest to where the nozzle is
+//!   ([`SeamRule::Nearest`](super::order::SeamRule::Nearest)).
+//! - **Speeds and widths.** Per tool ([`ToolPathParams`]): perimeters keep the width the
+//!   regions stage gave each loop; infill and skirt take the tool's widths; every path on the
+//!   program's first layer is printed at `first_layer_speed`.
+//!
+//! The nozzle position carries from one layer to the next, so layers are built one after the
+//! other; everything is deterministic (ordered maps, index tie-breaks, no clocks).
+
+use std::collections::BTreeMap;
+
+use super::order::{Group, OrderParams, order_groups};
+use super::toolpath::{Event, Layer, LayerItem, Program, Role, Toolpath};
+use crate::geom::{Point2, Point3, Polygon, scaled, unscaled};
+use crate::region::{LayerRegions, RegionParams, SolidRole};
+use crate::slice::LayerZ;
+
+/// The layers of one object (or one material of an object), printed with one tool.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjectLayers {
+    /// Tool index.
+    pub tool: usize,
+    /// Each layer's place in z and its regions, bottom to top.
+    pub layers: Vec<(LayerZ, LayerRegions)>,
+}
+
+/// Feed rates per role, mm/s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RoleSpeeds {
+    /// External perimeters. Default 25.
+    pub external_perimeter: f64,
+    /// Inner perimeters. Default 45.
+    pub perimeter: f64,
+    /// Internal and bottom solid infill. Default 40.
+    pub solid_infill: f64,
+    /// Top solid infill. Default 30.
+    pub top_solid_infill: f64,
+    /// Sparse infill, scaffold and buffer. Default 80.
+    pub sparse_infill: f64,
+    /// Skirt and brim. Default 30.
+    pub skirt: f64,
+    /// Conductive traces and drops. Default 10.
+    pub conductive: f64,
+}
+
+impl Default for RoleSpeeds {
+    /// The defaults of `[slice]` in the config.
+    fn default() -> Self {
+        Self {
+            external_perimeter: 25.0,
+            perimeter: 45.0,
+            solid_infill: 40.0,
+            top_solid_infill: 30.0,
+            sparse_infill: 80.0,
+            skirt: 30.0,
+            conductive: 10.0,
+        }
+    }
+}
+
+impl RoleSpeeds {
+    /// The speed of `role`, mm/s ([`Role::Custom`] moves at the perimeter speed).
+    pub fn for_role(&self, role: Role) -> f64 {
+        match role {
+            Role::ExternalPerimeter => self.external_perimeter,
+            Role::Perimeter | Role::Custom => self.perimeter,
+            Role::SolidInfill | Role::BottomSolidInfill => self.solid_infill,
+            Role::TopSolidInfill => self.top_solid_infill,
+            Role::SparseInfill | Role::Scaffold | Role::Buffer => self.sparse_infill,
+            Role::Skirt => self.skirt,
+            Role::ConductiveTrace | Role::ConductiveDrop => self.conductive,
+        }
+    }
+
+    /// Every speed limited to `max` mm/s.
+    pub fn clamped(self, max: f64) -> Self {
+        Self {
+            external_perimeter: self.external_perimeter.min(max),
+            perimeter: self.perimeter.min(max),
+            solid_infill: self.solid_infill.min(max),
+            top_solid_infill: self.top_solid_infill.min(max),
+            sparse_infill: self.sparse_infill.min(max),
+            skirt: self.skirt.min(max),
+            conductive: self.conductive.min(max),
+        }
+    }
+}
+
+/// How one tool's regions become toolpaths.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ToolPathParams {
+    /// Width of sparse infill lines, mm (the width the regions stage spaced them for).
+    /// Default 0.45.
+    pub infill_width: f64,
+    /// Width of solid infill lines (bottom, internal, top), mm. Default 0.45.
+    pub solid_infill_width: f64,
+    /// Width of skirt loops, mm. Default 0.45.
+    pub skirt_width: f64,
+    /// Speeds per role.
+    pub speeds: RoleSpeeds,
+    /// Speed of every path on the program's first layer, mm/s. Default 20.
+    pub first_layer_speed: f64,
+    /// When set, every path of this tool gets this role (e.g. [`Role::ConductiveTrace`] for a
+    /// paste tool, whose regions are traces, not walls and infill) and its speed.
+    pub role: Option<Role>,
+}
+
+impl Default for ToolPathParams {
+    fn default() -> Self {
+        Self::from_region(&RegionParams::default())
+    }
+}
+
+impl ToolPathParams {
+    /// Widths from the regions stage's parameters (so extrusion matches the spacing it used),
+    /// default speeds, no role override.
+    pub fn from_region(region: &RegionParams) -> Self {
+        Self {
+            infill_width: region.infill_width,
+            solid_infill_width: region.solid_infill_width,
+            skirt_width: region.perimeter_width,
+            speeds: RoleSpeeds::default(),
+            first_layer_speed: 20.0,
+            role: None,
+        }
+    }
+}
+
+/// Parameters of [`build_program`].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ProgramParams {
+    /// Per tool, indexed by tool number; tools past the end use [`ToolPathParams::default`].
+    pub tools: Vec<ToolPathParams>,
+    /// Travel ordering and seam placement.
+    pub order: OrderParams,
+    /// Nozzle position before the first layer (for the first travel), mm. Default the origin.
+    pub start: Point3,
+}
+
+impl ProgramParams {
+    /// The parameters of tool `tool`.
+    pub fn tool(&self, tool: usize) -> ToolPathParams {
+        self.tools.get(tool).copied().unwrap_or_default()
+    }
+}
+
+/// Whether `p` is inside `polygon` (even-odd crossing test, exact in `i128`; points on the
+/// boundary may go either way).
+fn inside(polygon: &Polygon, p: Point2) -> bool {
+    let pts = &polygon.points;
+    let mut result = false;
+    for i in 0..pts.len() {
+        let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+        if (a.y > p.y) != (b.y > p.y) {
+            let lhs = (p.x - a.x) as i128 * (b.y - a.y) as i128;
+            let rhs = (b.x - a.x) as i128 * (p.y - a.y) as i128;
+            if (lhs < rhs) == (b.y > a.y) {
+                result = !result;
+            }
+        }
+    }
+    result
+}
+
+fn point3(p: Point2, z: f64) -> Point3 {
+    Point3::new(unscaled(p.x), unscaled(p.y), z)
+}
+
+/// One object's layer, with what is needed to make its toolpaths.
+struct Entry<'a> {
+    object: usize,
+    tool: usize,
+    top: f64,
+    regions: &'a LayerRegions,
+}
+
+/// Makes toolpaths of one role for one object layer.
+struct PathMaker {
+    z: f64,
+    height: f64,
+    tool: usize,
+    params: ToolPathParams,
+    first_layer: bool,
+}
+
+impl PathMaker {
+    fn path(&self, points: Vec<Point3>, closed: bool, role: Role, width: f64) -> Toolpath {
+        let role = self.params.role.unwrap_or(role);
+        let speed = if self.first_layer {
+            self.params.first_layer_speed
+        } else {
+            self.params.speeds.for_role(role)
+        };
+        Toolpath {
+            points,
+            closed,
+            role,
+            tool: self.tool,
+            width,
+            height: self.height,
+            speed,
+            tool_axis: None,
+        }
+    }
+
+    fn points(&self, pts: &[Point2]) -> Vec<Point3> {
+        pts.iter().map(|&p| point3(p, self.z)).collect()
+    }
+
+    fn closed(&self, polygon: &Polygon, role: Role, width: f64) -> Option<Toolpath> {
+        (polygon.points.len() >= 2)
+            .then(|| self.path(self.points(&polygon.points), true, role, width))
+    }
+
+    fn open(&self, pts: &[Point2], role: Role, width: f64) -> Option<Toolpath> {
+        (pts.len() >= 2).then(|| self.path(self.points(pts), false, role, width))
+    }
+}
+
+/// The skirt groups and island groups of one object layer.
+fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
+    let r = e.regions;
+    let p = maker.params;
+    let skirt: Vec<Group> = r
+        .skirt
+        .iter()
+        .filter_map(|s| maker.closed(s, Role::Skirt, p.skirt_width))
+        .map(|path| Group {
+            first: vec![path],
+            rest: Vec::new(),
+        })
+        .collect();
+    // Islands by index, in index order; their outer loops for infill assignment.
+    let mut islands: BTreeMap<usize, Group> = BTreeMap::new();
+    let mut outer: Vec<(usize, &Polygon, i128)> = Vec::new();
+    for lp in &r.perimeters {
+        let role = if lp.external {
+            Role::ExternalPerimeter
+        } else {
+            Role::Perimeter
+        };
+        if let Some(path) = maker.closed(&lp.polygon, role, lp.width) {
+            islands.entry(lp.island).or_default().first.push(path);
+        }
+        if lp.external && !lp.is_hole {
+            outer.push((lp.island, &lp.polygon, lp.polygon.signed_area2().abs()));
+        }
+    }
+    let mut loose = Group::default();
+    let mut add_line = |pts: &[Point2], role: Role, width: f64| {
+        let Some(path) = maker.open(pts, role, width) else {
+            return;
+        };
+        let owner = outer
+            .iter()
+            .filter(|(_, poly, _)| inside(poly, pts[0]))
+            .min_by_key(|(island, _, area)| (*area, *island))
+            .map(|(island, _, _)| *island);
+        match owner {
+            Some(island) => islands.entry(island).or_default().rest.push(path),
+            None => loose.rest.push(path),
+        }
+    };
+    for fill in &r.solid_infill {
+        let role = match fill.role {
+            SolidRole::Top => Role::TopSolidInfill,
+            SolidRole::Bottom => Role::BottomSolidInfill,
+            SolidRole::Internal => Role::SolidInfill,
+        };
+        for line in &fill.lines {
+            add_line(&line.points, role, p.solid_infill_width);
+        }
+    }
+    for line in &r.sparse_infill {
+        add_line(&line.points, Role::SparseInfill, p.infill_width);
+    }
+    let mut groups: Vec<Group> = islands.into_values().collect();
+    if !loose.rest.is_empty() {
+        groups.push(loose);
+    }
+    (skirt, groups)
+}
+
+/// The [`Program`] printing `objects` (see the module docs).
+pub fn build_program(objects: &[ObjectLayers], params: &ProgramParams) -> Program {
+    let mut by_z: BTreeMap<i64, Vec<Entry<'_>>> = BTreeMap::new();
+    for (object, obj) in objects.iter().enumerate() {
+        for (lz, regions) in &obj.layers {
+            by_z.entry(scaled(lz.top)).or_default().push(Entry {
+                object,
+                tool: obj.tool,
+                top: lz.top,
+                regions,
+            });
+        }
+    }
+    let mut pos = params.start;
+    let mut current_tool: Option<usize> = None;
+    let mut layers = Vec::with_capacity(by_z.len());
+    for (index, entries) in by_z.into_values().enumerate() {
+        let z = entries.first().map_or(0.0, |e| e.top);
+        let height = entries.iter().map(|e| e.regions.height).fold(0.0, f64::max);
+        let mut tools: Vec<usize> = entries.iter().map(|e| e.tool).collect();
+        tools.sort_unstable();
+        tools.dedup();
+        if let Some(cur) = current_tool
+            && let Some(i) = tools.iter().position(|&t| t == cur)
+        {
+            let t = tools.remove(i);
+            tools.insert(0, t);
+        }
+        let mut items = Vec::new();
+        for tool in tools {
+            let tp = params.tool(tool);
+            let mut skirts = Vec::new();
+            let mut islands = Vec::new();
+            for e in entries.iter().filter(|e| e.tool == tool) {
+                let maker = PathMaker {
+                    z: e.top,
+                    height: e.regions.height,
+                    tool,
+                    params: tp,
+                    first_layer: index == 0,
+                };
+                let (s, g) = object_groups(e, &maker);
+                skirts.extend(s);
+                islands.extend(g);
+                debug_assert!(e.object < objects.len());
+            }
+            let (mut paths, end) = order_groups(skirts, &pos, &params.order);
+            let (island_paths, end) = order_groups(islands, &end, &params.order);
+            paths.extend(island_paths);
+            if paths.is_empty() {
+                continue;
+            }
+            if current_tool.is_some_and(|c| c != tool) {
+                items.push(LayerItem::Event(Event::ToolChange { tool }));
+            }
+            current_tool = Some(tool);
+            pos = end;
+            items.extend(paths.into_iter().map(LayerItem::Path));
+        }
+        layers.push(Layer {
+            index,
+            z,
+            height,
+            items,
+        });
+    }
+    Program { layers }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{ExPolygon, Polyline};
+    use crate::region::{make_regions, make_regions_with_heights};
+    use crate::slice::{SliceParams, layer_schedule};
+
+    fn square(x0: f64, y0: f64, side: f64) -> ExPolygon {
+        ExPolygon {
+            contour: Polygon::new(vec![
+                Point2::from_mm(x0, y0),
+                Point2::from_mm(x0 + side, y0),
+                Point2::from_mm(x0 + side, y0 + side),
+                Point2::from_mm(x0, y0 + side),
+            ]),
+            holes: vec![],
+        }
+    }
+
+    /// A stack of `n` layers of the given islands, 0.2 mm each.
+    fn object(
+        tool: usize,
+        islands: Vec<ExPolygon>,
+        n: usize,
+        region: &RegionParams,
+    ) -> ObjectLayers {
+        let zs = layer_schedule(n as f64 * 0.2, &SliceParams::default());
+        let layers = vec![islands; zs.len()];
+        let regions = make_regions(&layers, region);
+        ObjectLayers {
+            tool,
+            layers: zs.into_iter().zip(regions).collect(),
+        }
+    }
+
+    fn region() -> RegionParams {
+        RegionParams {
+            skirt_loops: 1,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn cube_layers_have_roles_speeds_and_islands_together() {
+        let obj = object(
+            0,
+            vec![square(0.0, 0.0, 20.0), square(40.0, 0.0, 10.0)],
+            10,
+            &region(),
+        );
+        let params = ProgramParams::default();
+        let program = build_program(std::slice::from_ref(&obj), &params);
+        assert_eq!(program.layers.len(), 10);
+        let l0 = &program.layers[0];
+        assert!((l0.z - 0.2).abs() < 1e-12 && (l0.height - 0.2).abs() < 1e-12);
+        let paths: Vec<&Toolpath> = l0.paths().collect();
+        assert_eq!(paths[0].role, Role::Skirt);
+        assert!(
+            paths
+                .iter()
+                .all(|p| p.speed == 20.0 && p.tool == 0 && p.points[0].z == 0.2)
+        );
+        // Every region path appears once.
+        let r0 = &obj.layers[0].1;
+        let want = r0.skirt.len()
+            + r0.perimeters.len()
+            + r0.solid_infill.iter().map(|f| f.lines.len()).sum::<usize>()
+            + r0.sparse_infill.len();
+        assert_eq!(paths.len(), want);
+        // Islands are contiguous: once the print leaves an island it never comes back.
+        let island_of = |p: &Toolpath| usize::from(p.points[0].x > 30.0);
+        let seq: Vec<usize> = paths[1..].iter().map(|p| island_of(p)).collect();
+        let changes = seq.windows(2).filter(|w| w[0] != w[1]).count();
+        assert_eq!(changes, 1, "{seq:?}");
+        // Perimeters before infill within each island; external perimeters marked.
+        for island in [0, 1] {
+            let roles: Vec<Role> = paths[1..]
+                .iter()
+                .filter(|p| island_of(p) == island)
+                .map(|p| p.role)
+                .collect();
+            let first_infill = roles.iter().position(|r| *r == Role::BottomSolidInfill);
+            let last_loop = roles
+                .iter()
+                .rposition(|r| matches!(r, Role::Perimeter | Role::ExternalPerimeter));
+            assert!(first_infill > last_loop, "{roles:?}");
+            assert!(roles.contains(&Role::ExternalPerimeter));
+        }
+        // Layer 5: sparse infill at its speed; widths from the region parameters.
+        let l5: Vec<&Toolpath> = program.layers[5].paths().collect();
+        let sparse: Vec<&&Toolpath> = l5.iter().filter(|p| p.role == Role::SparseInfill).collect();
+        assert!(!sparse.is_empty());
+        assert!(
+            sparse
+                .iter()
+                .all(|p| p.speed == 80.0 && p.width == 0.45 && !p.closed)
+        );
+        assert!(
+            l5.iter()
+                .any(|p| p.role == Role::ExternalPerimeter && p.speed == 25.0 && p.closed)
+        );
+        assert!(
+            program.layers[9]
+                .paths()
+                .any(|p| p.role == Role::TopSolidInfill && p.speed == 30.0)
+        );
+        assert!(
+            program
+                .layers
+                .iter()
+                .all(|l| l.items.iter().all(|i| matches!(i, LayerItem::Path(_))))
+        );
+    }
+
+    #[test]
+    fn two_tools_alternate_with_one_change_per_layer() {
+        let plastic = object(0, vec![square(0.0, 0.0, 20.0)], 4, &RegionParams::default());
+        let paste = object(1, vec![square(30.0, 0.0, 5.0)], 4, &RegionParams::default());
+        let params = ProgramParams {
+            tools: vec![
+                ToolPathParams::default(),
+                ToolPathParams {
+                    role: Some(Role::ConductiveTrace),
+                    ..Default::default()
+                },
+            ],
+            ..Default::default()
+        };
+        let program = build_program(&[paste, plastic], &params);
+        assert_eq!(program.first_tool(), Some(0));
+        assert_eq!(program.tools_used(), vec![0, 1]);
+        let mut sequence = Vec::new();
+        for layer in &program.layers {
+            let mut tools = Vec::new();
+            for item in &layer.items {
+                match item {
+                    LayerItem::Event(Event::ToolChange { tool }) => sequence.push(*tool),
+                    LayerItem::Path(p) => {
+                        if tools.last() != Some(&p.tool) {
+                            tools.push(p.tool);
+                        }
+                        assert_eq!(p.role == Role::ConductiveTrace, p.tool == 1);
+                    }
+                    LayerItem::Event(_) => {}
+                }
+            }
+            assert_eq!(tools.len(), 2, "each tool's paths together");
+        }
+        // T0 T1 | T1 T0 | T0 T1 | T1 T0: one change per layer.
+        assert_eq!(sequence, vec![1, 0, 1, 0]);
+    }
+
+    #[test]
+    fn layers_merge_by_height_and_infill_outside_loops_is_kept() {
+        // Object B has a thicker first layer: its layers land at 0.3, 0.5 ...; A's at 0.2, 0.4.
+        let a = object(0, vec![square(0.0, 0.0, 10.0)], 3, &RegionParams::default());
+        let zs = layer_schedule(
+            0.7,
+            &SliceParams {
+                layer_height: 0.2,
+                first_layer_height: 0.3,
+            },
+        );
+        let heights: Vec<f64> = zs.iter().map(LayerZ::height).collect();
+        let islands = vec![vec![square(20.0, 0.0, 10.0)]; zs.len()];
+        let no_perimeters = RegionParams {
+            perimeters: 0,
+            ..Default::default()
+        };
+        let regions =
+            make_regions_with_heights(&islands, &heights, &no_perimeters).unwrap_or_default();
+        let b = ObjectLayers {
+            tool: 0,
+            layers: zs.into_iter().zip(regions).collect(),
+        };
+        let program = build_program(&[a, b], &ProgramParams::default());
+        let zs: Vec<f64> = program.layers.iter().map(|l| l.z).collect();
+        assert_eq!(zs.len(), 6, "{zs:?}");
+        for w in zs.windows(2) {
+            assert!(w[0] < w[1]);
+        }
+        assert!(program.layers.iter().enumerate().all(|(i, l)| l.index == i));
+        // B has no loops: its infill is printed anyway, as a loose group.
+        assert!(
+            program.layers[1]
+                .paths()
+                .any(|p| p.points[0].x > 15.0 && p.height == 0.3)
+        );
+    }
+
+    #[test]
+    fn build_is_deterministic() {
+        let objs = vec![
+            object(
+                0,
+                vec![square(0.0, 0.0, 20.0), square(25.0, 25.0, 8.0)],
+                6,
+                &region(),
+            ),
+            object(1, vec![square(50.0, 0.0, 6.0)], 6, &RegionParams::default()),
+        ];
+        let params = ProgramParams::default();
+        assert_eq!(build_program(&objs, &params), build_program(&objs, &params));
+    }
+
+    #[test]
+    fn degenerate_paths_are_dropped() {
+        let mut obj = object(0, vec![square(0.0, 0.0, 10.0)], 1, &RegionParams::default());
+        obj.layers[0].1.sparse_infill.push(Polyline {
+            points: vec![Point2::new(0, 0)],
+        });
+        let n = obj.layers[0].1.perimeters.len()
+            + obj.layers[0]
+                .1
+                .solid_infill
+                .iter()
+                .map(|f| f.lines.len())
+                .sum::<usize>();
+        let program = build_program(&[obj], &ProgramParams::default());
+        assert_eq!(program.paths().count(), n);
+        assert!(
+            build_program(&[], &ProgramParams::default())
+                .layers
+                .is_empty()
+        );
+    }
+}
