@@ -21,3 +21,6 @@ pub mod program;
 pub mod region;
 pub mod scene;
 pub mod slice;
+pub mod config;
+pub mod emit;
+pub mod check;

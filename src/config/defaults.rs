@@ -35,7 +35,10 @@ const fn opt(
 }
 
 const SECTION_DOCS: &[(&str, &str)] = &[
-    ("printer", "The machine: bed, firmware, custom G-code, retraction, travel, fan."),
+    (
+        "printer",
+        "The machine: bed, firmware, custom G-code, retraction, travel, fan.",
+    ),
     (
         "tools",
         "One table per tool, numbered from 0 without gaps. Keys left out take the default of the \
@@ -48,7 +51,11 @@ const SECTION_DOCS: &[(&str, &str)] = &[
 ];
 
 const KEYS: &[KeyDoc] = &[
-    k("printer", "flavor", "G-code dialect: \"marlin\", \"reprapfirmware\" or \"klipper\"."),
+    k(
+        "printer",
+        "flavor",
+        "G-code dialect: \"marlin\", \"reprapfirmware\" or \"klipper\".",
+    ),
     k("printer", "bed_size", "Printable bed size [X, Y], mm."),
     k(
         "printer",
@@ -57,8 +64,16 @@ const KEYS: &[KeyDoc] = &[
          with the origin in its centre).",
     ),
     k("printer", "max_height", "Highest printable Z, mm."),
-    k("printer", "bed_temperature", "Bed temperature after the first layer, °C (0 = off)."),
-    k("printer", "first_layer_bed_temperature", "Bed temperature for the first layer, °C."),
+    k(
+        "printer",
+        "bed_temperature",
+        "Bed temperature after the first layer, °C (0 = off).",
+    ),
+    k(
+        "printer",
+        "first_layer_bed_temperature",
+        "Bed temperature for the first layer, °C.",
+    ),
     k(
         "printer",
         "start_gcode",
@@ -82,12 +97,36 @@ const KEYS: &[KeyDoc] = &[
         "retract_length",
         "Filament pulled back before travels, mm (a tool's retract_length overrides it).",
     ),
-    k("printer", "retract_speed", "Retraction speed, mm/s of filament."),
-    k("printer", "deretract_speed", "Un-retraction speed, mm/s; 0 = retract_speed."),
-    k("printer", "retract_before_travel", "Travels shorter than this do not retract, mm."),
-    k("printer", "retract_lift", "Z lift during retracted travels, mm; 0 = none."),
-    k("printer", "travel_speed", "Speed of non-printing moves, mm/s."),
-    k("printer", "max_acceleration", "Machine acceleration for time estimates, mm/s²."),
+    k(
+        "printer",
+        "retract_speed",
+        "Retraction speed, mm/s of filament.",
+    ),
+    k(
+        "printer",
+        "deretract_speed",
+        "Un-retraction speed, mm/s; 0 = retract_speed.",
+    ),
+    k(
+        "printer",
+        "retract_before_travel",
+        "Travels shorter than this do not retract, mm.",
+    ),
+    k(
+        "printer",
+        "retract_lift",
+        "Z lift during retracted travels, mm; 0 = none.",
+    ),
+    k(
+        "printer",
+        "travel_speed",
+        "Speed of non-printing moves, mm/s.",
+    ),
+    k(
+        "printer",
+        "max_acceleration",
+        "Machine acceleration for time estimates, mm/s².",
+    ),
     k(
         "printer",
         "max_print_speed",
@@ -98,10 +137,26 @@ const KEYS: &[KeyDoc] = &[
         "use_relative_e_distances",
         "Relative E (M83) instead of absolute E (M82).",
     ),
-    k("printer", "fan_min_speed", "Lowest part-cooling fan speed when on, %."),
-    k("printer", "fan_max_speed", "Highest part-cooling fan speed, %."),
-    k("printer", "disable_fan_first_layers", "Number of bottom layers printed with the fan off."),
-    k("printer", "use_firmware_retraction", "Retract with G10/G11 instead of E moves."),
+    k(
+        "printer",
+        "fan_min_speed",
+        "Lowest part-cooling fan speed when on, %.",
+    ),
+    k(
+        "printer",
+        "fan_max_speed",
+        "Highest part-cooling fan speed, %.",
+    ),
+    k(
+        "printer",
+        "disable_fan_first_layers",
+        "Number of bottom layers printed with the fan off.",
+    ),
+    k(
+        "printer",
+        "use_firmware_retraction",
+        "Retract with G10/G11 instead of E moves.",
+    ),
     k("tools", "name", "Name shown in comments and reports."),
     k(
         "tools",
@@ -109,11 +164,31 @@ const KEYS: &[KeyDoc] = &[
         "\"filament\" (E-driven extruder) or \"paste\" (dispenser switched by paste_on_gcode / \
          paste_off_gcode, time-based flow).",
     ),
-    k("tools", "nozzle_diameter", "Nozzle or needle inner diameter, mm."),
-    k("tools", "filament_diameter", "Filament diameter, mm (filament tools)."),
-    k("tools", "filament_density", "Material density for the weight estimate, g/cm³."),
-    k("tools", "temperature", "Nozzle temperature after the first layer, °C; 0 = not heated."),
-    k("tools", "first_layer_temperature", "Nozzle temperature for the first layer, °C."),
+    k(
+        "tools",
+        "nozzle_diameter",
+        "Nozzle or needle inner diameter, mm.",
+    ),
+    k(
+        "tools",
+        "filament_diameter",
+        "Filament diameter, mm (filament tools).",
+    ),
+    k(
+        "tools",
+        "filament_density",
+        "Material density for the weight estimate, g/cm³.",
+    ),
+    k(
+        "tools",
+        "temperature",
+        "Nozzle temperature after the first layer, °C; 0 = not heated.",
+    ),
+    k(
+        "tools",
+        "first_layer_temperature",
+        "Nozzle temperature for the first layer, °C.",
+    ),
     opt(
         "tools",
         "standby_temperature",
@@ -125,15 +200,27 @@ const KEYS: &[KeyDoc] = &[
         "offset",
         "Nozzle offset from tool 0 [X, Y], mm, when the firmware does not apply it.",
     ),
-    k("tools", "extrusion_multiplier", "Factor on the computed flow."),
+    k(
+        "tools",
+        "extrusion_multiplier",
+        "Factor on the computed flow.",
+    ),
     k(
         "tools",
         "paste_on_gcode",
         "G-code that starts the paste flow (paste tools). The default drives output pin 6 high:\n\
          set P to the pin wired to your dispenser's valve or screw driver (Klipper: SET_PIN).",
     ),
-    k("tools", "paste_off_gcode", "G-code that stops the paste flow (paste tools)."),
-    k("tools", "paste_flow_mm3_s", "Volume dispensed per second while on, mm³/s (paste tools)."),
+    k(
+        "tools",
+        "paste_off_gcode",
+        "G-code that stops the paste flow (paste tools).",
+    ),
+    k(
+        "tools",
+        "paste_flow_mm3_s",
+        "Volume dispensed per second while on, mm³/s (paste tools).",
+    ),
     opt(
         "tools",
         "retract_length",
@@ -141,27 +228,51 @@ const KEYS: &[KeyDoc] = &[
         "1.0",
     ),
     k("slice", "layer_height", "Layer height, mm."),
-    k("slice", "first_layer_height", "Height of the first layer, mm."),
+    k(
+        "slice",
+        "first_layer_height",
+        "Height of the first layer, mm.",
+    ),
     k(
         "slice",
         "nozzle_diameter",
         "Nozzle diameter the widths are checked against, mm (keep equal to tools.0.nozzle_diameter).",
     ),
-    k("slice", "perimeters", "Perimeter loops per island, the external one included."),
+    k(
+        "slice",
+        "perimeters",
+        "Perimeter loops per island, the external one included.",
+    ),
     k(
         "slice",
         "external_perimeters_first",
         "Print the external loop first (better accuracy, worse overhangs).",
     ),
-    k("slice", "top_solid_layers", "Solid layers under every top surface."),
-    k("slice", "bottom_solid_layers", "Solid layers over every bottom surface and the bed."),
-    k("slice", "infill_density", "Sparse infill density, 0 (none) to 1 (solid)."),
+    k(
+        "slice",
+        "top_solid_layers",
+        "Solid layers under every top surface.",
+    ),
+    k(
+        "slice",
+        "bottom_solid_layers",
+        "Solid layers over every bottom surface and the bed.",
+    ),
+    k(
+        "slice",
+        "infill_density",
+        "Sparse infill density, 0 (none) to 1 (solid).",
+    ),
     k(
         "slice",
         "infill_pattern",
         "Sparse infill pattern: \"rectilinear\", \"grid\" or \"triangles\".",
     ),
-    k("slice", "infill_angle_deg", "Base infill direction, degrees counter-clockwise from +X."),
+    k(
+        "slice",
+        "infill_angle_deg",
+        "Base infill direction, degrees counter-clockwise from +X.",
+    ),
     k(
         "slice",
         "infill_overlap",
@@ -172,26 +283,94 @@ const KEYS: &[KeyDoc] = &[
         "solid_infill_margin",
         "How far solid areas grow into the neighbouring sparse area, mm.",
     ),
-    k("slice", "top_fill_pattern", "Top solid infill pattern: \"rectilinear\"."),
-    k("slice", "bottom_fill_pattern", "Bottom solid infill pattern: \"rectilinear\"."),
-    k("slice", "external_perimeter_width", "Extrusion width of the external loop, mm."),
-    k("slice", "perimeter_width", "Extrusion width of inner loops, mm."),
-    k("slice", "infill_width", "Extrusion width of sparse infill, mm."),
-    k("slice", "solid_infill_width", "Extrusion width of solid infill, mm."),
-    k("slice", "top_solid_infill_width", "Extrusion width of top solid infill, mm."),
-    k("slice", "first_layer_width", "Extrusion width on the first layer (all roles), mm."),
-    k("slice", "skirt_loops", "Skirt loops around the first layer; 0 = no skirt."),
-    k("slice", "skirt_distance", "Gap between the objects and the skirt, mm."),
-    k("slice", "brim_width", "Brim width around the first layer, mm; 0 = none."),
+    k(
+        "slice",
+        "top_fill_pattern",
+        "Top solid infill pattern: \"rectilinear\".",
+    ),
+    k(
+        "slice",
+        "bottom_fill_pattern",
+        "Bottom solid infill pattern: \"rectilinear\".",
+    ),
+    k(
+        "slice",
+        "external_perimeter_width",
+        "Extrusion width of the external loop, mm.",
+    ),
+    k(
+        "slice",
+        "perimeter_width",
+        "Extrusion width of inner loops, mm.",
+    ),
+    k(
+        "slice",
+        "infill_width",
+        "Extrusion width of sparse infill, mm.",
+    ),
+    k(
+        "slice",
+        "solid_infill_width",
+        "Extrusion width of solid infill, mm.",
+    ),
+    k(
+        "slice",
+        "top_solid_infill_width",
+        "Extrusion width of top solid infill, mm.",
+    ),
+    k(
+        "slice",
+        "first_layer_width",
+        "Extrusion width on the first layer (all roles), mm.",
+    ),
+    k(
+        "slice",
+        "skirt_loops",
+        "Skirt loops around the first layer; 0 = no skirt.",
+    ),
+    k(
+        "slice",
+        "skirt_distance",
+        "Gap between the objects and the skirt, mm.",
+    ),
+    k(
+        "slice",
+        "brim_width",
+        "Brim width around the first layer, mm; 0 = none.",
+    ),
     k("slice", "support_material", "Generate support material."),
-    k("slice", "perimeter_speed", "Speed of inner perimeters, mm/s."),
-    k("slice", "external_perimeter_speed", "Speed of external perimeters, mm/s."),
+    k(
+        "slice",
+        "perimeter_speed",
+        "Speed of inner perimeters, mm/s.",
+    ),
+    k(
+        "slice",
+        "external_perimeter_speed",
+        "Speed of external perimeters, mm/s.",
+    ),
     k("slice", "infill_speed", "Speed of sparse infill, mm/s."),
-    k("slice", "solid_infill_speed", "Speed of internal and bottom solid infill, mm/s."),
-    k("slice", "top_solid_infill_speed", "Speed of top solid infill, mm/s."),
-    k("slice", "first_layer_speed", "Speed of every printing move on the first layer, mm/s."),
+    k(
+        "slice",
+        "solid_infill_speed",
+        "Speed of internal and bottom solid infill, mm/s.",
+    ),
+    k(
+        "slice",
+        "top_solid_infill_speed",
+        "Speed of top solid infill, mm/s.",
+    ),
+    k(
+        "slice",
+        "first_layer_speed",
+        "Speed of every printing move on the first layer, mm/s.",
+    ),
     k("slice", "skirt_speed", "Speed of skirt and brim, mm/s."),
-    k("slice", "conductive_speed", "Speed of conductive traces (paste tools), mm/s."),
+    k(
+        "slice",
+        "conductive_speed",
+        "Speed of conductive traces (paste tools), mm/s.",
+    ),
     k(
         "slice",
         "object_tools",
@@ -231,7 +410,10 @@ pub fn defaults_toml() -> String {
             }
             out.push_str(&format!("[{header}]\n"));
             for doc in KEYS.iter().filter(|d| d.section == section) {
-                push_comment(&mut out, doc.doc);
+                // Tool keys are documented once, in the first tool's table.
+                if i == 0 {
+                    push_comment(&mut out, doc.doc);
+                }
                 match (table.get(doc.key), doc.example) {
                     (Some(v), _) => out.push_str(&format!("{} = {}\n", doc.key, format_value(v))),
                     (None, Some(example)) => out.push_str(&format!("# {} = {example}\n", doc.key)),
@@ -284,7 +466,11 @@ mod tests {
         let mut serialised = std::collections::BTreeSet::new();
         for (section, value) in tree.as_table().into_iter().flatten() {
             let tables: Vec<&toml::Value> = if section == "tools" {
-                value.as_table().into_iter().flat_map(|t| t.values()).collect()
+                value
+                    .as_table()
+                    .into_iter()
+                    .flat_map(|t| t.values())
+                    .collect()
             } else {
                 vec![value]
             };
@@ -309,11 +495,17 @@ mod tests {
             .map(|d| (d.section.to_owned(), d.key.to_owned()))
             .collect();
         let undocumented: Vec<_> = serialised.difference(&documented).collect();
-        assert!(undocumented.is_empty(), "undocumented keys: {undocumented:?}");
+        assert!(
+            undocumented.is_empty(),
+            "undocumented keys: {undocumented:?}"
+        );
         let unknown: Vec<_> = documented
             .difference(&serialised)
             .filter(|k| !optional.contains(*k))
             .collect();
-        assert!(unknown.is_empty(), "documented keys that do not exist: {unknown:?}");
+        assert!(
+            unknown.is_empty(),
+            "documented keys that do not exist: {unknown:?}"
+        );
     }
 }

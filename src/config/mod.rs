@@ -206,8 +206,11 @@ pub enum SolidPattern {
 
 /// Slicing settings (`[slice]`): the regions stage's parameters ([`RegionParams`], flattened
 /// into the same table) plus first-layer, solid-fill and speed settings.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+///
+/// Deserialising reads every key directly (not through `#[serde(flatten)]`, which would lose
+/// the line and key of a wrong value), so a new [`RegionParams`] field must also be added to
+/// the private `SliceSpec`; the defaults round-trip test fails until it is.
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SliceSettings {
     /// Perimeters, infill, widths, layer height and nozzle diameter of the regions stage: the keys
     /// `perimeters`, `external_perimeter_width`, `perimeter_width`, `infill_width`,
@@ -722,10 +725,7 @@ impl Config {
                 if here == "tools" {
                     table.insert((*part).to_owned(), toml::Value::Table(toml::Table::new()));
                 } else {
-                    return Err(set_err(format!(
-                        "unknown key `{}`",
-                        parts[..=i].join(".")
-                    )));
+                    return Err(set_err(format!("unknown key `{}`", parts[..=i].join("."))));
                 }
             }
             node = table
@@ -793,6 +793,86 @@ impl<'de> Deserialize<'de> for Tool {
             paste_flow_mm3_s: s.paste_flow_mm3_s.unwrap_or(d.paste_flow_mm3_s),
             retract_length: s.retract_length.or(d.retract_length),
         })
+    }
+}
+
+/// Every key of `[slice]`, optional: what is left out keeps its default.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SliceSpec {
+    perimeters: Option<usize>,
+    external_perimeter_width: Option<f64>,
+    perimeter_width: Option<f64>,
+    infill_width: Option<f64>,
+    solid_infill_width: Option<f64>,
+    top_solid_layers: Option<usize>,
+    bottom_solid_layers: Option<usize>,
+    infill_density: Option<f64>,
+    infill_pattern: Option<crate::region::InfillPatternKind>,
+    infill_angle_deg: Option<f64>,
+    infill_overlap: Option<f64>,
+    solid_infill_margin: Option<f64>,
+    external_perimeters_first: Option<bool>,
+    skirt_loops: Option<usize>,
+    skirt_distance: Option<f64>,
+    nozzle_diameter: Option<f64>,
+    layer_height: Option<f64>,
+    first_layer_height: Option<f64>,
+    first_layer_width: Option<f64>,
+    top_solid_infill_width: Option<f64>,
+    top_fill_pattern: Option<SolidPattern>,
+    bottom_fill_pattern: Option<SolidPattern>,
+    support_material: Option<bool>,
+    brim_width: Option<f64>,
+    perimeter_speed: Option<f64>,
+    external_perimeter_speed: Option<f64>,
+    infill_speed: Option<f64>,
+    solid_infill_speed: Option<f64>,
+    top_solid_infill_speed: Option<f64>,
+    first_layer_speed: Option<f64>,
+    skirt_speed: Option<f64>,
+    conductive_speed: Option<f64>,
+    object_tools: Option<Vec<usize>>,
+}
+
+impl<'de> Deserialize<'de> for SliceSettings {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let s = SliceSpec::deserialize(deserializer)?;
+        let mut out = SliceSettings::default();
+        macro_rules! take {
+            ($target:ident: $($field:ident),+) => {
+                $(if let Some(v) = s.$field { out.$target.$field = v; })+
+            };
+        }
+        take!(region: perimeters, external_perimeter_width, perimeter_width, infill_width,
+            solid_infill_width, top_solid_layers, bottom_solid_layers, infill_density,
+            infill_pattern, infill_angle_deg, infill_overlap, solid_infill_margin,
+            external_perimeters_first, skirt_loops, skirt_distance, nozzle_diameter,
+            layer_height);
+        macro_rules! take_top {
+            ($($field:ident),+) => {
+                $(if let Some(v) = s.$field { out.$field = v; })+
+            };
+        }
+        take_top!(
+            first_layer_height,
+            first_layer_width,
+            top_solid_infill_width,
+            top_fill_pattern,
+            bottom_fill_pattern,
+            support_material,
+            brim_width,
+            perimeter_speed,
+            external_perimeter_speed,
+            infill_speed,
+            solid_infill_speed,
+            top_solid_infill_speed,
+            first_layer_speed,
+            skirt_speed,
+            conductive_speed,
+            object_tools
+        );
+        Ok(out)
     }
 }
 

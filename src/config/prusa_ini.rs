@@ -14,11 +14,12 @@
 //!   others become marlin with a warning), `start_gcode`, `end_gcode` (`\n` escapes undone),
 //!   `bed_temperature`, `first_layer_bed_temperature`, `retract_length`, `retract_speed`,
 //!   `deretract_speed`, `retract_before_travel`, `retract_lift`, `travel_speed`,
-//!   `max_print_speed`, `machine_max_acceleration_extruding` (or `default_acceleration`),
+//!   `machine_max_acceleration_extruding` (or `default_acceleration`),
 //!   `use_relative_e_distances`, `use_firmware_retraction`, `min_fan_speed`, `max_fan_speed`,
 //!   `disable_fan_first_layers`;
 //! - tools: the comma-separated lists give one value per extruder: `nozzle_diameter`,
-//!   `filament_diameter`, `filament_density`, `filament_type` (the tool's name), `temperature`,
+//!   `filament_diameter`, `filament_density` (0, PrusaSlicer's "unknown", keeps the default),
+//!   `filament_type` (the tool's name), `temperature`,
 //!   `first_layer_temperature`, `idle_temperature`, `extrusion_multiplier`, `extruder_offset`,
 //!   per-extruder `retract_length` (the first is the printer's, others that differ become tool
 //!   overrides). PrusaSlicer's extruders become filament tools `0..n`; conduit's default paste
@@ -35,12 +36,16 @@
 //!   `skirt_speed`, as PrusaSlicer prints skirts at support speed);
 //! - widths: `extrusion_width` and `first_layer_`, `perimeter_`, `external_perimeter_`,
 //!   `infill_`, `solid_infill_`, `top_infill_extrusion_width`. A value is mm or `%` of the first
-//!   nozzle diameter. 0 falls back to `extrusion_width`, and when that is 0 too to PrusaSlicer's
+//!   nozzle diameter. 0 (or a missing key) falls back to `extrusion_width`, and when that is 0 too to PrusaSlicer's
 //!   automatic width (`Flow::auto_extrusion_width`): 1.125 × nozzle for perimeters and
 //!   (solid) infill, 1 × nozzle for top solid infill. A first-layer width of 0 means each role's
 //!   own width; conduit has one first-layer width and takes the perimeter width.
 //!
-//! Every other key is listed, once, in a warning as ignored.
+//! Every other key is listed, once, in a warning as ignored — among them `max_print_speed`,
+//! which in PrusaSlicer only limits automatic speeds while conduit's clamps every speed.
+//!
+//! G-code written by PrusaSlicer or Slic3r carries its settings as `; key = value` comments;
+//! [`pairs_from_gcode`] collects them for [`from_prusa_pairs`].
 
 use std::collections::BTreeMap;
 use std::collections::BTreeSet;
@@ -94,16 +99,50 @@ pub fn from_slic3r_env(
     }))
 }
 
+/// The settings a PrusaSlicer or Slic3r G-code file carries as comments: the lines
+/// `; key = value` between `; prusaslicer_config = begin` and `= end` when present, otherwise
+/// every comment-only line of that form (Slic3r's footer). Keys are lower-case words with `_`,
+/// so header lines such as `; filament used [mm] = 1328.49` are not taken.
+pub fn pairs_from_gcode(g: &conduit_gcode::Gcode) -> Vec<(String, String)> {
+    let comment_pair = |line: &conduit_gcode::Line| -> Option<(String, String)> {
+        if !line.words.is_empty() {
+            return None;
+        }
+        let text = line.comment_text()?;
+        let (key, value) = text.split_once('=')?;
+        let key = key.trim();
+        let is_key = !key.is_empty()
+            && key
+                .bytes()
+                .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_');
+        is_key.then(|| (key.to_owned(), value.trim().to_owned()))
+    };
+    let begin = g
+        .lines
+        .iter()
+        .position(|l| l.comment_text() == Some("prusaslicer_config = begin"));
+    match begin {
+        Some(start) => g.lines[start + 1..]
+            .iter()
+            .take_while(|l| l.comment_text() != Some("prusaslicer_config = end"))
+            .filter_map(comment_pair)
+            .collect(),
+        None => g.lines.iter().filter_map(comment_pair).collect(),
+    }
+}
+
 struct Pairs {
     values: BTreeMap<String, (String, Option<usize>)>,
     used: BTreeSet<String>,
 }
 
 impl Pairs {
+    /// The value of `key`, marking it used; `None` when absent or empty (PrusaSlicer writes
+    /// `key = ` for unset strings).
     fn raw(&mut self, key: &str) -> Option<&str> {
         let (v, _) = self.values.get(key)?;
         self.used.insert(key.to_owned());
-        Some(v.as_str())
+        Some(v.as_str()).filter(|v| !v.trim().is_empty())
     }
 
     fn err(&self, key: &str, message: impl Into<String>) -> ConfigError {
@@ -230,7 +269,9 @@ const PER_EXTRUDER: &[&str] = &[
     "retract_length",
 ];
 
-fn convert(list: Vec<(String, String, Option<usize>)>) -> Result<(Config, Vec<String>), ConfigError> {
+fn convert(
+    list: Vec<(String, String, Option<usize>)>,
+) -> Result<(Config, Vec<String>), ConfigError> {
     let mut p = Pairs {
         values: list.into_iter().map(|(k, v, l)| (k, (v, l))).collect(),
         used: BTreeSet::new(),
@@ -269,6 +310,11 @@ fn convert(list: Vec<(String, String, Option<usize>)>) -> Result<(Config, Vec<St
     per_tool!("nozzle_diameter", nozzle_diameter);
     per_tool!("filament_diameter", filament_diameter);
     per_tool!("filament_density", filament_density);
+    for t in tools.iter_mut() {
+        if t.filament_density <= 0.0 {
+            t.filament_density = Tool::filament().filament_density;
+        }
+    }
     per_tool!("temperature", temperature);
     per_tool!("first_layer_temperature", first_layer_temperature);
     per_tool!("extrusion_multiplier", extrusion_multiplier);
@@ -355,13 +401,15 @@ fn convert(list: Vec<(String, String, Option<usize>)>) -> Result<(Config, Vec<St
     }
     for (key, field) in [
         ("bed_temperature", &mut pr.bed_temperature),
-        ("first_layer_bed_temperature", &mut pr.first_layer_bed_temperature),
+        (
+            "first_layer_bed_temperature",
+            &mut pr.first_layer_bed_temperature,
+        ),
         ("retract_speed", &mut pr.retract_speed),
         ("deretract_speed", &mut pr.deretract_speed),
         ("retract_before_travel", &mut pr.retract_before_travel),
         ("retract_lift", &mut pr.retract_lift),
         ("travel_speed", &mut pr.travel_speed),
-        ("max_print_speed", &mut pr.max_print_speed),
         ("min_fan_speed", &mut pr.fan_min_speed),
         ("max_fan_speed", &mut pr.fan_max_speed),
     ] {
@@ -371,7 +419,10 @@ fn convert(list: Vec<(String, String, Option<usize>)>) -> Result<(Config, Vec<St
     }
     let accel = p.num("machine_max_acceleration_extruding")?;
     let default_accel = p.num("default_acceleration")?;
-    if let Some(a) = accel.filter(|a| *a > 0.0).or(default_accel.filter(|a| *a > 0.0)) {
+    if let Some(a) = accel
+        .filter(|a| *a > 0.0)
+        .or(default_accel.filter(|a| *a > 0.0))
+    {
         pr.max_acceleration = a;
     }
     if let Some(v) = p.count("disable_fan_first_layers")? {
@@ -407,7 +458,9 @@ fn convert(list: Vec<(String, String, Option<usize>)>) -> Result<(Config, Vec<St
         let raw = raw.trim();
         let d = match raw.strip_suffix('%') {
             Some(pc) => pc.trim().parse::<f64>().map(|v| v / 100.0),
-            None => raw.parse::<f64>().map(|v| if v > 1.0 { v / 100.0 } else { v }),
+            None => raw
+                .parse::<f64>()
+                .map(|v| if v > 1.0 { v / 100.0 } else { v }),
         };
         s.region.infill_density = d.map_err(|_| p.err("fill_density", "expected a percentage"))?;
     }
@@ -425,8 +478,14 @@ fn convert(list: Vec<(String, String, Option<usize>)>) -> Result<(Config, Vec<St
         };
     }
     for (keys, field) in [
-        (["top_fill_pattern", "top_infill_pattern"], &mut s.top_fill_pattern),
-        (["bottom_fill_pattern", "bottom_infill_pattern"], &mut s.bottom_fill_pattern),
+        (
+            ["top_fill_pattern", "top_infill_pattern"],
+            &mut s.top_fill_pattern,
+        ),
+        (
+            ["bottom_fill_pattern", "bottom_infill_pattern"],
+            &mut s.bottom_fill_pattern,
+        ),
     ] {
         for key in keys {
             if let Some(pat) = p.raw(key).map(str::to_owned) {
@@ -477,20 +536,31 @@ fn convert(list: Vec<(String, String, Option<usize>)>) -> Result<(Config, Vec<St
         let given = p.abs_or_percent(key, nozzle)?;
         Ok(match given {
             Some(w) if w > 0.0 => Some(w),
-            Some(_) => Some(generic.unwrap_or(auto * nozzle)),
-            None => generic,
+            _ => Some(generic.unwrap_or(auto * nozzle)),
         })
     };
     for (key, auto, field) in [
-        ("perimeter_extrusion_width", 1.125, &mut s.region.perimeter_width),
+        (
+            "perimeter_extrusion_width",
+            1.125,
+            &mut s.region.perimeter_width,
+        ),
         (
             "external_perimeter_extrusion_width",
             1.125,
             &mut s.region.external_perimeter_width,
         ),
         ("infill_extrusion_width", 1.125, &mut s.region.infill_width),
-        ("solid_infill_extrusion_width", 1.125, &mut s.region.solid_infill_width),
-        ("top_infill_extrusion_width", 1.0, &mut s.top_solid_infill_width),
+        (
+            "solid_infill_extrusion_width",
+            1.125,
+            &mut s.region.solid_infill_width,
+        ),
+        (
+            "top_infill_extrusion_width",
+            1.0,
+            &mut s.top_solid_infill_width,
+        ),
     ] {
         if let Some(w) = width(&mut p, key, auto)? {
             *field = w;
@@ -689,7 +759,52 @@ gcode_comments = 0
         let all = warnings.join("\n");
         assert!(all.contains("gyroid") && all.contains("monotonic"), "{all}");
         assert!(all.contains("start_gcode uses PrusaSlicer macros"), "{all}");
-        assert!(all.contains("ignored PrusaSlicer settings (no conduit equivalent): gcode_comments, wipe"), "{all}");
+        assert!(
+            all.contains(
+                "ignored PrusaSlicer settings (no conduit equivalent): gcode_comments, wipe"
+            ),
+            "{all}"
+        );
+        Ok(())
+    }
+
+    #[test]
+    fn settings_embedded_in_peer_gcode_import() -> Result<(), Box<dyn std::error::Error>> {
+        let dir = BENCH_INI.replace("bench/configs/prusaslicer.ini", "corpus/peer-gcode");
+        let dir = std::path::Path::new(&dir);
+        if !dir.is_dir() {
+            println!("skipped: corpus not found");
+            return Ok(());
+        }
+        for (file, keys) in [
+            ("20mm_cube.prusaslicer-2.5.gcode", 264),
+            ("20mm_cube.slic3r-1.3.gcode", 156),
+        ] {
+            let g = conduit_gcode::parse(&std::fs::read(dir.join(file))?)?;
+            let pairs = pairs_from_gcode(&g);
+            assert_eq!(pairs.len(), keys, "{file}");
+            let (cfg, warnings) = from_prusa_pairs(pairs)?;
+            println!("{file}: {warnings:#?}");
+            let s = &cfg.slice;
+            assert_eq!(s.region.layer_height, 0.2, "{file}");
+            assert_eq!(s.region.perimeters, 2);
+            assert_eq!(s.region.perimeter_width, 0.45);
+            assert!((s.region.infill_density - 0.2).abs() < 1e-12);
+            assert_eq!(s.perimeter_speed, 60.0);
+            assert_eq!(s.external_perimeter_speed, 30.0);
+            assert_eq!(s.top_solid_infill_speed, 15.0);
+            assert_eq!(cfg.printer.retract_length, 2.0);
+            assert_eq!(cfg.printer.retract_speed, 40.0);
+            assert_eq!(cfg.printer.bed_size, [250.0, 250.0]);
+            assert_eq!(cfg.tools[0].temperature, 210.0);
+            assert_eq!(cfg.tools[0].filament_density, 1.24);
+            assert!(cfg.printer.start_gcode.starts_with("G28 ; home all axes\n"));
+            assert!(
+                warnings
+                    .iter()
+                    .any(|w| w.starts_with("ignored PrusaSlicer settings"))
+            );
+        }
         Ok(())
     }
 

@@ -29,7 +29,8 @@ impl Config {
         vars: &[(&str, String)],
     ) -> Result<String, ConfigError> {
         let tree = toml::Value::try_from(self).ok();
-        let lookup = |name: &str| -> Option<String> { self.lookup(tree.as_ref()?, name, tool, vars) };
+        let lookup =
+            |name: &str| -> Option<String> { self.lookup(tree.as_ref()?, name, tool, vars) };
         let mut out = String::with_capacity(template.len());
         let mut rest = template;
         while let Some(pos) = rest.find(['{', '[']) {
@@ -40,7 +41,9 @@ impl Config {
             // `[key]` with an index inside: `[key[1]]` is not PrusaSlicer syntax; only plain names.
             let end = match open {
                 b'{' => after.find('}'),
-                _ => after.find([']', '[', '\n', '{']).filter(|&e| after[e..].starts_with(']')),
+                _ => after
+                    .find([']', '[', '\n', '{'])
+                    .filter(|&e| after[e..].starts_with(']')),
             };
             match end {
                 Some(end) => {

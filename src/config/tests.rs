@@ -68,7 +68,11 @@ fn slice_keys_of_the_regions_stage_sit_in_the_slice_table() -> Result<(), Config
 #[test]
 fn typos_are_errors_naming_the_key_and_line() {
     for (src, key, line) in [
-        ("[printer]\nflavor = \"marlin\"\nbed_sise = [1, 2]\n", "bed_sise", 3),
+        (
+            "[printer]\nflavor = \"marlin\"\nbed_sise = [1, 2]\n",
+            "bed_sise",
+            3,
+        ),
         ("\n[slice]\nperimetres = 3\n", "perimetres", 3),
         ("[tools.0]\n\ntemprature = 200\n", "temprature", 3),
         ("[printr]\n", "printr", 1),
@@ -141,7 +145,9 @@ fn set_edits_any_key_by_dotted_path() -> Result<(), ConfigError> {
             Err(ConfigError::Set { key, message }) => {
                 assert!(bad.starts_with(&key), "{bad}: {key}");
                 if bad.contains("hieght") || bad.contains("temprature") {
-                    let wrong = bad.split(['.', '=']).nth(if bad.starts_with("tools") { 2 } else { 1 });
+                    let wrong =
+                        bad.split(['.', '='])
+                            .nth(if bad.starts_with("tools") { 2 } else { 1 });
                     assert!(message.contains(wrong.unwrap_or("?")), "{bad}: {message}");
                 }
             }
@@ -179,16 +185,19 @@ fn load_picks_the_format_by_extension() -> Result<(), Box<dyn std::error::Error>
         vec!["ignored PrusaSlicer settings (no conduit equivalent): bogus".to_owned()]
     );
     std::fs::write(&ini_path, "layer_height = 0.15\nperimeters = x\n")?;
-    let err = load(&ini_path).err().map(|e| e.to_string()).unwrap_or_default();
+    let err = load(&ini_path)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
     assert!(err.contains("p.ini:2: perimeters"), "{err}");
     let bad = dir.path().join("c.json");
-    assert!(matches!(
-        load(&bad),
-        Err(ConfigError::UnknownFormat { .. })
-    ));
+    assert!(matches!(load(&bad), Err(ConfigError::UnknownFormat { .. })));
     let bad_toml = dir.path().join("bad.toml");
     std::fs::write(&bad_toml, "[slice]\n\nlayer_height = \"x\"\n")?;
-    let err = load(&bad_toml).err().map(|e| e.to_string()).unwrap_or_default();
+    let err = load(&bad_toml)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
     assert!(err.contains("bad.toml:3"), "{err}");
     Ok(())
 }

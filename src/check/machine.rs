@@ -1,0 +1,761 @@
+//! The replay: machine state stepped line by line (see the module docs of [`super`]).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::f64::consts::PI;
+
+use conduit_gcode::{Gcode, Line};
+
+use super::time::Planner;
+use super::{Bounds3, CheckParams, CheckReport, Finding, FindingKind, Severity, Stats, ToolUsage};
+use crate::config::{Flavor, ToolKind};
+
+/// Heater state of one tool.
+#[derive(Debug, Clone, Default)]
+struct Heater {
+    /// Last target set, °C (`None`: never set).
+    target: Option<f64>,
+    /// Line of the command that set the target.
+    target_line: usize,
+    /// Estimated print time when the target was set, s.
+    set_at: f64,
+    /// Temperature last waited for (reached), °C.
+    reached: Option<f64>,
+    /// A temperature finding was reported since the target last changed.
+    reported: bool,
+}
+
+#[derive(Debug, Clone, Default)]
+struct Usage {
+    filament_mm: f64,
+    e_net_mm: f64,
+    extrusion_moves: usize,
+}
+
+struct Machine<'a> {
+    p: &'a CheckParams,
+    pos: [Option<f64>; 3],
+    e: f64,
+    coord_relative: bool,
+    e_relative_flag: bool,
+    scale: f64,
+    feed: f64,
+    tool: usize,
+    heaters: Vec<Heater>,
+    macro_seen: Option<String>,
+    last_motion: Option<u8>,
+    planner: Planner,
+    dwell: f64,
+    z_levels: BTreeSet<i64>,
+    usage: BTreeMap<usize, Usage>,
+    bounds: Option<Bounds3>,
+    stats: Stats,
+    findings: Vec<Finding>,
+    counts: BTreeMap<FindingKind, usize>,
+    errors: usize,
+    warnings: usize,
+}
+
+/// Klipper commands (by prefix) that are known not to heat anything, so they do not soften a
+/// cold-extrusion error the way an unknown macro (`PRINT_START`) does.
+const NON_HEATING_MACROS: &[&str] = &[
+    "EXCLUDE_OBJECT",
+    "SET_PRESSURE_ADVANCE",
+    "SET_VELOCITY_LIMIT",
+    "SET_RETRACTION",
+    "SET_GCODE_OFFSET",
+    "SET_FAN_SPEED",
+    "SET_PRINT_STATS_INFO",
+    "SAVE_GCODE_STATE",
+    "RESTORE_GCODE_STATE",
+    "BED_MESH_",
+    "SET_KINEMATIC_POSITION",
+];
+
+pub(super) fn replay(g: &Gcode, p: &CheckParams) -> CheckReport {
+    let mut m = Machine {
+        p,
+        pos: [None; 3],
+        e: 0.0,
+        coord_relative: false,
+        e_relative_flag: false,
+        scale: 1.0,
+        feed: p.default_feedrate,
+        tool: 0,
+        heaters: Vec::new(),
+        macro_seen: None,
+        last_motion: None,
+        planner: Planner::new(p.max_acceleration, p.jerk),
+        dwell: 0.0,
+        z_levels: BTreeSet::new(),
+        usage: BTreeMap::new(),
+        bounds: None,
+        stats: Stats::default(),
+        findings: Vec::new(),
+        counts: BTreeMap::new(),
+        errors: 0,
+        warnings: 0,
+    };
+    for line in &g.lines {
+        m.step(line);
+    }
+    m.finish(g.lines.len())
+}
+
+impl Machine<'_> {
+    /// Estimated print time so far, s.
+    fn now(&self) -> f64 {
+        self.planner.total + self.dwell
+    }
+
+    fn e_relative(&self) -> bool {
+        match self.p.flavor {
+            Flavor::Klipper => self.coord_relative || self.e_relative_flag,
+            Flavor::Marlin | Flavor::RepRapFirmware => self.e_relative_flag,
+        }
+    }
+
+    fn heater(&mut self, tool: usize) -> &mut Heater {
+        if self.heaters.len() <= tool {
+            self.heaters.resize(tool + 1, Heater::default());
+        }
+        &mut self.heaters[tool]
+    }
+
+    fn report(&mut self, severity: Severity, kind: FindingKind, line: usize, message: String) {
+        let count = self.counts.entry(kind).or_insert(0);
+        *count += 1;
+        match severity {
+            Severity::Error => self.errors += 1,
+            Severity::Warning => self.warnings += 1,
+        }
+        if *count <= self.p.max_findings_per_kind {
+            self.findings.push(Finding {
+                severity,
+                kind,
+                line,
+                message,
+            });
+        }
+    }
+
+    fn step(&mut self, line: &Line) {
+        let Some((letter, number)) = line.command() else {
+            if let Some(name) = line.extended_command() {
+                self.extended(line, name);
+            } else if line
+                .words
+                .iter()
+                .any(|w| matches!(w.letter, b'X' | b'Y' | b'Z' | b'E'))
+            {
+                // Bare coordinates continue the last motion command (CNC modal style).
+                if let Some(n) = self.last_motion {
+                    self.motion(line, n);
+                }
+            }
+            return;
+        };
+        if number.fract() != 0.0 {
+            return;
+        }
+        let n = number as i64;
+        match (letter, n) {
+            (b'G', 0..=3) => {
+                self.last_motion = Some(n as u8);
+                self.motion(line, n as u8);
+            }
+            (b'G', 4) => {
+                let ms = line.get(b'P').unwrap_or(0.0) + line.get(b'S').unwrap_or(0.0) * 1000.0;
+                self.planner.flush();
+                self.dwell += ms.max(0.0) / 1000.0;
+            }
+            (b'G', 10) => {
+                if line.get(b'P').is_some() || line.get(b'S').is_some() || line.get(b'R').is_some()
+                {
+                    // RepRapFirmware: G10 P<tool> S<active> R<standby> sets temperatures.
+                    let tool = line.get(b'P').map_or(self.tool, |t| t.max(0.0) as usize);
+                    if let Some(s) = line.get(b'S') {
+                        self.set_target(tool, s, line.number, false);
+                    }
+                } else {
+                    self.stats.retractions += 1;
+                }
+            }
+            (b'G', 11) => {}
+            (b'G', 20) => self.scale = 25.4,
+            (b'G', 21) => self.scale = 1.0,
+            (b'G', 28) => {
+                self.planner.flush();
+                let named: Vec<usize> = [b'X', b'Y', b'Z']
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, l)| line.words.iter().any(|w| w.letter == **l))
+                    .map(|(i, _)| i)
+                    .collect();
+                if named.is_empty() {
+                    self.pos = [Some(0.0); 3];
+                } else {
+                    for i in named {
+                        self.pos[i] = Some(0.0);
+                    }
+                }
+            }
+            (b'G', 90) => {
+                self.coord_relative = false;
+                if self.p.flavor == Flavor::Marlin {
+                    self.e_relative_flag = false;
+                }
+            }
+            (b'G', 91) => {
+                self.coord_relative = true;
+                if self.p.flavor == Flavor::Marlin {
+                    self.e_relative_flag = true;
+                }
+            }
+            (b'G', 92) => {
+                for (i, l) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+                    if let Some(v) = line.get(l) {
+                        self.pos[i] = Some(v * self.scale);
+                    }
+                }
+                if let Some(v) = line.get(b'E') {
+                    self.e = v * self.scale;
+                }
+            }
+            (b'M', 82) => self.e_relative_flag = false,
+            (b'M', 83) => self.e_relative_flag = true,
+            (b'M', 104 | 109) => {
+                let tool = line.get(b'T').map_or(self.tool, |t| t.max(0.0) as usize);
+                let wait = n == 109;
+                if wait {
+                    self.planner.flush();
+                }
+                match line.get(b'S').or_else(|| line.get(b'R')) {
+                    Some(s) => self.set_target(tool, s, line.number, wait),
+                    None if wait => {
+                        let h = self.heater(tool);
+                        h.reached = h.target;
+                    }
+                    None => {}
+                }
+            }
+            (b'M', 568) => {
+                // RepRapFirmware 3.3+: M568 P<tool> S<active> R<standby>.
+                let tool = line.get(b'P').map_or(self.tool, |t| t.max(0.0) as usize);
+                if let Some(s) = line.get(b'S') {
+                    self.set_target(tool, s, line.number, false);
+                }
+            }
+            (b'M', 116) => {
+                self.planner.flush();
+                let only = line.get(b'P').map(|t| t.max(0.0) as usize);
+                for (i, h) in self.heaters.iter_mut().enumerate() {
+                    if only.is_none_or(|t| t == i) {
+                        h.reached = h.target;
+                    }
+                }
+            }
+            (b'M', 140 | 190) => {
+                if n == 190 {
+                    self.planner.flush();
+                }
+                if let Some(s) = line.get(b'S').or_else(|| line.get(b'R')) {
+                    let max = self.stats.max_bed_temperature.get_or_insert(s);
+                    *max = max.max(s);
+                }
+            }
+            (b'T', t) if t >= 0 => {
+                let t = t as usize;
+                self.planner.flush();
+                if t != self.tool {
+                    self.stats.tool_changes += 1;
+                }
+                self.tool = t;
+            }
+            _ => {}
+        }
+    }
+
+    fn set_target(&mut self, tool: usize, target: f64, line: usize, wait: bool) {
+        let time = self.now();
+        let h = self.heater(tool);
+        if h.target != Some(target) {
+            h.reported = false;
+        }
+        h.target = Some(target);
+        h.target_line = line;
+        h.set_at = time;
+        if wait {
+            h.reached = Some(target);
+        }
+    }
+
+    /// Klipper's temperature commands; any other macro is remembered as a possible heater.
+    fn extended(&mut self, line: &Line, name: &str) {
+        let text = String::from_utf8_lossy(&line.text);
+        let params: BTreeMap<String, String> = text
+            .split_whitespace()
+            .skip(1)
+            .take_while(|t| !t.starts_with(';'))
+            .filter_map(|t| t.split_once('='))
+            .map(|(k, v)| (k.to_ascii_uppercase(), v.to_owned()))
+            .collect();
+        let extruder = |key: &str| -> Option<usize> {
+            let h = params.get(key)?.to_ascii_lowercase();
+            let rest = h.strip_prefix("extruder")?;
+            if rest.is_empty() {
+                Some(0)
+            } else {
+                rest.parse().ok()
+            }
+        };
+        let num = |key: &str| params.get(key).and_then(|v| v.parse::<f64>().ok());
+        match name.to_ascii_uppercase().as_str() {
+            "SET_HEATER_TEMPERATURE" => {
+                if let (Some(t), Some(target)) = (extruder("HEATER"), num("TARGET")) {
+                    self.set_target(t, target, line.number, false);
+                }
+            }
+            "TEMPERATURE_WAIT" => {
+                if let (Some(t), Some(min)) = (extruder("SENSOR"), num("MINIMUM")) {
+                    let h = self.heater(t);
+                    h.reached = Some(min.max(h.reached.unwrap_or(min)));
+                }
+            }
+            other => {
+                let harmless = NON_HEATING_MACROS.iter().any(|p| other.starts_with(p));
+                if self.macro_seen.is_none() && !harmless {
+                    self.macro_seen = Some(other.to_owned());
+                }
+            }
+        }
+    }
+
+    fn motion(&mut self, line: &Line, g: u8) {
+        self.stats.moves += 1;
+        let scale = self.scale;
+        if let Some(f) = line.get(b'F') {
+            if f > 0.0 {
+                self.feed = f * scale / 60.0;
+            }
+        }
+        let start = self.pos;
+        let mut end = start;
+        for (i, l) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+            if let Some(v) = line.get(l) {
+                let v = v * scale;
+                end[i] = if self.coord_relative {
+                    start[i].map(|s| s + v)
+                } else {
+                    Some(v)
+                };
+            }
+        }
+        let de = match line.get(b'E') {
+            Some(v) if self.e_relative() => {
+                self.e += v * scale;
+                v * scale
+            }
+            Some(v) => {
+                let d = v * scale - self.e;
+                self.e = v * scale;
+                d
+            }
+            None => 0.0,
+        };
+        let has_xy = line.get(b'X').is_some() || line.get(b'Y').is_some();
+        // Path: a polyline (two points for a line, samples for an arc) and its length.
+        let mut path: Vec<[Option<f64>; 3]> = vec![start, end];
+        let mut length = None;
+        if g == 2 || g == 3 {
+            self.stats.arcs += 1;
+            match self.arc(line, g == 2, start, end) {
+                Ok(Some((len, samples))) => {
+                    length = Some(len);
+                    path = samples;
+                }
+                Ok(None) => {}
+                Err(msg) => self.report(Severity::Error, FindingKind::InvalidArc, line.number, msg),
+            }
+        }
+        let length = length.or_else(|| distance(start, end)).unwrap_or(0.0);
+        self.pos = end;
+
+        // Time.
+        let v = self.feed.min(self.p.max_feedrate);
+        if length > 0.0 {
+            let dir_in = direction(path.first(), path.get(1));
+            let dir_out = direction(path.iter().rev().nth(1), path.last());
+            self.planner.push(length, v, dir_in, dir_out);
+        } else {
+            self.planner.push(de.abs(), v, [0.0; 3], [0.0; 3]);
+        }
+
+        let extruding = has_xy && de > 0.0;
+        let usage = self.usage.entry(self.tool).or_default();
+        usage.e_net_mm += de;
+        if extruding {
+            usage.filament_mm += de;
+            usage.extrusion_moves += 1;
+            self.stats.extrusion_moves += 1;
+            self.stats.print_distance_mm += length;
+            if let Some(z) = end[2] {
+                self.z_levels.insert((z * 1000.0).round() as i64);
+            }
+            for q in &path {
+                self.grow_bounds(*q);
+            }
+            self.check_temperature(line.number);
+            self.check_flow(line.number, de, length);
+        } else if has_xy {
+            self.stats.travel_moves += 1;
+            self.stats.travel_distance_mm += length;
+        }
+        if de < 0.0 {
+            self.stats.retractions += 1;
+            let drop = -de;
+            if drop > self.p.lost_reset_drop {
+                self.report(
+                    Severity::Error,
+                    FindingKind::LostExtrusionReset,
+                    line.number,
+                    format!(
+                        "E drops by {drop:.3} mm in one move: a missing `G92 E0` or the wrong \
+                         M82/M83 extrusion mode?"
+                    ),
+                );
+            } else if has_xy && length > 0.0 && drop > self.p.max_moving_retraction {
+                self.report(
+                    Severity::Warning,
+                    FindingKind::RetractionWhileMoving,
+                    line.number,
+                    format!(
+                        "retraction of {drop:.3} mm during a {length:.3} mm move (more than \
+                         {} mm)",
+                        self.p.max_moving_retraction
+                    ),
+                );
+            }
+        }
+        self.check_bounds(line.number, &path, extruding);
+    }
+
+    /// Length and sampled points of an arc, `Ok(None)` when a position is unknown.
+    #[allow(clippy::type_complexity)]
+    fn arc(
+        &self,
+        line: &Line,
+        clockwise: bool,
+        start: [Option<f64>; 3],
+        end: [Option<f64>; 3],
+    ) -> Result<Option<(f64, Vec<[Option<f64>; 3]>)>, String> {
+        let (Some(x0), Some(y0), Some(x1), Some(y1)) = (start[0], start[1], end[0], end[1]) else {
+            return Ok(None);
+        };
+        let s = self.scale;
+        let (cx, cy, r, sweep);
+        if let Some(rr) = line.get(b'R') {
+            let rr = rr * s;
+            let (dx, dy) = (x1 - x0, y1 - y0);
+            let chord = dx.hypot(dy);
+            if chord == 0.0 || rr.abs() < chord / 2.0 - 1e-9 {
+                return Err(format!(
+                    "arc radius R{} is shorter than half the chord ({chord:.4} mm)",
+                    rr / s
+                ));
+            }
+            r = rr.abs();
+            let h = (r * r - chord * chord / 4.0).max(0.0).sqrt();
+            // Centre to the left of the chord for a CCW short arc, right for CW; R<0 flips.
+            let left = (!clockwise) ^ (rr < 0.0);
+            let (mx, my) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+            let (nx, ny) = (-dy / chord, dx / chord);
+            let sign = if left { 1.0 } else { -1.0 };
+            cx = mx + sign * h * nx;
+            cy = my + sign * h * ny;
+            let short = 2.0 * (chord / (2.0 * r)).min(1.0).asin();
+            sweep = if rr < 0.0 { 2.0 * PI - short } else { short };
+        } else {
+            let (i, j) = (line.get(b'I'), line.get(b'J'));
+            if i.is_none() && j.is_none() {
+                return Err("arc without I/J centre or R radius".to_owned());
+            }
+            cx = x0 + i.unwrap_or(0.0) * s;
+            cy = y0 + j.unwrap_or(0.0) * s;
+            r = (x0 - cx).hypot(y0 - cy);
+            let a0 = (y0 - cy).atan2(x0 - cx);
+            let a1 = (y1 - cy).atan2(x1 - cx);
+            let mut d = if clockwise { a0 - a1 } else { a1 - a0 };
+            d = d.rem_euclid(2.0 * PI);
+            // Same start and end: a full circle.
+            if d < 1e-9 {
+                d = 2.0 * PI;
+            }
+            sweep = d;
+        }
+        let planar = r * sweep;
+        let dz = match (start[2], end[2]) {
+            (Some(a), Some(b)) => b - a,
+            _ => 0.0,
+        };
+        let length = planar.hypot(dz);
+        let a0 = (y0 - cy).atan2(x0 - cx);
+        let steps = ((sweep / (PI / 18.0)).ceil() as usize).max(1);
+        let dir = if clockwise { -1.0 } else { 1.0 };
+        let mut samples = Vec::with_capacity(steps + 1);
+        for k in 0..=steps {
+            let t = k as f64 / steps as f64;
+            let a = a0 + dir * sweep * t;
+            let z = match (start[2], end[2]) {
+                (Some(za), Some(zb)) => Some(za + (zb - za) * t),
+                _ => end[2],
+            };
+            samples.push([Some(cx + r * a.cos()), Some(cy + r * a.sin()), z]);
+        }
+        if let Some(last) = samples.last_mut() {
+            *last = end;
+        }
+        Ok(Some((length, samples)))
+    }
+
+    fn grow_bounds(&mut self, q: [Option<f64>; 3]) {
+        let [Some(x), Some(y), Some(z)] = q else {
+            return;
+        };
+        let b = self.bounds.get_or_insert(Bounds3 {
+            min: [x, y, z],
+            max: [x, y, z],
+        });
+        for (i, v) in [x, y, z].into_iter().enumerate() {
+            b.min[i] = b.min[i].min(v);
+            b.max[i] = b.max[i].max(v);
+        }
+    }
+
+    fn check_temperature(&mut self, line: usize) {
+        let tool = self.tool;
+        let tc = self.p.tool(tool);
+        if tc.kind != ToolKind::Filament {
+            return;
+        }
+        let (tol, heat_up, time) = (
+            self.p.temperature_tolerance,
+            self.p.heat_up_time_s,
+            self.now(),
+        );
+        let macro_seen = self.macro_seen.clone();
+        let h = self.heater(tool).clone();
+        if h.reported {
+            return;
+        }
+        let finding = match h.target {
+            Some(target) if target > 0.0 => {
+                let waited = h.reached.is_some_and(|r| r >= target - tol);
+                let timed = time - h.set_at >= heat_up;
+                if !(waited || timed) {
+                    Some((
+                        Severity::Warning,
+                        FindingKind::HeatingNotWaited,
+                        format!(
+                            "tool {tool} extrudes while heating to {target} °C: the target set at \
+                             line {} was not waited for (M109/M116), and only {:.0} s passed",
+                            h.target_line,
+                            time - h.set_at
+                        ),
+                    ))
+                } else {
+                    let temp = if waited {
+                        target.min(h.reached.unwrap_or(target))
+                    } else {
+                        target
+                    };
+                    (temp < tc.min_extrude_temperature).then(|| {
+                        (
+                            Severity::Error,
+                            FindingKind::BelowMinTemperature,
+                            format!(
+                                "tool {tool} extrudes at {temp} °C, below the {} °C at which \
+                                 firmware allows extrusion",
+                                tc.min_extrude_temperature
+                            ),
+                        )
+                    })
+                }
+            }
+            _ => {
+                let what = match h.target {
+                    None => "was never heated".to_owned(),
+                    Some(_) => format!("has its heater off (line {})", h.target_line),
+                };
+                match &macro_seen {
+                    Some(m) => Some((
+                        Severity::Warning,
+                        FindingKind::ColdExtrusion,
+                        format!("tool {tool} extrudes but {what}; the macro {m} may heat it"),
+                    )),
+                    None => Some((
+                        Severity::Error,
+                        FindingKind::ColdExtrusion,
+                        format!("tool {tool} extrudes but {what}"),
+                    )),
+                }
+            }
+        };
+        if let Some((sev, kind, msg)) = finding {
+            self.heater(tool).reported = true;
+            self.report(sev, kind, line, msg);
+        }
+    }
+
+    fn check_flow(&mut self, line: usize, de: f64, length: f64) {
+        let tc = self.p.tool(self.tool);
+        if tc.kind != ToolKind::Filament || length < self.p.flow_check_min_length {
+            return;
+        }
+        let filament_area = PI * tc.filament_diameter * tc.filament_diameter / 4.0;
+        let nozzle_area = PI * tc.nozzle_diameter * tc.nozzle_diameter / 4.0;
+        let section = de * filament_area / length;
+        let factor = section / nozzle_area;
+        if factor > self.p.max_flow_factor {
+            self.report(
+                Severity::Warning,
+                FindingKind::ExcessiveExtrusion,
+                line,
+                format!(
+                    "{section:.3} mm³ of filament per mm of path, {factor:.1}× the nozzle's \
+                     area (limit {}×)",
+                    self.p.max_flow_factor
+                ),
+            );
+        }
+    }
+
+    fn check_bounds(&mut self, line: usize, path: &[[Option<f64>; 3]], extruding: bool) {
+        let p = self.p;
+        let m = p.bed_margin;
+        let mut outside = None;
+        let mut below = None;
+        let mut above = None;
+        // The start point was checked with the previous move.
+        for q in path.iter().skip(1) {
+            if let (Some(x), Some(y)) = (q[0], q[1]) {
+                let out_x = x < p.bed_origin[0] - m || x > p.bed_origin[0] + p.bed_size[0] + m;
+                let out_y = y < p.bed_origin[1] - m || y > p.bed_origin[1] + p.bed_size[1] + m;
+                if (out_x || out_y) && outside.is_none() {
+                    outside = Some((x, y));
+                }
+            }
+            if let Some(z) = q[2] {
+                if z < -1e-9 && below.is_none() {
+                    below = Some(z);
+                }
+                if z > p.max_height + m && above.is_none() {
+                    above = Some(z);
+                }
+            }
+        }
+        if let Some((x, y)) = outside {
+            let (x0, y0) = (p.bed_origin[0], p.bed_origin[1]);
+            self.report(
+                Severity::Warning,
+                FindingKind::OutsideBed,
+                line,
+                format!(
+                    "{} to X{x:.3} Y{y:.3}, outside the bed X {x0}..{} Y {y0}..{} (margin {m} mm)",
+                    if extruding { "extrusion" } else { "move" },
+                    x0 + p.bed_size[0],
+                    y0 + p.bed_size[1]
+                ),
+            );
+        }
+        if let Some(z) = below {
+            let sev = if extruding {
+                Severity::Error
+            } else {
+                Severity::Warning
+            };
+            self.report(
+                sev,
+                FindingKind::BelowBed,
+                line,
+                format!(
+                    "{} to Z{z:.3}, below the bed",
+                    if extruding { "extrusion" } else { "move" }
+                ),
+            );
+        }
+        if let Some(z) = above {
+            self.report(
+                Severity::Warning,
+                FindingKind::AboveMaxHeight,
+                line,
+                format!("move to Z{z:.3}, above max_height {} mm", p.max_height),
+            );
+        }
+    }
+
+    fn finish(mut self, lines: usize) -> CheckReport {
+        self.stats.lines = lines;
+        self.stats.layers = self.z_levels.len();
+        if let (Some(lo), Some(hi)) = (self.z_levels.first(), self.z_levels.last()) {
+            self.stats.layer_z_range = Some([*lo as f64 / 1000.0, *hi as f64 / 1000.0]);
+        }
+        self.stats.extrusion_bounds = self.bounds;
+        self.planner.flush();
+        self.stats.estimated_time_s = self.now();
+        self.stats.tools = self
+            .usage
+            .iter()
+            .filter(|(_, u)| u.extrusion_moves > 0 || u.e_net_mm != 0.0)
+            .map(|(&tool, u)| {
+                let d = self.p.tool(tool).filament_diameter;
+                ToolUsage {
+                    tool,
+                    filament_mm: u.filament_mm,
+                    filament_mm3: u.filament_mm * PI * d * d / 4.0,
+                    e_net_mm: u.e_net_mm,
+                    extrusion_moves: u.extrusion_moves,
+                }
+            })
+            .collect();
+        CheckReport {
+            findings: self.findings,
+            counts: self.counts,
+            errors: self.errors,
+            warnings: self.warnings,
+            stats: self.stats,
+        }
+    }
+}
+
+fn distance(a: [Option<f64>; 3], b: [Option<f64>; 3]) -> Option<f64> {
+    let mut sum = 0.0;
+    for i in 0..3 {
+        match (a[i], b[i]) {
+            (Some(p), Some(q)) => sum += (q - p) * (q - p),
+            (None, None) => {}
+            // Moving from or to an unknown position: the length is unknown.
+            _ => return None,
+        }
+    }
+    Some(sum.sqrt())
+}
+
+/// Unit vector from `a` to `b`, zero when either is unknown or they coincide.
+fn direction(a: Option<&[Option<f64>; 3]>, b: Option<&[Option<f64>; 3]>) -> [f64; 3] {
+    let (Some(a), Some(b)) = (a, b) else {
+        return [0.0; 3];
+    };
+    let mut d = [0.0; 3];
+    for k in 0..3 {
+        d[k] = match (a[k], b[k]) {
+            (Some(p), Some(q)) => q - p,
+            _ => 0.0,
+        };
+    }
+    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    if len > 0.0 {
+        d.map(|c| c / len)
+    } else {
+        [0.0; 3]
+    }
+}
