@@ -34,6 +34,7 @@ use std::collections::BTreeMap;
 
 use super::order::{Group, OrderParams, order_groups};
 use super::toolpath::{Event, Layer, LayerItem, Program, Role, Toolpath};
+use crate::config::{Config, ToolKind};
 use crate::geom::{Point2, Point3, Polygon, scaled, unscaled};
 use crate::region::{LayerRegions, RegionParams, SolidRole};
 use crate::slice::LayerZ;
@@ -150,7 +151,7 @@ impl ToolPathParams {
 }
 
 /// Parameters of [`build_program`].
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ProgramParams {
     /// Per tool, indexed by tool number; tools past the end use [`ToolPathParams::default`].
     pub tools: Vec<ToolPathParams>,
@@ -158,9 +159,136 @@ pub struct ProgramParams {
     pub order: OrderParams,
     /// Nozzle position before the first layer (for the first travel), mm. Default the origin.
     pub start: Point3,
+    /// Largest deviation (mm) allowed when dropping vertices of region paths
+    /// (Douglas–Peucker), PrusaSlicer's `gcode_resolution`: sliced meshes carry vertices far
+    /// closer than any printer resolves. 0 keeps every vertex. Default 0.0125.
+    pub resolution: f64,
+}
+
+impl Default for ProgramParams {
+    fn default() -> Self {
+        Self {
+            tools: Vec::new(),
+            order: OrderParams::default(),
+            start: Point3::origin(),
+            resolution: DEFAULT_RESOLUTION_MM,
+        }
+    }
+}
+
+/// Default [`ProgramParams::resolution`], mm (PrusaSlicer's default `gcode_resolution`).
+pub const DEFAULT_RESOLUTION_MM: f64 = 0.0125;
+
+/// `points` with every vertex dropped that lies within `tolerance` nm of the simplified chain
+/// (Douglas–Peucker, iterative, exact integer inputs). A closed ring keeps its first vertex and
+/// is simplified as the chain from it back to itself.
+pub fn simplify(points: &[Point2], tolerance: i64, closed: bool) -> Vec<Point2> {
+    if tolerance <= 0 || points.len() < 3 {
+        return points.to_vec();
+    }
+    let mut chain = points.to_vec();
+    if closed {
+        chain.push(points[0]);
+    }
+    let n = chain.len();
+    let mut keep = vec![false; n];
+    keep[0] = true;
+    keep[n - 1] = true;
+    let tol2 = (tolerance as f64) * (tolerance as f64);
+    let mut stack = vec![(0usize, n - 1)];
+    while let Some((a, b)) = stack.pop() {
+        if b <= a + 1 {
+            continue;
+        }
+        let (pa, pb) = (chain[a], chain[b]);
+        let mut worst = (a, -1.0f64);
+        for (i, &p) in chain.iter().enumerate().take(b).skip(a + 1) {
+            let d2 = segment_distance2(p, pa, pb);
+            if d2 > worst.1 {
+                worst = (i, d2);
+            }
+        }
+        if worst.1 > tol2 {
+            keep[worst.0] = true;
+            stack.push((a, worst.0));
+            stack.push((worst.0, b));
+        }
+    }
+    if closed {
+        keep.pop();
+        chain.pop();
+    }
+    let out: Vec<Point2> = chain
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(p, k)| k.then_some(p))
+        .collect();
+    // A ring needs three vertices to stay a ring.
+    if closed && out.len() < 3 {
+        points.to_vec()
+    } else {
+        out
+    }
+}
+
+/// Squared distance (nm²) from `p` to the segment `a`–`b`.
+fn segment_distance2(p: Point2, a: Point2, b: Point2) -> f64 {
+    let (dx, dy) = ((b.x - a.x) as f64, (b.y - a.y) as f64);
+    let (px, py) = ((p.x - a.x) as f64, (p.y - a.y) as f64);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        ((px * dx + py * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (ex, ey) = (px - t * dx, py - t * dy);
+    ex * ex + ey * ey
 }
 
 impl ProgramParams {
+    /// Parameters from a run's configuration: widths from `[slice]` (the regions stage's), role
+    /// speeds and the first-layer speed from `[slice]` limited to `printer.max_print_speed`;
+    /// paste tools print every path as [`Role::ConductiveTrace`] at `slice.conductive_speed`
+    /// (also on the first layer, if that is slower than `first_layer_speed`). Ordering and
+    /// start position take their defaults.
+    pub fn from_config(cfg: &Config) -> Self {
+        let s = &cfg.slice;
+        let max = cfg.printer.max_print_speed;
+        let speeds = RoleSpeeds {
+            external_perimeter: s.external_perimeter_speed,
+            perimeter: s.perimeter_speed,
+            solid_infill: s.solid_infill_speed,
+            top_solid_infill: s.top_solid_infill_speed,
+            sparse_infill: s.infill_speed,
+            skirt: s.skirt_speed,
+            conductive: s.conductive_speed,
+        }
+        .clamped(max);
+        let tools = cfg
+            .tools
+            .iter()
+            .map(|t| {
+                let base = ToolPathParams {
+                    speeds,
+                    first_layer_speed: s.first_layer_speed.min(max),
+                    ..ToolPathParams::from_region(&s.region)
+                };
+                match t.kind {
+                    ToolKind::Filament => base,
+                    ToolKind::Paste => ToolPathParams {
+                        role: Some(Role::ConductiveTrace),
+                        first_layer_speed: base.first_layer_speed.min(speeds.conductive),
+                        ..base
+                    },
+                }
+            })
+            .collect();
+        Self {
+            tools,
+            ..Self::default()
+        }
+    }
+
     /// The parameters of tool `tool`.
     pub fn tool(&self, tool: usize) -> ToolPathParams {
         self.tools.get(tool).copied().unwrap_or_default()
@@ -199,6 +327,8 @@ struct Entry<'a> {
 
 /// Makes toolpaths of one role for one object layer.
 struct PathMaker {
+    /// Simplification tolerance, nm.
+    tolerance: i64,
     z: f64,
     height: f64,
     tool: usize,
@@ -226,17 +356,20 @@ impl PathMaker {
         }
     }
 
-    fn points(&self, pts: &[Point2]) -> Vec<Point3> {
-        pts.iter().map(|&p| point3(p, self.z)).collect()
+    fn points(&self, pts: &[Point2], closed: bool) -> Vec<Point3> {
+        simplify(pts, self.tolerance, closed)
+            .into_iter()
+            .map(|p| point3(p, self.z))
+            .collect()
     }
 
     fn closed(&self, polygon: &Polygon, role: Role, width: f64) -> Option<Toolpath> {
         (polygon.points.len() >= 2)
-            .then(|| self.path(self.points(&polygon.points), true, role, width))
+            .then(|| self.path(self.points(&polygon.points, true), true, role, width))
     }
 
     fn open(&self, pts: &[Point2], role: Role, width: f64) -> Option<Toolpath> {
-        (pts.len() >= 2).then(|| self.path(self.points(pts), false, role, width))
+        (pts.len() >= 2).then(|| self.path(self.points(pts, false), false, role, width))
     }
 }
 
@@ -339,6 +472,7 @@ pub fn build_program(objects: &[ObjectLayers], params: &ProgramParams) -> Progra
             let mut islands = Vec::new();
             for e in entries.iter().filter(|e| e.tool == tool) {
                 let maker = PathMaker {
+                    tolerance: scaled(params.resolution.max(0.0)),
                     z: e.top,
                     height: e.regions.height,
                     tool,
@@ -560,6 +694,39 @@ mod tests {
             program.layers[1]
                 .paths()
                 .any(|p| p.points[0].x > 15.0 && p.height == 0.3)
+        );
+    }
+
+    #[test]
+    fn simplify_drops_collinear_and_tiny_deviations_only() {
+        let mm = Point2::from_mm;
+        let line = [
+            mm(0.0, 0.0),
+            mm(1.0, 0.0),
+            mm(2.0, 0.005),
+            mm(3.0, 0.0),
+            mm(3.0, 1.0),
+        ];
+        let tol = scaled(DEFAULT_RESOLUTION_MM);
+        assert_eq!(
+            simplify(&line, tol, false),
+            vec![mm(0.0, 0.0), mm(3.0, 0.0), mm(3.0, 1.0)]
+        );
+        let bump = [mm(0.0, 0.0), mm(1.0, 0.02), mm(2.0, 0.0)];
+        assert_eq!(simplify(&bump, tol, false), bump.to_vec());
+        assert_eq!(simplify(&line, 0, false), line.to_vec());
+        // A ring with midpoints on its edges keeps its four corners, starting where it did.
+        let ring = [
+            mm(0.0, 0.0),
+            mm(5.0, 0.0),
+            mm(10.0, 0.0),
+            mm(10.0, 10.0),
+            mm(5.0, 10.0),
+            mm(0.0, 10.0),
+        ];
+        assert_eq!(
+            simplify(&ring, tol, true),
+            vec![mm(0.0, 0.0), mm(10.0, 0.0), mm(10.0, 10.0), mm(0.0, 10.0)]
         );
     }
 

@@ -527,7 +527,11 @@ mod tests {
             nn < before / 3.0,
             "nearest neighbour {nn} vs input {before}"
         );
-        assert!(after <= nn, "improved {after} vs nearest neighbour {nn}");
+        // 4181 mm in input order, 695 mm nearest-neighbour, 561 mm after 2-opt / or-opt.
+        assert!(
+            after < 0.9 * nn,
+            "improved {after} vs nearest neighbour {nn}"
+        );
         let mut a: Vec<_> = input.iter().map(key).collect();
         let mut b: Vec<_> = ordered.iter().map(key).collect();
         a.sort();

@@ -1,0 +1,263 @@
+//! G-code for FFF printers with filament and paste tools: Marlin, RepRapFirmware, Klipper.
+//!
+//! Place in the pipeline: Program → **emit** → file. [`write_gcode`] writes a whole file; the
+//! body is produced by a state machine that sends lines and motions to a [`GcodeSink`]
+//! ([`write_program`]), so the same code can feed a preview or a test [`Recorder`].
+//!
+//! # Output
+//!
+//! - A header: `; conduit <version>`, flavour, E mode, layer count, tools used, filament per
+//!   tool (mm, cm³, g) and the estimated time ([`estimate`]). The totals are known only at the
+//!   end, so the body is built in memory and the header written before it.
+//! - Fan off (`M107`), then, as PrusaSlicer does, the first-layer bed and tool temperatures when
+//!   the start G-code sets none itself; `;TYPE:Custom` and the rendered `printer.start_gcode`;
+//!   `G21`, `G90`, `M82`/`M83`, `G92 E0`; a preheat (to the standby or first-layer
+//!   temperature) of the other used tools the start G-code leaves cold; `T<n>` of the first tool
+//!   on multi-tool prints; a wait for the first tool when the start G-code does not wait for it.
+//! - Per layer, PrusaSlicer's markers: `;LAYER_CHANGE`, `;Z:<z>`, `;HEIGHT:<h>`, then
+//!   `G1 Z<z>` (after a retraction when the way to the layer's first path is long) and, in
+//!   absolute E mode, `G92 E0`. On layer 1 the bed and tool temperatures change to their
+//!   after-first-layer values. The fan is off for the first `disable_fan_first_layers` layers,
+//!   then follows the layer's extrusion time as PrusaSlicer's cooling does with its default
+//!   thresholds: `fan_max_speed` under 5 s, `fan_min_speed` over 60 s, linear in between
+//!   (`M106 S0-255`, written only when it changes).
+//! - Per path: a travel (`G1 X Y F<travel>`; longer than `retract_before_travel`: retract
+//!   first, and with `retract_lift > 0` a z-hop up before and back down after), un-retract,
+//!   `;TYPE:<role>` and `;WIDTH:<w>` when they change (`;HEIGHT:` too, within a layer), `G1 F`
+//!   when the speed changes, then `G1 X Y [Z] E` moves (a closed path returns to its start).
+//!   Filament tools: `E = length × bead area / filament area × extrusion_multiplier`
+//!   ([`crate::program::extrusion`]). Paste tools: `paste_on_gcode`, moves without E,
+//!   `paste_off_gcode`.
+//! - Tool changes: retract, `before_tool_change_gcode` (`{previous_tool}`, `{next_tool}`), the
+//!   old tool to its standby temperature, `T<n>`, heat-and-wait for the new tool,
+//!   `after_tool_change_gcode`, `G92 E0` (absolute E). Coordinates of tool `n` are the program's
+//!   minus `tools.n.offset` (PrusaSlicer's `extruder_offset` convention). Flavour differences
+//!   are listed in [`flavor`](self#flavours).
+//! - Events: `;PICK_AND_PLACE PART=.. X=.. Y=.. Z=.. ROTATION=..` (a marker for a host plugin),
+//!   a manual-insert pause in the flavour's way, comments, `G4 P<ms>` dwells.
+//! - The end: retract, `;TYPE:Custom`, the rendered `printer.end_gcode`, then PrusaSlicer's
+//!   footer lines (`; filament used [mm] = ...`, `; estimated printing time (normal mode) =
+//!   ...`) that OctoPrint and other tools read.
+//!
+//! # Flavours
+//!
+//! See the table in the `flavor` module source: temperatures are `M104 T`/`M109 T` on Marlin
+//! and Klipper, `G10 P S R`/`M116 P` on RepRapFirmware (which handles standby itself);
+//! firmware retraction is `G10`/`G11` on all three.
+//!
+//! Every number goes through [`conduit_gcode::fmt_xyz`], [`conduit_gcode::fmt_e`] and
+//! [`conduit_gcode::fmt_f`]; nothing depends on clocks, hashing or thread count, so the output is
+//! byte-identical across runs.
+
+pub mod estimate;
+mod flavor;
+mod sink;
+mod writer;
+
+#[cfg(test)]
+mod tests;
+
+pub use sink::{GcodeSink, Motion, MotionKind, Recorder};
+
+use std::io::Write;
+
+use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
+use serde::Serialize;
+
+use crate::config::{Config, ConfigError, ToolKind};
+use crate::program::Program;
+use estimate::format_duration;
+use writer::{Writer, used_tools};
+
+/// Why G-code could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum EmitError {
+    /// Writing the output failed.
+    ///
+    /// How to fix: check the output path, the free space and the permissions.
+    #[error("writing G-code: {0}")]
+    Io(#[from] std::io::Error),
+    /// A custom G-code template has a placeholder that is neither a config key nor a variable
+    /// the writer provides.
+    ///
+    /// How to fix: correct the placeholder in the named template; `conduit config --defaults`
+    /// lists the keys. The writer provides `{previous_tool}`, `{next_tool}`, `{layer_num}` and
+    /// `{layer_z}` in tool-change templates, `{initial_tool}`, `{initial_extruder}`,
+    /// `{total_layer_count}` and `{max_layer_z}` in the start G-code.
+    #[error("{template}: unknown placeholder {{{placeholder}}}")]
+    Template {
+        /// Which template (`printer.start_gcode`, `tools.1.paste_on_gcode`, ...).
+        template: String,
+        /// The placeholder without braces.
+        placeholder: String,
+    },
+    /// Filling a template failed for another reason.
+    ///
+    /// How to fix: see the wrapped error.
+    #[error("{template}: {source}")]
+    Config {
+        /// Which template.
+        template: String,
+        /// The config's error.
+        source: Box<ConfigError>,
+    },
+    /// The program uses a tool the config does not define.
+    ///
+    /// How to fix: add a `[tools.N]` table for it, or assign the object to an existing tool.
+    #[error("the program uses tool {tool}, but the config defines only {count} tool(s)")]
+    UnknownTool {
+        /// The tool index.
+        tool: usize,
+        /// Number of tools in the config.
+        count: usize,
+    },
+    /// A path has a coordinate, width, height or speed that is NaN or infinite, or a speed that
+    /// is not positive.
+    ///
+    /// How to fix: this is a bug in the stage that made the program; please file an issue.
+    #[error("layer {layer}: a toolpath has a non-finite coordinate or size, or no speed")]
+    NotFinite {
+        /// The layer index.
+        layer: usize,
+    },
+}
+
+/// Material used by one tool.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ToolStats {
+    /// Tool index.
+    pub tool: usize,
+    /// Tool name from the config.
+    pub name: String,
+    /// Filament or paste.
+    pub kind: ToolKind,
+    /// Filament pushed, mm (0 for paste tools).
+    pub filament_mm: f64,
+    /// Material volume, cm³ (paste: flow × time the paste is on).
+    pub volume_cm3: f64,
+    /// Material weight, g (volume × density).
+    pub grams: f64,
+    /// Time spent extruding, s.
+    pub extrusion_time_s: f64,
+}
+
+/// What a G-code file contains, for reports.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GcodeStats {
+    /// Number of layers.
+    pub layers: usize,
+    /// Estimated print time, s (see [`estimate`]).
+    pub estimated_time_s: f64,
+    /// Per tool used, ascending.
+    pub tools: Vec<ToolStats>,
+}
+
+/// Writes the body of the G-code for `program` (start G-code to end G-code, no header or
+/// footer) to `sink`, and returns the totals.
+pub fn write_program<S: GcodeSink>(
+    program: &Program,
+    cfg: &Config,
+    sink: &mut S,
+) -> Result<GcodeStats, EmitError> {
+    let used = used_tools(program);
+    if let Some(&tool) = used.iter().find(|&&t| t >= cfg.tools.len()) {
+        return Err(EmitError::UnknownTool {
+            tool,
+            count: cfg.tools.len(),
+        });
+    }
+    let first_tool = program.first_tool().or(used.first().copied()).unwrap_or(0);
+    let mut w = Writer::new(cfg, sink)?;
+    w.start(program, first_tool)?;
+    for layer in &program.layers {
+        w.layer(layer)?;
+    }
+    w.finish(program)
+}
+
+/// Writes a complete G-code file for `program` to `w`: header, body ([`write_program`]) and
+/// footer. See the module docs for what it contains.
+pub fn write_gcode(
+    program: &Program,
+    cfg: &Config,
+    w: &mut impl Write,
+) -> Result<GcodeStats, EmitError> {
+    let mut body: Vec<u8> = Vec::new();
+    let stats = write_program(program, cfg, &mut body)?;
+    let mut head = String::new();
+    header(&stats, cfg, &mut head);
+    let mut foot = String::new();
+    footer(&stats, &mut foot);
+    w.write_all(head.as_bytes())?;
+    w.write_all(&body)?;
+    w.write_all(foot.as_bytes())?;
+    w.flush()?;
+    Ok(stats)
+}
+
+fn header(stats: &GcodeStats, cfg: &Config, out: &mut String) {
+    let version = env!("CARGO_PKG_VERSION");
+    out.line(&format!("; conduit {version}"));
+    out.line(&format!("; generated by conduit {version}"));
+    out.line(&format!("; flavor = {}", cfg.printer.flavor));
+    out.line(&format!(
+        "; extrusion = {}",
+        if cfg.printer.use_relative_e_distances {
+            "relative (M83)"
+        } else {
+            "absolute (M82)"
+        }
+    ));
+    out.line(&format!("; layer count = {}", stats.layers));
+    let tools: Vec<String> = stats
+        .tools
+        .iter()
+        .map(|t| format!("{} ({})", t.tool, t.name))
+        .collect();
+    out.line(&format!("; tools used = {}", tools.join(", ")));
+    for t in &stats.tools {
+        let kind = match t.kind {
+            ToolKind::Filament => "filament",
+            ToolKind::Paste => "paste",
+        };
+        out.line(&format!(
+            "; tool {} {kind} used = {} mm, {} cm3, {} g",
+            t.tool,
+            fmt_xyz(t.filament_mm),
+            fmt_e(t.volume_cm3),
+            fmt_xyz(t.grams)
+        ));
+    }
+    out.line(&format!(
+        "; estimated printing time = {} ({} s)",
+        format_duration(stats.estimated_time_s),
+        fmt_f(stats.estimated_time_s)
+    ));
+    out.line("");
+}
+
+fn footer(stats: &GcodeStats, out: &mut String) {
+    let join =
+        |f: &dyn Fn(&ToolStats) -> String| stats.tools.iter().map(f).collect::<Vec<_>>().join(", ");
+    out.line("");
+    out.line(&format!(
+        "; filament used [mm] = {}",
+        join(&|t| fmt_xyz(t.filament_mm))
+    ));
+    out.line(&format!(
+        "; filament used [cm3] = {}",
+        join(&|t| fmt_xyz(t.volume_cm3))
+    ));
+    out.line(&format!(
+        "; filament used [g] = {}",
+        join(&|t| fmt_xyz(t.grams))
+    ));
+    out.line(&format!(
+        "; total filament used [g] = {}",
+        fmt_xyz(stats.tools.iter().map(|t| t.grams).sum())
+    ));
+    out.line(&format!(
+        "; estimated printing time (normal mode) = {}",
+        format_duration(stats.estimated_time_s)
+    ));
+}

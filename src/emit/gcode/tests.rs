@@ -1,0 +1,597 @@
+//! Tests of the G-code writer on real output: every file is re-parsed with `conduit_gcode` and
+//! replayed (positions, E, tool) to check what the machine would do.
+
+use super::*;
+use crate::config::{Flavor, Tool};
+use crate::geom::Point3;
+use crate::program::{Event, Layer, LayerItem, Role, Toolpath, e_per_mm};
+
+/// One replayed G0/G1 move.
+#[derive(Debug, Clone, Copy)]
+struct Move {
+    /// Index of the line in the file.
+    line: usize,
+    tool: usize,
+    from: [f64; 3],
+    to: [f64; 3],
+    /// E change (filament mm).
+    de: f64,
+}
+
+impl Move {
+    fn xy_len(&self) -> f64 {
+        ((self.to[0] - self.from[0]).powi(2) + (self.to[1] - self.from[1]).powi(2)).sqrt()
+    }
+    fn moves_xy(&self) -> bool {
+        self.xy_len() > 0.0
+    }
+}
+
+/// Parses `text` and replays it: positions, E (absolute or relative per M82/M83, G92 E), tool.
+/// Returns the lines and the moves from the first `;LAYER_CHANGE` on (the start G-code's
+/// priming moves are left out).
+fn replay(text: &str) -> (Vec<String>, Vec<Move>) {
+    let g = match conduit_gcode::parse(text.as_bytes()) {
+        Ok(g) => g,
+        Err(e) => panic!("output does not parse: {e}"),
+    };
+    let lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    let (mut pos, mut e, mut relative, mut tool) = ([0.0f64; 3], 0.0f64, false, 0usize);
+    let mut moves = Vec::new();
+    for (i, l) in g.lines.iter().enumerate() {
+        match l.command() {
+            Some((b'G', c)) if c == 0.0 || c == 1.0 => {
+                let mut to = pos;
+                for (k, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+                    if let Some(v) = l.get(letter) {
+                        to[k] = v;
+                    }
+                }
+                let de = match l.get(b'E') {
+                    Some(v) if relative => v,
+                    Some(v) => v - e,
+                    None => 0.0,
+                };
+                e += de;
+                moves.push(Move {
+                    line: i,
+                    tool,
+                    from: pos,
+                    to,
+                    de,
+                });
+                pos = to;
+            }
+            Some((b'G', 92.0)) => {
+                if let Some(v) = l.get(b'E') {
+                    e = v;
+                }
+            }
+            Some((b'M', 82.0)) => relative = false,
+            Some((b'M', 83.0)) => relative = true,
+            Some((b'T', n)) => tool = n as usize,
+            _ => {}
+        }
+    }
+    let body = lines.iter().position(|l| l == ";LAYER_CHANGE").unwrap_or(0);
+    moves.retain(|m| m.line > body);
+    (lines, moves)
+}
+
+fn path(points: &[(f64, f64)], z: f64, closed: bool, role: Role, tool: usize) -> Toolpath {
+    Toolpath {
+        points: points.iter().map(|&(x, y)| Point3::new(x, y, z)).collect(),
+        closed,
+        role,
+        tool,
+        width: 0.45,
+        height: 0.2,
+        speed: 30.0,
+        tool_axis: None,
+    }
+}
+
+fn square(x: f64, y: f64, side: f64, z: f64, role: Role, tool: usize) -> Toolpath {
+    path(
+        &[(x, y), (x + side, y), (x + side, y + side), (x, y + side)],
+        z,
+        true,
+        role,
+        tool,
+    )
+}
+
+/// One layer: an inner and an outer square loop (short travel between them), an infill line
+/// inside (short travel), and a far square (long travel).
+fn one_layer_program() -> Program {
+    let z = 0.2;
+    Program {
+        layers: vec![Layer {
+            index: 0,
+            z,
+            height: 0.2,
+            items: vec![
+                LayerItem::Path(square(11.0, 11.0, 18.0, z, Role::Perimeter, 0)),
+                LayerItem::Path(square(10.0, 10.0, 20.0, z, Role::ExternalPerimeter, 0)),
+                LayerItem::Path(path(
+                    &[(12.0, 12.0), (28.0, 28.0)],
+                    z,
+                    false,
+                    Role::SparseInfill,
+                    0,
+                )),
+                LayerItem::Path(square(60.0, 60.0, 10.0, z, Role::ExternalPerimeter, 0)),
+            ],
+        }],
+    }
+}
+
+fn test_config() -> Config {
+    let mut cfg = Config::default();
+    cfg.printer.retract_length = 0.8;
+    cfg.printer.retract_before_travel = 2.0;
+    cfg.printer.retract_lift = 0.4;
+    cfg
+}
+
+fn write(program: &Program, cfg: &Config) -> (String, GcodeStats) {
+    let mut out = Vec::new();
+    match write_gcode(program, cfg, &mut out) {
+        Ok(stats) => (String::from_utf8_lossy(&out).into_owned(), stats),
+        Err(e) => panic!("write_gcode failed: {e}"),
+    }
+}
+
+#[test]
+fn one_layer_square_header_markers_extrusion_retraction_and_zhop() {
+    let cfg = test_config();
+    let program = one_layer_program();
+    let (text, stats) = write(&program, &cfg);
+    let (lines, moves) = replay(&text);
+
+    // Header first, with the version and totals; PrusaSlicer's markers in the body.
+    assert_eq!(lines[0], format!("; conduit {}", env!("CARGO_PKG_VERSION")));
+    assert!(text.contains("; tools used = 0 (PLA)\n"), "{text}");
+    assert!(
+        text.contains(";LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\nG1 Z0.2 F7800\nG92 E0\n"),
+        "{text}"
+    );
+    for marker in [
+        ";TYPE:Perimeter",
+        ";TYPE:External perimeter",
+        ";TYPE:Internal infill",
+        ";WIDTH:0.45",
+        ";TYPE:Custom",
+    ] {
+        assert!(lines.iter().any(|l| l == marker), "{marker} missing");
+    }
+    assert_eq!(lines.iter().filter(|l| *l == ";WIDTH:0.45").count(), 1);
+    assert!(text.contains("M82 ; use absolute distances for extrusion"));
+    assert!(text.contains("; estimated printing time (normal mode) = "));
+    assert_eq!(stats.layers, 1);
+
+    // E per mm of every extrusion equals the flow formula.
+    let k = e_per_mm(0.45, 0.2, 1.75);
+    let extrusions: Vec<&Move> = moves
+        .iter()
+        .filter(|m| m.moves_xy() && m.de > 0.0)
+        .collect();
+    assert_eq!(extrusions.len(), 4 + 4 + 1 + 4);
+    for m in &extrusions {
+        assert!(
+            (m.de / m.xy_len() - k).abs() < 1e-5,
+            "line {}: {} vs {k}",
+            m.line,
+            m.de / m.xy_len()
+        );
+        assert!(
+            (m.to[2] - 0.2).abs() < 1e-9,
+            "z-hop not restored before line {}",
+            m.line
+        );
+    }
+    let total: f64 = extrusions.iter().map(|m| m.de).sum();
+    assert!((stats.tools[0].filament_mm - total).abs() < 1e-4);
+    let expected_len = 4.0 * 18.0 + 4.0 * 20.0 + 16.0 * 2f64.sqrt() + 40.0;
+    assert!((total - expected_len * k).abs() < 1e-4, "{total}");
+    assert!(stats.tools[0].grams > 0.0 && stats.estimated_time_s > 0.0);
+
+    // Retraction (and z-hop) on long travels only, un-retraction before the next extrusion.
+    let mut retracted = false;
+    let mut travels = 0;
+    for m in &moves {
+        if !m.moves_xy() && m.de < 0.0 {
+            assert!(!retracted);
+            assert!((m.de + 0.8).abs() < 1e-9);
+            retracted = true;
+        } else if !m.moves_xy() && m.de > 0.0 {
+            assert!(retracted);
+            retracted = false;
+        } else if m.moves_xy() && m.de == 0.0 {
+            travels += 1;
+            if travels == 1 {
+                // From the end of the start G-code, where the writer does not know the
+                // position: no retraction.
+                continue;
+            }
+            let long = m.xy_len() > 2.0;
+            assert_eq!(
+                retracted,
+                long,
+                "travel at line {} of {} mm",
+                m.line,
+                m.xy_len()
+            );
+            let lifted = (m.to[2] - 0.6).abs() < 1e-9;
+            assert_eq!(lifted, long, "z-hop at line {}", m.line);
+        } else if m.de > 0.0 {
+            assert!(!retracted, "extruding while retracted at line {}", m.line);
+        }
+    }
+    // Travels: to the first loop (from the unknown start: not replayed as long), inner→outer
+    // (1.4 mm), outer→infill (2.8 mm: long), infill→far square (long).
+    assert!(travels >= 3, "{travels}");
+    // The end retracts; the last travel restored Z before extruding.
+    assert!(retracted);
+}
+
+/// Two filament tools; tool 0 has a standby temperature, tool 1 an offset.
+fn two_tool_config() -> Config {
+    let mut cfg = test_config();
+    cfg.tools = vec![
+        Tool {
+            standby_temperature: Some(170.0),
+            ..Tool::filament()
+        },
+        Tool {
+            name: "PETG".to_owned(),
+            temperature: 240.0,
+            first_layer_temperature: 235.0,
+            offset: [20.0, 5.0],
+            ..Tool::filament()
+        },
+    ];
+    cfg.printer.before_tool_change_gcode = "; before {previous_tool} -> {next_tool}".to_owned();
+    cfg
+}
+
+fn two_tool_program() -> Program {
+    let layer = |index: usize, z: f64, first: usize| {
+        let second = 1 - first;
+        Layer {
+            index,
+            z,
+            height: 0.2,
+            items: vec![
+                LayerItem::Path(square(
+                    10.0 + 40.0 * first as f64,
+                    10.0,
+                    10.0,
+                    z,
+                    Role::ExternalPerimeter,
+                    first,
+                )),
+                LayerItem::Event(Event::ToolChange { tool: second }),
+                LayerItem::Path(square(
+                    10.0 + 40.0 * second as f64,
+                    10.0,
+                    10.0,
+                    z,
+                    Role::ExternalPerimeter,
+                    second,
+                )),
+            ],
+        }
+    };
+    Program {
+        layers: vec![layer(0, 0.2, 0), layer(1, 0.4, 1)],
+    }
+}
+
+#[test]
+fn two_tools_standby_wait_before_first_use_and_offsets() {
+    let cfg = two_tool_config();
+    let (text, stats) = write(&two_tool_program(), &cfg);
+    let (lines, moves) = replay(&text);
+    let at = |s: &str| lines.iter().position(|l| l == s).unwrap_or(usize::MAX);
+    let t1 = at("T1");
+    assert!(t1 < usize::MAX, "{text}");
+    // T0 goes to standby before T1 is selected; T1 heats and waits before it extrudes.
+    assert!(at("; before 0 -> 1") < t1);
+    assert!(at("M104 T0 S170") < t1);
+    let wait = at("M109 T1 S235");
+    let first_t1_extrusion = moves
+        .iter()
+        .find(|m| m.tool == 1 && m.de > 0.0 && m.moves_xy())
+        .map_or(usize::MAX, |m| m.line);
+    assert!(
+        t1 < wait && wait < first_t1_extrusion,
+        "{t1} {wait} {first_t1_extrusion}"
+    );
+    // Layer 1 starts with T1 (no change), then goes back to T0, which is waited for again at
+    // its after-first-layer temperature.
+    assert!(text.contains("M104 T1 S240"), "{text}");
+    assert!(!text.contains("M104 T1 S170"));
+    assert!(text.contains("T0\nM109 T0 S210"), "{text}");
+    assert_eq!(
+        lines.iter().filter(|l| l.starts_with('T')).count(),
+        3,
+        "T0 at start, T1, T0"
+    );
+    // Offsets: tool 1's square (nominal x 50..60, y 10..20) is printed at x 30..40, y 5..15.
+    for m in moves.iter().filter(|m| m.de > 0.0 && m.moves_xy()) {
+        let (x0, y0) = if m.tool == 1 {
+            (30.0, 5.0)
+        } else {
+            (10.0, 10.0)
+        };
+        for p in [m.from, m.to] {
+            assert!(
+                p[0] >= x0 - 1e-9 && p[0] <= x0 + 10.0 + 1e-9,
+                "tool {} x {}",
+                m.tool,
+                p[0]
+            );
+            assert!(
+                p[1] >= y0 - 1e-9 && p[1] <= y0 + 10.0 + 1e-9,
+                "tool {} y {}",
+                m.tool,
+                p[1]
+            );
+        }
+    }
+    assert_eq!(stats.tools.len(), 2);
+    assert!(stats.tools.iter().all(|t| t.filament_mm > 0.0));
+    // The start G-code heats only tool 0: tool 1 is preheated right after it.
+    let preheat = at("M104 T1 S235");
+    assert!(
+        at("G92 E0") < preheat && preheat < at(";LAYER_CHANGE"),
+        "{text}"
+    );
+    // Fan off on the first layer (disable_fan_first_layers = 1), on for the short layer 1.
+    let layer1 = lines
+        .iter()
+        .rposition(|l| l == ";LAYER_CHANGE")
+        .unwrap_or(0);
+    assert!(at("M107") < at(";LAYER_CHANGE"));
+    assert!(at("M106 S255") > layer1, "{text}");
+    assert_eq!(lines.iter().filter(|l| l.starts_with("M106")).count(), 1);
+}
+
+#[test]
+fn fan_follows_layer_time_between_min_and_max() {
+    let mut cfg = test_config();
+    cfg.printer.disable_fan_first_layers = 0;
+    cfg.printer.fan_min_speed = 40.0;
+    cfg.printer.fan_max_speed = 100.0;
+    // Layer 0: one 40 mm loop at 30 mm/s (under 5 s: full fan). Layer 1: the same loop at
+    // 1 mm/s (40 s plus ramps: between). Layer 2: at 0.5 mm/s (80 s: minimum fan).
+    let layer = |index: usize, speed: f64| {
+        let z = 0.2 * (index + 1) as f64;
+        let mut p = square(10.0, 10.0, 10.0, z, Role::Perimeter, 0);
+        p.speed = speed;
+        Layer {
+            index,
+            z,
+            height: 0.2,
+            items: vec![LayerItem::Path(p)],
+        }
+    };
+    let program = Program {
+        layers: vec![layer(0, 30.0), layer(1, 1.0), layer(2, 0.5)],
+    };
+    let (text, _) = write(&program, &cfg);
+    let fans: Vec<&str> = text.lines().filter(|l| l.starts_with("M106")).collect();
+    // 40 mm at 1 mm/s with 1000 mm/s² ramps: 40.001 s → 100 − 60·35.001/55 = 61.8 % → S158.
+    assert_eq!(fans, ["M106 S255", "M106 S158", "M106 S102"], "{text}");
+}
+
+#[test]
+fn paste_tool_is_switched_on_and_off_without_e() {
+    let mut cfg = test_config();
+    cfg.tools[1].offset = [0.0, 0.0];
+    let mut program = one_layer_program();
+    program.layers[0].items.push(LayerItem::Path(square(
+        80.0,
+        10.0,
+        5.0,
+        0.2,
+        Role::ConductiveTrace,
+        1,
+    )));
+    let (text, stats) = write(&program, &cfg);
+    let (lines, moves) = replay(&text);
+    let on = lines
+        .iter()
+        .position(|l| l == "M42 P6 S255 ; paste on")
+        .unwrap_or(usize::MAX);
+    let off = lines
+        .iter()
+        .position(|l| l == "M42 P6 S0 ; paste off")
+        .unwrap_or(usize::MAX);
+    assert!(on < off && off < usize::MAX, "{text}");
+    assert!(lines.iter().any(|l| l == ";TYPE:Conductive trace"));
+    let paste: Vec<&Move> = moves
+        .iter()
+        .filter(|m| m.line > on && m.line < off)
+        .collect();
+    assert_eq!(paste.len(), 4);
+    for m in &paste {
+        assert_eq!(m.tool, 1);
+        assert!(!lines[m.line].contains('E'), "{}", lines[m.line]);
+    }
+    // Unheated paste tool: no temperature commands for it.
+    assert!(!text.contains("T1 S"));
+    let t1 = &stats.tools[1];
+    assert_eq!(t1.filament_mm, 0.0);
+    assert!(
+        t1.extrusion_time_s > 0.0
+            && (t1.volume_cm3 - t1.extrusion_time_s * 0.5 / 1000.0).abs() < 1e-12
+    );
+}
+
+#[test]
+fn relative_and_absolute_e_give_the_same_moves() {
+    let program = two_tool_program();
+    let mut cfg = two_tool_config();
+    let (abs_text, abs_stats) = write(&program, &cfg);
+    cfg.printer.use_relative_e_distances = true;
+    let (rel_text, rel_stats) = write(&program, &cfg);
+    assert!(rel_text.contains("M83 ; use relative distances for extrusion"));
+    let body = rel_text.find(";LAYER_CHANGE").unwrap_or(0);
+    assert!(
+        !rel_text[body..].contains("G92 E0"),
+        "no E resets in relative mode"
+    );
+    let (_, a) = replay(&abs_text);
+    let (_, r) = replay(&rel_text);
+    assert_eq!(a.len(), r.len());
+    for (x, y) in a.iter().zip(&r) {
+        assert_eq!(x.to, y.to);
+        // Absolute E is rounded once per position, relative once per move: 2 roundings apart.
+        assert!(
+            (x.de - y.de).abs() <= 1.1e-5,
+            "line {}: {} vs {}",
+            x.line,
+            x.de,
+            y.de
+        );
+    }
+    assert!((abs_stats.tools[0].filament_mm - rel_stats.tools[0].filament_mm).abs() < 1e-9);
+}
+
+#[test]
+fn unknown_placeholders_are_errors_naming_them() {
+    let mut cfg = test_config();
+    cfg.printer.start_gcode = "M190 S{bed_temperature}\nM104 S{nozzle_temp}\n".to_owned();
+    let err = write_gcode(&one_layer_program(), &cfg, &mut Vec::new());
+    assert!(
+        matches!(&err, Err(EmitError::Template { template, placeholder })
+            if template == "printer.start_gcode" && placeholder == "nozzle_temp"),
+        "{err:?}"
+    );
+    let mut cfg = two_tool_config();
+    cfg.printer.after_tool_change_gcode = "G1 E{purge_length}".to_owned();
+    let err = write_gcode(&two_tool_program(), &cfg, &mut Vec::new());
+    assert!(
+        matches!(&err, Err(EmitError::Template { placeholder, .. }) if placeholder == "purge_length")
+    );
+    // Known placeholders of every kind are filled.
+    let mut cfg = two_tool_config();
+    cfg.printer.start_gcode =
+        "M140 S{bed_temperature} ; {first_layer_bed_temperature} {temperature[0]} \
+                               {first_layer_temperature[1]} {layer_height} {total_layer_count}"
+            .to_owned();
+    let (text, _) = write(&two_tool_program(), &cfg);
+    assert!(text.contains("M140 S60 ; 60 210 235 0.2 2\n"), "{text}");
+}
+
+#[test]
+fn unknown_tools_are_errors() {
+    let mut program = one_layer_program();
+    program.layers[0].items.push(LayerItem::Path(square(
+        0.0,
+        0.0,
+        1.0,
+        0.2,
+        Role::Perimeter,
+        5,
+    )));
+    assert!(matches!(
+        write_gcode(&program, &test_config(), &mut Vec::new()),
+        Err(EmitError::UnknownTool { tool: 5, count: 2 })
+    ));
+}
+
+#[test]
+fn output_is_byte_identical_across_runs() {
+    let program = two_tool_program();
+    let cfg = two_tool_config();
+    let (a, _) = write(&program, &cfg);
+    let (b, _) = write(&program, &cfg);
+    assert_eq!(a.as_bytes(), b.as_bytes());
+}
+
+#[test]
+fn flavours_differ_in_temperatures_and_firmware_retraction() {
+    let program = two_tool_program();
+    let mut cfg = two_tool_config();
+    cfg.printer.flavor = Flavor::RepRapFirmware;
+    cfg.printer.use_firmware_retraction = true;
+    let (rrf, _) = write(&program, &cfg);
+    assert!(rrf.contains("G10 P0 S210 R170\n"), "{rrf}");
+    assert!(rrf.contains("G10 P1 S235 R235\n"));
+    assert!(rrf.contains("T1\nM116 P1\n"));
+    assert!(!rrf.contains("M104 T0 S170"), "RRF applies standby itself");
+    assert!(rrf.contains("G10 ; retract\n") && rrf.contains("G11 ; unretract\n"));
+    assert!(!rrf.lines().any(|l| l.starts_with("G1 E")));
+    cfg.printer.flavor = Flavor::Klipper;
+    let (klipper, _) = write(&program, &cfg);
+    assert!(klipper.contains("M104 T0 S170\n") && klipper.contains("M109 T1 S235\n"));
+}
+
+#[test]
+fn events_become_markers_pauses_and_dwells() {
+    let mut program = one_layer_program();
+    program.layers[0].items.extend([
+        LayerItem::Event(Event::Comment("two\nlines".to_owned())),
+        LayerItem::Event(Event::Dwell { seconds: 1.5 }),
+        LayerItem::Event(Event::PickAndPlace {
+            part: "R1".to_owned(),
+            x: 12.5,
+            y: 3.0,
+            z: 2.4,
+            rotation_deg: 90.0,
+        }),
+        LayerItem::Event(Event::ManualInsertPause {
+            part: "U1".to_owned(),
+            message: "insert U1; pin 1 top-left".to_owned(),
+        }),
+    ]);
+    let (text, _) = write(&program, &test_config());
+    assert!(text.contains("; two\n; lines\nG4 P1500\n"), "{text}");
+    assert!(text.contains(";PICK_AND_PLACE PART=R1 X=12.5 Y=3 Z=2.4 ROTATION=90\n"));
+    assert!(
+        text.contains(";MANUAL_INSERT PART=U1\nM0 insert U1  pin 1 top-left\n"),
+        "{text}"
+    );
+}
+
+#[test]
+fn built_program_round_trips_through_the_writer() {
+    use crate::program::{ObjectLayers, ProgramParams, build_program};
+    use crate::region::{RegionParams, make_regions};
+    use crate::slice::{SliceParams, layer_schedule};
+    let island = crate::geom::ExPolygon {
+        contour: crate::geom::Polygon::new(vec![
+            crate::geom::Point2::from_mm(100.0, 100.0),
+            crate::geom::Point2::from_mm(120.0, 100.0),
+            crate::geom::Point2::from_mm(120.0, 120.0),
+            crate::geom::Point2::from_mm(100.0, 120.0),
+        ]),
+        holes: vec![],
+    };
+    let zs = layer_schedule(2.0, &SliceParams::default());
+    let regions = make_regions(&vec![vec![island]; zs.len()], &RegionParams::default());
+    let obj = ObjectLayers {
+        tool: 0,
+        layers: zs.into_iter().zip(regions).collect(),
+    };
+    let cfg = test_config();
+    let program = build_program(&[obj], &ProgramParams::from_config(&cfg));
+    let (text, stats) = write(&program, &cfg);
+    assert_eq!(stats.layers, 10);
+    assert_eq!(text.matches(";LAYER_CHANGE\n").count(), 10);
+    let (_, moves) = replay(&text);
+    let k = e_per_mm(0.45, 0.2, 1.75);
+    for m in moves.iter().filter(|m| m.de > 0.0 && m.xy_len() > 0.5) {
+        assert!((m.de / m.xy_len() - k).abs() < 1e-4, "line {}", m.line);
+    }
+    // Everything stays inside the island.
+    assert!(
+        moves
+            .iter()
+            .filter(|m| m.de > 0.0)
+            .all(|m| (99.9..=120.1).contains(&m.to[0]))
+    );
+}

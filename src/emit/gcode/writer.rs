@@ -1,0 +1,903 @@
+//! The state machine that walks a [`Program`] and writes G-code lines to a [`GcodeSink`].
+
+use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
+
+use super::estimate::move_time;
+use super::flavor::{Dialect, fan, set_bed, wait_bed};
+use super::sink::{GcodeSink, Motion, MotionKind};
+use super::{EmitError, GcodeStats, ToolStats};
+use crate::config::{Config, ConfigError, ToolKind};
+use crate::geom::Point3;
+use crate::program::{BeadShape, Event, Feed, Layer, LayerItem, Program, Toolpath};
+
+/// Layers printed faster than this (s) get the fan at `fan_max_speed` (PrusaSlicer's default
+/// `slowdown_below_layer_time`).
+const SLOWDOWN_BELOW_S: f64 = 5.0;
+
+/// Layers printed slower than this (s) get the fan at `fan_min_speed` (PrusaSlicer's default
+/// `fan_below_layer_time`).
+const FAN_BELOW_S: f64 = 60.0;
+
+/// Per-tool state and settings prepared once.
+struct ToolState {
+    /// Filament or paste.
+    feed: Feed,
+    /// Factor on E.
+    multiplier: f64,
+    /// Rendered `paste_on_gcode` lines (paste tools).
+    paste_on: Vec<String>,
+    /// Rendered `paste_off_gcode` lines (paste tools).
+    paste_off: Vec<String>,
+    /// Filament currently retracted, mm (0 = primed).
+    retracted: f64,
+    /// Whether the writer has waited for this tool's temperature since it was selected.
+    waited: bool,
+    /// Totals.
+    filament_mm: f64,
+    extrusion_time_s: f64,
+}
+
+/// Renders `template` for `tool`, naming the template in errors.
+fn render(
+    cfg: &Config,
+    name: &str,
+    template: &str,
+    tool: usize,
+    vars: &[(&str, String)],
+) -> Result<Vec<String>, EmitError> {
+    if template.trim().is_empty() {
+        return Ok(Vec::new());
+    }
+    match cfg.render_template(template, tool, vars) {
+        Ok(text) => Ok(text.lines().map(str::to_owned).collect()),
+        Err(ConfigError::Template { placeholder }) => Err(EmitError::Template {
+            template: name.to_owned(),
+            placeholder,
+        }),
+        Err(source) => Err(EmitError::Config {
+            template: name.to_owned(),
+            source: Box::new(source),
+        }),
+    }
+}
+
+/// Replaces line breaks and `;` in text that goes into one G-code line or comment.
+fn one_line(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if matches!(c, '\n' | '\r' | ';') {
+                ' '
+            } else {
+                c
+            }
+        })
+        .collect()
+}
+
+pub(super) struct Writer<'a, S: GcodeSink> {
+    cfg: &'a Config,
+    sink: &'a mut S,
+    dialect: Dialect,
+    relative_e: bool,
+    tools: Vec<ToolState>,
+    /// Nozzle position (machine coordinates); `None` until the first XY move.
+    pos: Option<Point3>,
+    /// Z written last, when known, and as written.
+    z: Option<f64>,
+    z_str: Option<String>,
+    /// Absolute E position (absolute mode).
+    e: f64,
+    /// F word written last (mm/min, formatted).
+    feed: Option<String>,
+    tool: Option<usize>,
+    layer_index: usize,
+    layer_z: f64,
+    type_name: Option<&'static str>,
+    width: Option<String>,
+    height: Option<String>,
+    time_s: f64,
+    /// Tools the program uses, ascending.
+    used: Vec<usize>,
+    /// Fan command written last.
+    fan: Option<String>,
+}
+
+impl<'a, S: GcodeSink> Writer<'a, S> {
+    pub fn new(cfg: &'a Config, sink: &'a mut S) -> Result<Self, EmitError> {
+        let mut tools = Vec::with_capacity(cfg.tools.len());
+        for (i, t) in cfg.tools.iter().enumerate() {
+            let (feed, paste_on, paste_off) = match t.kind {
+                ToolKind::Filament => (
+                    Feed::Filament {
+                        diameter: t.filament_diameter,
+                    },
+                    Vec::new(),
+                    Vec::new(),
+                ),
+                ToolKind::Paste => (
+                    Feed::Paste,
+                    render(
+                        cfg,
+                        &format!("tools.{i}.paste_on_gcode"),
+                        &t.paste_on_gcode,
+                        i,
+                        &[],
+                    )?,
+                    render(
+                        cfg,
+                        &format!("tools.{i}.paste_off_gcode"),
+                        &t.paste_off_gcode,
+                        i,
+                        &[],
+                    )?,
+                ),
+            };
+            tools.push(ToolState {
+                feed,
+                multiplier: t.extrusion_multiplier,
+                paste_on,
+                paste_off,
+                retracted: 0.0,
+                waited: false,
+                filament_mm: 0.0,
+                extrusion_time_s: 0.0,
+            });
+        }
+        Ok(Self {
+            cfg,
+            sink,
+            dialect: super::flavor::Dialect(cfg.printer.flavor),
+            relative_e: cfg.printer.use_relative_e_distances,
+            tools,
+            pos: None,
+            z: None,
+            z_str: None,
+            e: 0.0,
+            feed: None,
+            tool: None,
+            layer_index: 0,
+            layer_z: 0.0,
+            type_name: None,
+            width: None,
+            height: None,
+            time_s: 0.0,
+            used: Vec::new(),
+            fan: None,
+        })
+    }
+
+    fn line(&mut self, line: &str) {
+        self.sink.line(line);
+    }
+
+    fn lines(&mut self, lines: &[String]) {
+        for l in lines {
+            self.sink.line(l);
+        }
+    }
+
+    fn motion(
+        &mut self,
+        kind: MotionKind,
+        to: Point3,
+        e: f64,
+        feed: f64,
+        role: Option<crate::program::Role>,
+    ) {
+        let distance = match (kind, self.pos) {
+            (MotionKind::Retract | MotionKind::Unretract, _) => e.abs(),
+            (_, Some(from)) => (to - from).norm(),
+            (_, None) => 0.0,
+        };
+        let t = move_time(distance, feed, self.cfg.printer.max_acceleration);
+        self.time_s += t;
+        if kind == MotionKind::Extrude
+            && let Some(tool) = self.tool
+            && let Some(ts) = self.tools.get_mut(tool)
+        {
+            ts.filament_mm += e;
+            ts.extrusion_time_s += t;
+        }
+        let m = Motion {
+            kind,
+            tool: self.tool,
+            role,
+            from: self.pos,
+            to,
+            e,
+            feed,
+        };
+        self.sink.motion(&m);
+    }
+
+    /// The F word for `mm_s`, or nothing when it is the one in force.
+    fn feed_word(&mut self, mm_s: f64) -> Option<String> {
+        let f = fmt_f(mm_s * 60.0);
+        if self.feed.as_deref() == Some(f.as_str()) {
+            None
+        } else {
+            self.feed = Some(f.clone());
+            Some(format!(" F{f}"))
+        }
+    }
+
+    /// Temperature of `tool` on the current layer.
+    fn temperature(&self, tool: usize) -> f64 {
+        self.cfg.tools.get(tool).map_or(0.0, |t| {
+            if self.layer_index == 0 {
+                t.first_layer_temperature
+            } else {
+                t.temperature
+            }
+        })
+    }
+
+    fn standby_temperature(&self, tool: usize) -> f64 {
+        let temp = self.temperature(tool);
+        self.cfg
+            .tools
+            .get(tool)
+            .and_then(|t| t.standby_temperature)
+            .unwrap_or(temp)
+    }
+
+    /// Machine coordinates of a program point printed with `tool`: the point minus the tool's
+    /// offset (PrusaSlicer's `extruder_offset` convention: the offset is where the tool's
+    /// nozzle sits relative to tool 0's, so the carriage moves the other way).
+    fn machine(&self, p: &Point3, tool: usize) -> Point3 {
+        let [dx, dy] = self.cfg.tools.get(tool).map_or([0.0, 0.0], |t| t.offset);
+        Point3::new(p.x - dx, p.y - dy, p.z)
+    }
+
+    fn retract(&mut self) {
+        let Some(tool) = self.tool else { return };
+        let len = self.cfg.retract_length(tool);
+        let is_filament = matches!(
+            self.tools.get(tool).map(|t| t.feed),
+            Some(Feed::Filament { .. })
+        );
+        if !is_filament || len <= 0.0 || self.tools[tool].retracted > 0.0 {
+            return;
+        }
+        let speed = self.cfg.printer.retract_speed;
+        let at = self
+            .pos
+            .unwrap_or_else(|| Point3::new(0.0, 0.0, self.z.unwrap_or(0.0)));
+        if self.cfg.printer.use_firmware_retraction {
+            self.line("G10 ; retract");
+        } else {
+            let f = self.feed_word(speed).unwrap_or_default();
+            let word = if self.relative_e {
+                fmt_e(-len)
+            } else {
+                self.e -= len;
+                fmt_e(self.e)
+            };
+            self.line(&format!("G1 E{word}{f}"));
+        }
+        self.tools[tool].retracted = len;
+        self.motion(MotionKind::Retract, at, -len, speed, None);
+    }
+
+    fn unretract(&mut self) {
+        let Some(tool) = self.tool else { return };
+        let len = self.tools.get(tool).map_or(0.0, |t| t.retracted);
+        if len <= 0.0 {
+            return;
+        }
+        let speed = self.cfg.deretract_speed();
+        let at = self
+            .pos
+            .unwrap_or_else(|| Point3::new(0.0, 0.0, self.z.unwrap_or(0.0)));
+        if self.cfg.printer.use_firmware_retraction {
+            self.line("G11 ; unretract");
+        } else {
+            let f = self.feed_word(speed).unwrap_or_default();
+            let word = if self.relative_e {
+                fmt_e(len)
+            } else {
+                self.e += len;
+                fmt_e(self.e)
+            };
+            self.line(&format!("G1 E{word}{f}"));
+        }
+        self.tools[tool].retracted = 0.0;
+        self.motion(MotionKind::Unretract, at, len, speed, None);
+    }
+
+    /// Records that Z `z` was written.
+    fn set_z(&mut self, z: f64) {
+        self.z = Some(z);
+        self.z_str = Some(fmt_xyz(z));
+    }
+
+    /// Moves Z alone to `z` at travel speed.
+    fn move_z(&mut self, z: f64) {
+        if self.z_str.as_deref() == Some(fmt_xyz(z).as_str()) {
+            return;
+        }
+        let speed = self.cfg.printer.travel_speed;
+        let f = self.feed_word(speed).unwrap_or_default();
+        self.line(&format!("G1 Z{}{f}", fmt_xyz(z)));
+        self.set_z(z);
+        if let Some(p) = self.pos {
+            let to = Point3::new(p.x, p.y, z);
+            self.motion(MotionKind::Travel, to, 0.0, speed, None);
+            self.pos = Some(to);
+        }
+    }
+
+    /// Travels to `target` (machine coordinates): retract and z-hop when the travel is longer
+    /// than `retract_before_travel`.
+    fn travel_to(&mut self, target: Point3) {
+        let speed = self.cfg.printer.travel_speed;
+        let Some(cur) = self.pos else {
+            // Position unknown after the start G-code: Z first, then XY.
+            self.move_z(target.z);
+            let f = self.feed_word(speed).unwrap_or_default();
+            self.line(&format!(
+                "G1 X{} Y{}{f}",
+                fmt_xyz(target.x),
+                fmt_xyz(target.y)
+            ));
+            self.motion(MotionKind::Travel, target, 0.0, speed, None);
+            self.pos = Some(target);
+            return;
+        };
+        let distance = (target - cur).norm();
+        let same_xy = fmt_xyz(cur.x) == fmt_xyz(target.x) && fmt_xyz(cur.y) == fmt_xyz(target.y);
+        if same_xy {
+            self.move_z(target.z);
+            self.pos = Some(target);
+            return;
+        }
+        let long = distance > self.cfg.printer.retract_before_travel;
+        if long {
+            self.retract();
+        }
+        let lift = self.cfg.printer.retract_lift;
+        let hop = long && lift > 0.0;
+        if hop {
+            self.move_z(cur.z + lift);
+        }
+        let f = self.feed_word(speed).unwrap_or_default();
+        let z_word = match self.z {
+            Some(_) if !hop && self.z_str.as_deref() != Some(fmt_xyz(target.z).as_str()) => {
+                format!(" Z{}", fmt_xyz(target.z))
+            }
+            _ => String::new(),
+        };
+        self.line(&format!(
+            "G1 X{} Y{}{z_word}{f}",
+            fmt_xyz(target.x),
+            fmt_xyz(target.y)
+        ));
+        let at = Point3::new(
+            target.x,
+            target.y,
+            if hop { cur.z + lift } else { target.z },
+        );
+        self.motion(MotionKind::Travel, at, 0.0, speed, None);
+        self.pos = Some(at);
+        if !z_word.is_empty() {
+            self.set_z(target.z);
+        }
+        if hop {
+            self.move_z(target.z);
+        }
+        self.pos = Some(target);
+    }
+
+    /// Waits for `tool`'s temperature if it is heated and the writer has not done so since it
+    /// was selected.
+    fn wait_for_tool(&mut self, tool: usize) {
+        let temp = self.temperature(tool);
+        if temp > 0.0 && self.tools.get(tool).is_some_and(|t| !t.waited) {
+            let l = self.dialect.wait_tool_temperature(tool, temp);
+            self.line(&l);
+        }
+        if let Some(t) = self.tools.get_mut(tool) {
+            t.waited = true;
+        }
+    }
+
+    /// Switches to `tool`: retract, before snippet, standby for the old tool, `T`, wait, after
+    /// snippet, E reset.
+    fn tool_change(&mut self, tool: usize) -> Result<(), EmitError> {
+        if self.tool == Some(tool) {
+            return Ok(());
+        }
+        let Some(old) = self.tool else {
+            self.line(&format!("T{tool}"));
+            self.tool = Some(tool);
+            return Ok(());
+        };
+        self.retract();
+        let vars = [
+            ("previous_tool", old.to_string()),
+            ("next_tool", tool.to_string()),
+            ("layer_num", self.layer_index.to_string()),
+            ("layer_z", fmt_xyz(self.layer_z)),
+        ];
+        let before = render(
+            self.cfg,
+            "printer.before_tool_change_gcode",
+            &self.cfg.printer.before_tool_change_gcode,
+            old,
+            &vars,
+        )?;
+        self.lines(&before);
+        if self.temperature(old) > 0.0
+            && let Some(standby) = self.cfg.tools.get(old).and_then(|t| t.standby_temperature)
+            && let Some(l) = self.dialect.standby(old, standby)
+        {
+            self.line(&l);
+        }
+        if let Some(t) = self.tools.get_mut(old) {
+            // A tool that cooled to standby must be waited for again.
+            t.waited = false;
+        }
+        self.line(&format!("T{tool}"));
+        self.tool = Some(tool);
+        self.wait_for_tool(tool);
+        let after = render(
+            self.cfg,
+            "printer.after_tool_change_gcode",
+            &self.cfg.printer.after_tool_change_gcode,
+            tool,
+            &vars,
+        )?;
+        self.lines(&after);
+        if !self.relative_e {
+            self.line("G92 E0");
+            self.e = 0.0;
+        }
+        self.type_name = None;
+        self.width = None;
+        Ok(())
+    }
+
+    pub fn start(&mut self, program: &Program, first_tool: usize) -> Result<(), EmitError> {
+        let cfg = self.cfg;
+        let layers = program.layers.len();
+        let max_z = program.layers.iter().map(|l| l.z).fold(0.0, f64::max);
+        let vars = [
+            ("initial_tool", first_tool.to_string()),
+            ("initial_extruder", first_tool.to_string()),
+            ("total_layer_count", layers.to_string()),
+            ("max_layer_z", fmt_xyz(max_z)),
+        ];
+        let start = render(
+            cfg,
+            "printer.start_gcode",
+            &cfg.printer.start_gcode,
+            first_tool,
+            &vars,
+        )?;
+        let used = used_tools(program);
+        self.used = used.clone();
+        let scan = scan_start_gcode(&start);
+        let rrf = cfg.printer.flavor == crate::config::Flavor::RepRapFirmware;
+        self.line("M107");
+        self.fan = Some("M107".to_owned());
+        if !scan.bed && cfg.printer.first_layer_bed_temperature > 0.0 {
+            self.line(&wait_bed(cfg.printer.first_layer_bed_temperature));
+        }
+        // As PrusaSlicer: a start G-code that heats no tool gets every used tool heated before
+        // it (and a wait for the first one after it). RepRapFirmware always gets its tools'
+        // active and standby temperatures (`G10 P S R`), which it needs before selecting them.
+        for &t in &used {
+            let temp = self.temperature(t);
+            if temp > 0.0 && (!scan.any_tool || rrf) {
+                let standby = self.standby_temperature(t);
+                let l = self.dialect.set_tool_temperature(t, temp, standby);
+                self.line(&l);
+            }
+        }
+        self.line(";TYPE:Custom");
+        self.lines(&start);
+        self.line("G21 ; set units to millimeters");
+        self.line("G90 ; use absolute coordinates");
+        self.line(if self.relative_e {
+            "M83 ; use relative distances for extrusion"
+        } else {
+            "M82 ; use absolute distances for extrusion"
+        });
+        self.line("G92 E0");
+        for &t in &scan.waited {
+            if let Some(ts) = self.tools.get_mut(t) {
+                ts.waited = true;
+            }
+        }
+        // Tools the start G-code leaves cold are preheated to their standby (or first-layer)
+        // temperature, so their first tool change does not wait from cold.
+        if scan.any_tool && !rrf {
+            for &t in used
+                .iter()
+                .filter(|&&t| t != first_tool && !scan.heats.contains(&t))
+            {
+                let temp = self.standby_temperature(t);
+                if temp > 0.0 {
+                    let l = self.dialect.set_tool_temperature(t, temp, temp);
+                    self.line(&l);
+                }
+            }
+        }
+        if used.len() > 1 || first_tool != 0 {
+            self.line(&format!("T{first_tool}"));
+        }
+        self.tool = Some(first_tool);
+        if !scan.any_tool {
+            self.wait_for_tool(first_tool);
+        }
+        Ok(())
+    }
+
+    /// Part-cooling fan for `layer`, percent: off on the first `disable_fan_first_layers`
+    /// layers; then, as PrusaSlicer's cooling logic with its default thresholds, full speed
+    /// (`fan_max_speed`) for layers printed faster than [`SLOWDOWN_BELOW_S`], `fan_min_speed`
+    /// for layers slower than [`FAN_BELOW_S`], linear in between. The layer time is the
+    /// extrusion time of its paths ([`move_time`] per segment).
+    fn fan_speed(&self, layer: &Layer) -> f64 {
+        let p = &self.cfg.printer;
+        if layer.index < p.disable_fan_first_layers {
+            return 0.0;
+        }
+        let accel = p.max_acceleration;
+        let time: f64 = layer
+            .paths()
+            .map(|path| {
+                let closing = path.closed.then(|| path.points[0]);
+                path.points
+                    .iter()
+                    .zip(path.points.iter().skip(1).chain(closing.iter()))
+                    .map(|(a, b)| move_time((b - a).norm(), path.speed, accel))
+                    .sum::<f64>()
+            })
+            .sum();
+        let (lo, hi) = (p.fan_min_speed, p.fan_max_speed);
+        if time <= SLOWDOWN_BELOW_S {
+            hi
+        } else if time >= FAN_BELOW_S {
+            lo
+        } else {
+            hi - (hi - lo) * (time - SLOWDOWN_BELOW_S) / (FAN_BELOW_S - SLOWDOWN_BELOW_S)
+        }
+    }
+
+    pub fn layer(&mut self, layer: &Layer) -> Result<(), EmitError> {
+        let cfg = self.cfg;
+        self.layer_index = layer.index;
+        self.layer_z = layer.z;
+        self.line(";LAYER_CHANGE");
+        self.line(&format!(";Z:{}", fmt_xyz(layer.z)));
+        let h = fmt_xyz(layer.height);
+        self.line(&format!(";HEIGHT:{h}"));
+        self.height = Some(h);
+        if layer.index == 1 {
+            if cfg.printer.bed_temperature != cfg.printer.first_layer_bed_temperature {
+                self.line(&set_bed(cfg.printer.bed_temperature));
+            }
+            // Marlin and Klipper: the active tool now; the others get their temperature from
+            // the wait at their next tool change. RepRapFirmware: every tool's active value.
+            let tools = if cfg.printer.flavor == crate::config::Flavor::RepRapFirmware {
+                self.used.clone()
+            } else {
+                self.tool.into_iter().collect()
+            };
+            for t in tools {
+                let Some(tool) = cfg.tools.get(t) else {
+                    continue;
+                };
+                if tool.temperature > 0.0 && tool.temperature != tool.first_layer_temperature {
+                    let standby = self.standby_temperature(t);
+                    let l = self
+                        .dialect
+                        .set_tool_temperature(t, tool.temperature, standby);
+                    self.line(&l);
+                }
+            }
+        }
+        let fan_line = fan(self.fan_speed(layer));
+        if self.fan.as_deref() != Some(fan_line.as_str()) {
+            self.line(&fan_line);
+            self.fan = Some(fan_line);
+        }
+        // Retract before leaving the last layer's end when the way to this layer's first path
+        // is long; then lift to the layer.
+        let next = layer
+            .paths()
+            .next()
+            .map(|p| (p.tool, p.points.first().copied()));
+        if let (Some(cur), Some((tool, Some(first)))) = (self.pos, next)
+            && self.tool == Some(tool)
+            && (self.machine(&first, tool) - cur).norm() > cfg.printer.retract_before_travel
+        {
+            self.retract();
+        }
+        self.move_z(layer.z);
+        if !self.relative_e {
+            self.line("G92 E0");
+            self.e = 0.0;
+        }
+        for item in &layer.items {
+            match item {
+                LayerItem::Path(p) => self.path(p)?,
+                LayerItem::Event(e) => self.event(e)?,
+            }
+        }
+        Ok(())
+    }
+
+    fn path(&mut self, path: &Toolpath) -> Result<(), EmitError> {
+        if path.points.len() < 2 {
+            return Ok(());
+        }
+        if !is_finite(path) {
+            return Err(EmitError::NotFinite {
+                layer: self.layer_index,
+            });
+        }
+        let tool = path.tool;
+        if tool >= self.tools.len() {
+            return Err(EmitError::UnknownTool {
+                tool,
+                count: self.tools.len(),
+            });
+        }
+        self.tool_change(tool)?;
+        self.travel_to(self.machine(&path.points[0], tool));
+        self.wait_for_tool(tool);
+        self.unretract();
+        let type_name = path.role.type_name();
+        if self.type_name != Some(type_name) {
+            self.line(&format!(";TYPE:{type_name}"));
+            self.type_name = Some(type_name);
+        }
+        let w = fmt_xyz(path.width);
+        if self.width.as_deref() != Some(w.as_str()) {
+            self.line(&format!(";WIDTH:{w}"));
+            self.width = Some(w);
+        }
+        let h = fmt_xyz(path.height);
+        if self.height.as_deref() != Some(h.as_str()) {
+            self.line(&format!(";HEIGHT:{h}"));
+            self.height = Some(h);
+        }
+        if let Some(f) = self.feed_word(path.speed) {
+            self.line(&format!("G1{f}"));
+        }
+        let ts = &self.tools[tool];
+        let e_per_mm = ts
+            .feed
+            .e_per_mm(BeadShape::RoundedRectangle, path.width, path.height)
+            .map(|e| e * ts.multiplier);
+        let paste_on = ts.paste_on.clone();
+        let paste_off = ts.paste_off.clone();
+        let is_paste = ts.feed == Feed::Paste;
+        if is_paste {
+            self.lines(&paste_on);
+        }
+        let closing = path.closed.then(|| path.points[0]);
+        let start = self
+            .pos
+            .unwrap_or_else(|| self.machine(&path.points[0], tool));
+        let mut last_xy = (fmt_xyz(start.x), fmt_xyz(start.y));
+        // Relative E of points dropped for being closer than the output resolution.
+        let mut pending_de = 0.0;
+        for p in path.points[1..].iter().chain(closing.iter()) {
+            let to = self.machine(p, tool);
+            let from = self.pos.unwrap_or(to);
+            let de = e_per_mm.map_or(0.0, |k| (to - from).norm() * k);
+            let (xs, ys, zs) = (fmt_xyz(to.x), fmt_xyz(to.y), fmt_xyz(to.z));
+            let z_changes = self.z_str.as_deref() != Some(zs.as_str());
+            if !self.relative_e {
+                self.e += de;
+            }
+            if xs == last_xy.0 && ys == last_xy.1 && !z_changes {
+                // The same position once written: merge into the next move (absolute E is
+                // cumulative; relative E is carried).
+                pending_de += de;
+                self.motion(MotionKind::Extrude, to, de, path.speed, Some(path.role));
+                self.pos = Some(to);
+                continue;
+            }
+            let mut words = format!("G1 X{xs} Y{ys}");
+            if z_changes {
+                words.push_str(" Z");
+                words.push_str(&zs);
+                self.set_z(to.z);
+            }
+            if e_per_mm.is_some() {
+                let e = if self.relative_e {
+                    fmt_e(de + pending_de)
+                } else {
+                    fmt_e(self.e)
+                };
+                words.push_str(" E");
+                words.push_str(&e);
+            }
+            pending_de = 0.0;
+            self.line(&words);
+            self.motion(MotionKind::Extrude, to, de, path.speed, Some(path.role));
+            self.pos = Some(to);
+            last_xy = (xs, ys);
+        }
+        if is_paste {
+            self.lines(&paste_off);
+        }
+        Ok(())
+    }
+
+    fn event(&mut self, event: &Event) -> Result<(), EmitError> {
+        match event {
+            Event::ToolChange { tool } => {
+                if *tool >= self.tools.len() {
+                    return Err(EmitError::UnknownTool {
+                        tool: *tool,
+                        count: self.tools.len(),
+                    });
+                }
+                self.tool_change(*tool)?;
+            }
+            Event::PickAndPlace {
+                part,
+                x,
+                y,
+                z,
+                rotation_deg,
+            } => {
+                self.retract();
+                self.line(&format!(
+                    ";PICK_AND_PLACE PART={} X={} Y={} Z={} ROTATION={}",
+                    one_line(part).replace(' ', "_"),
+                    fmt_xyz(*x),
+                    fmt_xyz(*y),
+                    fmt_xyz(*z),
+                    fmt_xyz(*rotation_deg)
+                ));
+            }
+            Event::ManualInsertPause { part, message } => {
+                self.retract();
+                self.line(&format!(
+                    ";MANUAL_INSERT PART={}",
+                    one_line(part).replace(' ', "_")
+                ));
+                let lines = self.dialect.pause(one_line(message).trim());
+                self.lines(&lines);
+            }
+            Event::Comment(text) => {
+                for l in text.lines() {
+                    self.line(&format!("; {}", l.trim_end()));
+                }
+            }
+            Event::Dwell { seconds } => {
+                if seconds.is_finite() && *seconds > 0.0 {
+                    self.line(&format!("G4 P{}", fmt_f(seconds * 1000.0)));
+                    self.time_s += seconds;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    pub fn finish(&mut self, program: &Program) -> Result<GcodeStats, EmitError> {
+        let cfg = self.cfg;
+        self.retract();
+        let tool = self.tool.unwrap_or(0);
+        let end = render(
+            cfg,
+            "printer.end_gcode",
+            &cfg.printer.end_gcode,
+            tool,
+            &[
+                ("layer_num", self.layer_index.to_string()),
+                ("layer_z", fmt_xyz(self.layer_z)),
+            ],
+        )?;
+        self.line(";TYPE:Custom");
+        self.lines(&end);
+        let tools = used_tools(program)
+            .into_iter()
+            .filter_map(|t| {
+                let (ts, tc) = (self.tools.get(t)?, cfg.tools.get(t)?);
+                let volume_mm3 = match ts.feed {
+                    Feed::Filament { .. } => ts.filament_mm * tc.filament_area(),
+                    Feed::Paste => ts.extrusion_time_s * tc.paste_flow_mm3_s,
+                };
+                Some(ToolStats {
+                    tool: t,
+                    name: tc.name.clone(),
+                    kind: tc.kind,
+                    filament_mm: ts.filament_mm,
+                    volume_cm3: volume_mm3 / 1000.0,
+                    grams: volume_mm3 / 1000.0 * tc.filament_density,
+                    extrusion_time_s: ts.extrusion_time_s,
+                })
+            })
+            .collect();
+        Ok(GcodeStats {
+            layers: program.layers.len(),
+            estimated_time_s: self.time_s,
+            tools,
+        })
+    }
+}
+
+/// Whether every coordinate, the width and the height of `path` are finite and its speed is
+/// positive.
+fn is_finite(path: &Toolpath) -> bool {
+    let points = path
+        .points
+        .iter()
+        .all(|p| p.x.is_finite() && p.y.is_finite() && p.z.is_finite());
+    points
+        && path.width.is_finite()
+        && path.height.is_finite()
+        && path.speed.is_finite()
+        && path.speed > 0.0
+}
+
+/// Tools the program extrudes with or changes to, ascending.
+pub(super) fn used_tools(program: &Program) -> Vec<usize> {
+    let mut tools = program.tools_used();
+    for layer in &program.layers {
+        for item in &layer.items {
+            if let LayerItem::Event(Event::ToolChange { tool }) = item {
+                tools.push(*tool);
+            }
+        }
+    }
+    tools.sort_unstable();
+    tools.dedup();
+    tools
+}
+
+/// What the rendered start G-code does itself.
+#[derive(Debug, Default)]
+struct StartScan {
+    /// Sets the bed temperature (`M140`, `M190`).
+    bed: bool,
+    /// Sets some tool temperature (`M104`, `M109`, `M116`, `M568`, `G10 P.. S..`,
+    /// `SET_HEATER_TEMPERATURE`).
+    any_tool: bool,
+    /// Tools whose temperature it sets (`T`/`P` word, tool 0 without one).
+    heats: Vec<usize>,
+    /// Tools it waits for (`M109`, `M116`).
+    waited: Vec<usize>,
+}
+
+fn scan_start_gcode(lines: &[String]) -> StartScan {
+    let mut scan = StartScan::default();
+    let text = lines.join("\n");
+    let Ok(g) = conduit_gcode::parse(text.as_bytes()) else {
+        return scan;
+    };
+    for l in &g.lines {
+        let index = |letter| l.get(letter).map_or(0, |v| v.max(0.0) as usize);
+        if l.is_command(b'M', 140) || l.is_command(b'M', 190) {
+            scan.bed = true;
+        }
+        if l.is_command(b'M', 104) || l.is_command(b'M', 109) {
+            scan.any_tool = true;
+            scan.heats.push(index(b'T'));
+        }
+        if l.is_command(b'M', 568) || (l.is_command(b'G', 10) && l.get(b'S').is_some()) {
+            scan.any_tool = true;
+            scan.heats.push(index(b'P'));
+        }
+        if l.is_command(b'M', 109) {
+            scan.waited.push(index(b'T'));
+        }
+        if l.is_command(b'M', 116) {
+            scan.any_tool = true;
+            scan.waited.push(index(b'P'));
+        }
+        if l.extended_command()
+            .is_some_and(|c| c.eq_ignore_ascii_case("SET_HEATER_TEMPERATURE"))
+        {
+            scan.any_tool = true;
+        }
+    }
+    scan
+}
