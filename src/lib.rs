@@ -15,12 +15,12 @@
 //!
 //! The `conduit` binary (`src/main.rs`, `src/cli/`) turns command lines into calls of these modules.
 
+pub mod check;
+pub mod config;
+pub mod emit;
 pub mod geom;
 pub mod mesh;
 pub mod program;
 pub mod region;
 pub mod scene;
 pub mod slice;
-pub mod config;
-pub mod emit;
-pub mod check;

@@ -1,7 +1,7 @@
 //! The indexed mesh type: shared vertices plus triangles of vertex indices.
 
+use super::edges::FastMap;
 use crate::geom::{BoundingBox, Point3, Transform};
-use std::collections::HashMap;
 
 /// An indexed triangle mesh in millimetres.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -27,7 +27,9 @@ impl Mesh {
             ..Mesh::default()
         };
         mesh.triangles.reserve(iter.size_hint().0);
-        let mut index: HashMap<[u64; 3], u32> = HashMap::with_capacity(iter.size_hint().0 / 2 + 1);
+        // Vertex ids come from first appearance, so the hash order never reaches the result.
+        let mut index: FastMap<[u64; 3], u32> =
+            FastMap::with_capacity_and_hasher(iter.size_hint().0 / 2 + 1, Default::default());
         for tri in iter {
             let mut t = [0u32; 3];
             for (slot, p) in t.iter_mut().zip(tri.iter()) {
