@@ -1,7 +1,7 @@
 //! conduit turns 3D models and circuit designs into machine programs for printed electronics and
 //! non-planar printing.
 //!
-//! The pipeline runs one way (see `design.md` in the project notes):
+//! The pipeline runs one way:
 //!
 //! ```text
 //! files ──read──► Scene (meshes, transforms) ──slice──► Layers ──► Program ──emit──► G-code, reports
@@ -12,6 +12,13 @@
 //! - [`mesh`]: the indexed triangle mesh with validation and repair.
 //! - [`scene`]: reading every supported file into a [`scene::Scene`] (or a circuit, a point cloud,
 //!   a G-code listing) and writing meshes back out.
+//! - [`config`]: the one TOML configuration (printer, tools, slicing), PrusaSlicer `.ini` import.
+//! - [`slice`]: meshes cut into layers of polygons with holes.
+//! - [`region`]: perimeters, top/bottom skins, infill patterns and skirt per layer.
+//! - [`program`]: toolpaths and events in print order — what every writer consumes.
+//! - [`emit`]: G-code (Marlin, RepRapFirmware, Klipper) from a program.
+//! - [`check`]: replaying any G-code to find problems and measure it.
+//! - [`pipeline`]: the stages above as one walk, scene to G-code.
 //!
 //! The `conduit` binary (`src/main.rs`, `src/cli/`) turns command lines into calls of these modules.
 
@@ -20,6 +27,7 @@ pub mod config;
 pub mod emit;
 pub mod geom;
 pub mod mesh;
+pub mod pipeline;
 pub mod program;
 pub mod region;
 pub mod scene;

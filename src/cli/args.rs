@@ -20,6 +20,67 @@ pub enum Command {
     Info(InfoArgs),
     /// Convert meshes between STL, 3MF and OBJ (reads STL, 3MF, OBJ, OFF, PLY), in parallel.
     Convert(ConvertArgs),
+    /// Slice models into G-code (planar layers; one object per tool as the config assigns).
+    Slice(SliceArgs),
+    /// Replay a G-code file and report problems, layers, filament and time.
+    Check(CheckArgs),
+    /// Print or check configuration files.
+    Config(ConfigArgs),
+}
+
+/// Where settings come from: a config file plus `--set` overrides.
+#[derive(Debug, Args)]
+pub struct ConfigSource {
+    /// Config file: conduit TOML (`conduit config --defaults` prints every key) or a PrusaSlicer
+    /// `.ini` profile.
+    #[arg(short = 'c', long = "config", value_name = "CONFIG")]
+    pub config: Option<PathBuf>,
+    /// Override one setting, e.g. `--set slice.layer_height=0.3` or `--set tools.1.temperature=25`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+}
+
+/// Arguments of `conduit slice`.
+#[derive(Debug, Args)]
+pub struct SliceArgs {
+    /// Models to slice (STL, 3MF, OBJ, OFF, PLY); objects keep their order for tool assignment.
+    #[arg(required = true, value_name = "MODEL")]
+    pub models: Vec<PathBuf>,
+    /// Settings.
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// The G-code file to write.
+    #[arg(short, long, value_name = "OUT.gcode")]
+    pub output: PathBuf,
+    /// Also write a JSON report (objects, layers, filament, time, stage timings).
+    #[arg(long, value_name = "REPORT.json")]
+    pub report: Option<PathBuf>,
+}
+
+/// Arguments of `conduit check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// G-code file to replay.
+    #[arg(value_name = "FILE.gcode")]
+    pub file: PathBuf,
+    /// Printer settings for the bed volume and filament diameters (default: conduit's defaults).
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `conduit config`.
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("what").required(true).args(["defaults", "check"])))]
+pub struct ConfigArgs {
+    /// Print the default configuration as commented TOML.
+    #[arg(long)]
+    pub defaults: bool,
+    /// Load a config file (TOML or PrusaSlicer .ini), report problems, print the result as TOML.
+    #[arg(long, value_name = "CONFIG")]
+    pub check: Option<PathBuf>,
 }
 
 /// Arguments of `conduit info`.

@@ -2,9 +2,12 @@
 //! (`args`), then each command runs (`info`, `convert`). Errors are printed with their cause chain.
 
 mod args;
+mod check;
+mod config;
 mod convert;
 mod info;
 mod progress;
+mod slice;
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -44,6 +47,9 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         args::Command::Info(a) => info::run(a),
         args::Command::Convert(a) => convert::run(a),
+        args::Command::Slice(a) => slice::run(a),
+        args::Command::Check(a) => check::run(a),
+        args::Command::Config(a) => config::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -294,7 +294,7 @@ G28 ; home all axes
 M190 S{first_layer_bed_temperature} ; wait for the bed
 M109 T0 S{first_layer_temperature[0]} ; wait for tool 0
 G92 E0
-G1 Z0.3 F720
+G1 Z{first_layer_height} F720
 G1 X5 Y5 F6000
 G1 X60 Y5 E9 F1000 ; prime line
 G92 E0

@@ -1,0 +1,201 @@
+//! The planar pipeline as one walk: Scene → placed on the bed → slice → regions → Program → G-code.
+//!
+//! [`Stage`] names the steps in order (for progress reporting); [`slice_scene`] runs them and
+//! returns the G-code bytes with a [`SliceSummary`] for the report.
+
+use crate::config::Config;
+use crate::emit::gcode::{GcodeStats, write_gcode};
+use crate::geom::{BoundingBox, Transform};
+use crate::mesh::Mesh;
+use crate::program::{ObjectLayers, Program, ProgramParams, build_program};
+use crate::region::{RegionError, make_regions_with_heights};
+use crate::scene::{Scene, placed_meshes};
+use crate::slice::{SliceParams, SliceReport, slice_mesh};
+use serde::Serialize;
+use std::time::Instant;
+
+/// The pipeline's steps, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stage {
+    /// Objects placed on the bed.
+    Place,
+    /// Meshes cut into layers of regions with holes.
+    Slice,
+    /// Perimeters, skins, infill and skirt per layer.
+    Regions,
+    /// Toolpaths and events ordered into a Program.
+    Program,
+    /// The Program written as G-code.
+    Emit,
+}
+
+impl Stage {
+    /// Every stage in order.
+    pub const ALL: [Stage; 5] = [Stage::Place, Stage::Slice, Stage::Regions, Stage::Program, Stage::Emit];
+
+    /// A short human name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Place => "placing",
+            Stage::Slice => "slicing",
+            Stage::Regions => "regions",
+            Stage::Program => "toolpaths",
+            Stage::Emit => "writing G-code",
+        }
+    }
+}
+
+/// Why the pipeline failed.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// The scene has no triangles.
+    #[error("the scene has no triangles to slice")]
+    EmptyScene,
+    /// An object does not fit the printer.
+    #[error("object '{object}' is {size:.1} mm along {axis}, larger than the printer's {limit:.1} mm")]
+    TooLarge {
+        /// The object's name.
+        object: String,
+        /// "x", "y" or "z".
+        axis: &'static str,
+        /// The object's extent in mm.
+        size: f64,
+        /// The printer's extent in mm.
+        limit: f64,
+    },
+    /// An object is assigned a tool the config does not define.
+    #[error("object '{object}' is assigned tool {tool}, but the config defines {tools} tool(s)")]
+    UnknownTool {
+        /// The object's name.
+        object: String,
+        /// The tool index.
+        tool: usize,
+        /// How many tools the config has.
+        tools: usize,
+    },
+    /// Slice parameters are unusable.
+    #[error("{0}")]
+    SliceParams(#[from] crate::slice::SliceParamsError),
+    /// Region parameters are unusable.
+    #[error("{0}")]
+    Regions(#[from] RegionError),
+    /// Writing G-code failed.
+    #[error("{0}")]
+    Emit(#[from] crate::emit::gcode::EmitError),
+}
+
+/// What slicing one object found.
+#[derive(Debug, Clone, Serialize)]
+pub struct ObjectSummary {
+    /// The object's name.
+    pub name: String,
+    /// The tool printing it.
+    pub tool: usize,
+    /// Where it ended up on the bed.
+    pub bbox: Option<BoundingBox>,
+    /// Slicer findings (open chains closed or dropped).
+    pub slice: SliceReport,
+}
+
+/// What a pipeline run produced, for the JSON report.
+#[derive(Debug, Clone, Serialize)]
+pub struct SliceSummary {
+    /// Per object.
+    pub objects: Vec<ObjectSummary>,
+    /// Layers in the program.
+    pub layers: usize,
+    /// Filament, time and per-tool figures from the writer.
+    pub gcode: GcodeStats,
+    /// Wall time per stage in seconds, in stage order.
+    pub stage_seconds: Vec<(Stage, f64)>,
+}
+
+/// Places every object of the scene on the bed: the scene's combined footprint is centred on the
+/// bed (objects keep their positions relative to each other, as a 3MF build arranges them) and each
+/// object is dropped so its lowest point touches the bed.
+pub fn place_on_bed(scene: &Scene, cfg: &Config) -> Vec<Mesh> {
+    let mut meshes = placed_meshes(scene);
+    let Some(all) = meshes.iter().filter_map(Mesh::bounding_box).reduce(|a, b| a.union(&b)) else {
+        return meshes;
+    };
+    let p = &cfg.printer;
+    let dx = p.bed_origin[0] + p.bed_size[0] / 2.0 - (all.min[0] + all.max[0]) / 2.0;
+    let dy = p.bed_origin[1] + p.bed_size[1] / 2.0 - (all.min[1] + all.max[1]) / 2.0;
+    for m in &mut meshes {
+        if let Some(bb) = m.bounding_box() {
+            m.transform(&Transform::translation(dx, dy, -bb.min[2]));
+        }
+    }
+    meshes
+}
+
+/// Runs the whole planar pipeline on a scene; `progress` is told when each stage starts.
+pub fn slice_scene(
+    scene: &Scene,
+    cfg: &Config,
+    mut progress: impl FnMut(Stage),
+) -> Result<(Vec<u8>, Program, SliceSummary), PipelineError> {
+    if scene.triangle_count() == 0 {
+        return Err(PipelineError::EmptyScene);
+    }
+    let mut times = Vec::new();
+    let mut clock = Instant::now();
+    let mut lap = |stage: Stage, times: &mut Vec<(Stage, f64)>| {
+        times.push((stage, clock.elapsed().as_secs_f64()));
+        clock = Instant::now();
+    };
+
+    progress(Stage::Place);
+    let meshes = place_on_bed(scene, cfg);
+    check_fits(&meshes, cfg)?;
+    lap(Stage::Place, &mut times);
+
+    progress(Stage::Slice);
+    let params = SliceParams::new(cfg.slice.region.layer_height, cfg.slice.first_layer_height)?;
+    let sliced: Vec<_> = meshes.iter().map(|m| slice_mesh(m, &params)).collect();
+    lap(Stage::Slice, &mut times);
+
+    progress(Stage::Regions);
+    let mut objects = Vec::with_capacity(sliced.len());
+    let mut summaries = Vec::with_capacity(sliced.len());
+    for (i, ((layers, report), mesh)) in sliced.into_iter().zip(&meshes).enumerate() {
+        let tool = cfg.tool_for_object(i);
+        if tool >= cfg.tools.len() {
+            return Err(PipelineError::UnknownTool { object: mesh.name.clone(), tool, tools: cfg.tools.len() });
+        }
+        let islands: Vec<_> = layers.iter().map(|l| l.islands.clone()).collect();
+        let heights: Vec<f64> = layers.iter().map(|l| l.z.height()).collect();
+        let regions = make_regions_with_heights(&islands, &heights, &cfg.slice.region)?;
+        objects.push(ObjectLayers { tool, layers: layers.into_iter().map(|l| l.z).zip(regions).collect() });
+        summaries.push(ObjectSummary { name: mesh.name.clone(), tool, bbox: mesh.bounding_box(), slice: report });
+    }
+    lap(Stage::Regions, &mut times);
+
+    progress(Stage::Program);
+    let program = build_program(&objects, &ProgramParams::from_config(cfg));
+    lap(Stage::Program, &mut times);
+
+    progress(Stage::Emit);
+    let mut gcode = Vec::new();
+    let stats = write_gcode(&program, cfg, &mut gcode)?;
+    lap(Stage::Emit, &mut times);
+
+    let summary = SliceSummary { objects: summaries, layers: program.layers.len(), gcode: stats, stage_seconds: times };
+    Ok((gcode, program, summary))
+}
+
+fn check_fits(meshes: &[Mesh], cfg: &Config) -> Result<(), PipelineError> {
+    let p = &cfg.printer;
+    let limits = [("x", p.bed_size[0]), ("y", p.bed_size[1]), ("z", p.max_height)];
+    for m in meshes {
+        let Some(bb) = m.bounding_box() else { continue };
+        let size = bb.size();
+        for (k, (axis, limit)) in limits.iter().enumerate() {
+            if size[k] > *limit {
+                return Err(PipelineError::TooLarge { object: m.name.clone(), axis, size: size[k], limit: *limit });
+            }
+        }
+    }
+    Ok(())
+}
