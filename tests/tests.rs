@@ -5,5 +5,7 @@
 
 mod cli;
 mod conformance;
+mod preview;
 mod roundtrip;
+mod slice;
 mod support;

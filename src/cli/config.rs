@@ -13,7 +13,7 @@ pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
         None => (Config::default(), Vec::new()),
     };
     for kv in &src.set {
-        cfg.apply_set(kv).map_err(|e| Failure::Usage(format!("--set {kv}: {e}")))?;
+        cfg.apply_set(kv).map_err(|e| Failure::Usage(e.to_string()))?;
     }
     warnings.extend(cfg.validate().context("invalid configuration")?);
     for w in warnings {
