@@ -38,7 +38,9 @@ const DEVIATIONS: &[(&str, &str, &str)] = &[
     ),
 ];
 
-fn deviation(path: &std::path::Path) -> Option<&'static (&'static str, &'static str, &'static str)> {
+fn deviation(
+    path: &std::path::Path,
+) -> Option<&'static (&'static str, &'static str, &'static str)> {
     let name = path.file_name()?.to_str()?;
     DEVIATIONS.iter().find(|d| d.0 == name)
 }
