@@ -1,13 +1,15 @@
-//! The replay: machine state stepped line by line (see the module docs of [`super`]).
+//! The checker: heaters, time, statistics and findings on top of the motion [`Replay`] (see the
+//! module docs of [`super`]).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::f64::consts::PI;
 
 use conduit_gcode::{Gcode, Line};
 
+use super::replay::{Move, Position, Replay};
 use super::time::Planner;
 use super::{Bounds3, CheckParams, CheckReport, Finding, FindingKind, Severity, Stats, ToolUsage};
-use crate::config::{Flavor, ToolKind};
+use crate::config::ToolKind;
 
 /// Heater state of one tool.
 #[derive(Debug, Clone, Default)]
@@ -33,16 +35,9 @@ struct Usage {
 
 struct Machine<'a> {
     p: &'a CheckParams,
-    pos: [Option<f64>; 3],
-    e: f64,
-    coord_relative: bool,
-    e_relative_flag: bool,
-    scale: f64,
-    feed: f64,
-    tool: usize,
+    replay: Replay,
     heaters: Vec<Heater>,
     macro_seen: Option<String>,
-    last_motion: Option<u8>,
     planner: Planner,
     dwell: f64,
     z_levels: BTreeSet<i64>,
@@ -74,16 +69,9 @@ const NON_HEATING_MACROS: &[&str] = &[
 pub(super) fn replay(g: &Gcode, p: &CheckParams) -> CheckReport {
     let mut m = Machine {
         p,
-        pos: [None; 3],
-        e: 0.0,
-        coord_relative: false,
-        e_relative_flag: false,
-        scale: 1.0,
-        feed: p.default_feedrate,
-        tool: 0,
+        replay: Replay::new(p.flavor, p.default_feedrate),
         heaters: Vec::new(),
         macro_seen: None,
-        last_motion: None,
         planner: Planner::new(p.max_acceleration, p.jerk),
         dwell: 0.0,
         z_levels: BTreeSet::new(),
@@ -105,13 +93,6 @@ impl Machine<'_> {
     /// Estimated print time so far, s.
     fn now(&self) -> f64 {
         self.planner.total + self.dwell
-    }
-
-    fn e_relative(&self) -> bool {
-        match self.p.flavor {
-            Flavor::Klipper => self.coord_relative || self.e_relative_flag,
-            Flavor::Marlin | Flavor::RepRapFirmware => self.e_relative_flag,
-        }
     }
 
     fn heater(&mut self, tool: usize) -> &mut Heater {
@@ -139,18 +120,16 @@ impl Machine<'_> {
     }
 
     fn step(&mut self, line: &Line) {
+        // The replay applies motion and the modal state (units, modes, G92, homing, tool);
+        // the checker adds heaters, time and statistics.
+        let tool_before = self.replay.tool();
+        if let Some(mv) = self.replay.step(line) {
+            self.motion(&mv);
+            return;
+        }
         let Some((letter, number)) = line.command() else {
             if let Some(name) = line.extended_command() {
                 self.extended(line, name);
-            } else if line
-                .words
-                .iter()
-                .any(|w| matches!(w.letter, b'X' | b'Y' | b'Z' | b'E'))
-            {
-                // Bare coordinates continue the last motion command (CNC modal style).
-                if let Some(n) = self.last_motion {
-                    self.motion(line, n);
-                }
             }
             return;
         };
@@ -158,11 +137,8 @@ impl Machine<'_> {
             return;
         }
         let n = number as i64;
+        let current = self.replay.tool();
         match (letter, n) {
-            (b'G', 0..=3) => {
-                self.last_motion = Some(n as u8);
-                self.motion(line, n as u8);
-            }
             (b'G', 4) => {
                 let ms = line.get(b'P').unwrap_or(0.0) + line.get(b'S').unwrap_or(0.0) * 1000.0;
                 self.planner.flush();
@@ -172,7 +148,7 @@ impl Machine<'_> {
                 if line.get(b'P').is_some() || line.get(b'S').is_some() || line.get(b'R').is_some()
                 {
                     // RepRapFirmware: G10 P<tool> S<active> R<standby> sets temperatures.
-                    let tool = line.get(b'P').map_or(self.tool, |t| t.max(0.0) as usize);
+                    let tool = line.get(b'P').map_or(current, |t| t.max(0.0) as usize);
                     if let Some(s) = line.get(b'S') {
                         self.set_target(tool, s, line.number, false);
                     }
@@ -180,51 +156,9 @@ impl Machine<'_> {
                     self.stats.retractions += 1;
                 }
             }
-            (b'G', 11) => {}
-            (b'G', 20) => self.scale = 25.4,
-            (b'G', 21) => self.scale = 1.0,
-            (b'G', 28) => {
-                self.planner.flush();
-                let named: Vec<usize> = [b'X', b'Y', b'Z']
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, l)| line.words.iter().any(|w| w.letter == **l))
-                    .map(|(i, _)| i)
-                    .collect();
-                if named.is_empty() {
-                    self.pos = [Some(0.0); 3];
-                } else {
-                    for i in named {
-                        self.pos[i] = Some(0.0);
-                    }
-                }
-            }
-            (b'G', 90) => {
-                self.coord_relative = false;
-                if self.p.flavor == Flavor::Marlin {
-                    self.e_relative_flag = false;
-                }
-            }
-            (b'G', 91) => {
-                self.coord_relative = true;
-                if self.p.flavor == Flavor::Marlin {
-                    self.e_relative_flag = true;
-                }
-            }
-            (b'G', 92) => {
-                for (i, l) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
-                    if let Some(v) = line.get(l) {
-                        self.pos[i] = Some(v * self.scale);
-                    }
-                }
-                if let Some(v) = line.get(b'E') {
-                    self.e = v * self.scale;
-                }
-            }
-            (b'M', 82) => self.e_relative_flag = false,
-            (b'M', 83) => self.e_relative_flag = true,
+            (b'G', 28) => self.planner.flush(),
             (b'M', 104 | 109) => {
-                let tool = line.get(b'T').map_or(self.tool, |t| t.max(0.0) as usize);
+                let tool = line.get(b'T').map_or(current, |t| t.max(0.0) as usize);
                 let wait = n == 109;
                 if wait {
                     self.planner.flush();
@@ -240,7 +174,7 @@ impl Machine<'_> {
             }
             (b'M', 568) => {
                 // RepRapFirmware 3.3+: M568 P<tool> S<active> R<standby>.
-                let tool = line.get(b'P').map_or(self.tool, |t| t.max(0.0) as usize);
+                let tool = line.get(b'P').map_or(current, |t| t.max(0.0) as usize);
                 if let Some(s) = line.get(b'S') {
                     self.set_target(tool, s, line.number, false);
                 }
@@ -264,12 +198,10 @@ impl Machine<'_> {
                 }
             }
             (b'T', t) if t >= 0 => {
-                let t = t as usize;
                 self.planner.flush();
-                if t != self.tool {
+                if t as usize != tool_before {
                     self.stats.tool_changes += 1;
                 }
-                self.tool = t;
             }
             _ => {}
         }
@@ -330,58 +262,23 @@ impl Machine<'_> {
         }
     }
 
-    fn motion(&mut self, line: &Line, g: u8) {
+    fn motion(&mut self, mv: &Move) {
         self.stats.moves += 1;
-        let scale = self.scale;
-        if let Some(f) = line.get(b'F') {
-            if f > 0.0 {
-                self.feed = f * scale / 60.0;
-            }
-        }
-        let start = self.pos;
-        let mut end = start;
-        for (i, l) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
-            if let Some(v) = line.get(l) {
-                let v = v * scale;
-                end[i] = if self.coord_relative {
-                    start[i].map(|s| s + v)
-                } else {
-                    Some(v)
-                };
-            }
-        }
-        let de = match line.get(b'E') {
-            Some(v) if self.e_relative() => {
-                self.e += v * scale;
-                v * scale
-            }
-            Some(v) => {
-                let d = v * scale - self.e;
-                self.e = v * scale;
-                d
-            }
-            None => 0.0,
-        };
-        let has_xy = line.get(b'X').is_some() || line.get(b'Y').is_some();
-        // Path: a polyline (two points for a line, samples for an arc) and its length.
-        let mut path: Vec<[Option<f64>; 3]> = vec![start, end];
-        let mut length = None;
-        if g == 2 || g == 3 {
+        if mv.arc {
             self.stats.arcs += 1;
-            match self.arc(line, g == 2, start, end) {
-                Ok(Some((len, samples))) => {
-                    length = Some(len);
-                    path = samples;
-                }
-                Ok(None) => {}
-                Err(msg) => self.report(Severity::Error, FindingKind::InvalidArc, line.number, msg),
-            }
         }
-        let length = length.or_else(|| distance(start, end)).unwrap_or(0.0);
-        self.pos = end;
+        if let Some(msg) = &mv.arc_error {
+            self.report(
+                Severity::Error,
+                FindingKind::InvalidArc,
+                mv.line,
+                msg.clone(),
+            );
+        }
+        let (length, de, has_xy, path) = (mv.length, mv.e, mv.has_xy, &mv.path);
 
         // Time.
-        let v = self.feed.min(self.p.max_feedrate);
+        let v = mv.feed.min(self.p.max_feedrate);
         if length > 0.0 {
             let dir_in = direction(path.first(), path.get(1));
             let dir_out = direction(path.iter().rev().nth(1), path.last());
@@ -391,21 +288,21 @@ impl Machine<'_> {
         }
 
         let extruding = has_xy && de > 0.0;
-        let usage = self.usage.entry(self.tool).or_default();
+        let usage = self.usage.entry(mv.tool).or_default();
         usage.e_net_mm += de;
         if extruding {
             usage.filament_mm += de;
             usage.extrusion_moves += 1;
             self.stats.extrusion_moves += 1;
             self.stats.print_distance_mm += length;
-            if let Some(z) = end[2] {
+            if let Some(z) = mv.to[2] {
                 self.z_levels.insert((z * 1000.0).round() as i64);
             }
-            for q in &path {
+            for q in path {
                 self.grow_bounds(*q);
             }
-            self.check_temperature(line.number);
-            self.check_flow(line.number, de, length);
+            self.check_temperature(mv.line);
+            self.check_flow(mv.line, de, length);
         } else if has_xy {
             self.stats.travel_moves += 1;
             self.stats.travel_distance_mm += length;
@@ -417,7 +314,7 @@ impl Machine<'_> {
                 self.report(
                     Severity::Error,
                     FindingKind::LostExtrusionReset,
-                    line.number,
+                    mv.line,
                     format!(
                         "E drops by {drop:.3} mm in one move: a missing `G92 E0` or the wrong \
                          M82/M83 extrusion mode?"
@@ -427,7 +324,7 @@ impl Machine<'_> {
                 self.report(
                     Severity::Warning,
                     FindingKind::RetractionWhileMoving,
-                    line.number,
+                    mv.line,
                     format!(
                         "retraction of {drop:.3} mm during a {length:.3} mm move (more than \
                          {} mm)",
@@ -436,88 +333,10 @@ impl Machine<'_> {
                 );
             }
         }
-        self.check_bounds(line.number, &path, extruding);
+        self.check_bounds(mv.line, path, extruding);
     }
 
-    /// Length and sampled points of an arc, `Ok(None)` when a position is unknown.
-    #[allow(clippy::type_complexity)]
-    fn arc(
-        &self,
-        line: &Line,
-        clockwise: bool,
-        start: [Option<f64>; 3],
-        end: [Option<f64>; 3],
-    ) -> Result<Option<(f64, Vec<[Option<f64>; 3]>)>, String> {
-        let (Some(x0), Some(y0), Some(x1), Some(y1)) = (start[0], start[1], end[0], end[1]) else {
-            return Ok(None);
-        };
-        let s = self.scale;
-        let (cx, cy, r, sweep);
-        if let Some(rr) = line.get(b'R') {
-            let rr = rr * s;
-            let (dx, dy) = (x1 - x0, y1 - y0);
-            let chord = dx.hypot(dy);
-            if chord == 0.0 || rr.abs() < chord / 2.0 - 1e-9 {
-                return Err(format!(
-                    "arc radius R{} is shorter than half the chord ({chord:.4} mm)",
-                    rr / s
-                ));
-            }
-            r = rr.abs();
-            let h = (r * r - chord * chord / 4.0).max(0.0).sqrt();
-            // Centre to the left of the chord for a CCW short arc, right for CW; R<0 flips.
-            let left = (!clockwise) ^ (rr < 0.0);
-            let (mx, my) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-            let (nx, ny) = (-dy / chord, dx / chord);
-            let sign = if left { 1.0 } else { -1.0 };
-            cx = mx + sign * h * nx;
-            cy = my + sign * h * ny;
-            let short = 2.0 * (chord / (2.0 * r)).min(1.0).asin();
-            sweep = if rr < 0.0 { 2.0 * PI - short } else { short };
-        } else {
-            let (i, j) = (line.get(b'I'), line.get(b'J'));
-            if i.is_none() && j.is_none() {
-                return Err("arc without I/J centre or R radius".to_owned());
-            }
-            cx = x0 + i.unwrap_or(0.0) * s;
-            cy = y0 + j.unwrap_or(0.0) * s;
-            r = (x0 - cx).hypot(y0 - cy);
-            let a0 = (y0 - cy).atan2(x0 - cx);
-            let a1 = (y1 - cy).atan2(x1 - cx);
-            let mut d = if clockwise { a0 - a1 } else { a1 - a0 };
-            d = d.rem_euclid(2.0 * PI);
-            // Same start and end: a full circle.
-            if d < 1e-9 {
-                d = 2.0 * PI;
-            }
-            sweep = d;
-        }
-        let planar = r * sweep;
-        let dz = match (start[2], end[2]) {
-            (Some(a), Some(b)) => b - a,
-            _ => 0.0,
-        };
-        let length = planar.hypot(dz);
-        let a0 = (y0 - cy).atan2(x0 - cx);
-        let steps = ((sweep / (PI / 18.0)).ceil() as usize).max(1);
-        let dir = if clockwise { -1.0 } else { 1.0 };
-        let mut samples = Vec::with_capacity(steps + 1);
-        for k in 0..=steps {
-            let t = k as f64 / steps as f64;
-            let a = a0 + dir * sweep * t;
-            let z = match (start[2], end[2]) {
-                (Some(za), Some(zb)) => Some(za + (zb - za) * t),
-                _ => end[2],
-            };
-            samples.push([Some(cx + r * a.cos()), Some(cy + r * a.sin()), z]);
-        }
-        if let Some(last) = samples.last_mut() {
-            *last = end;
-        }
-        Ok(Some((length, samples)))
-    }
-
-    fn grow_bounds(&mut self, q: [Option<f64>; 3]) {
+    fn grow_bounds(&mut self, q: Position) {
         let [Some(x), Some(y), Some(z)] = q else {
             return;
         };
@@ -532,7 +351,7 @@ impl Machine<'_> {
     }
 
     fn check_temperature(&mut self, line: usize) {
-        let tool = self.tool;
+        let tool = self.replay.tool();
         let tc = self.p.tool(tool);
         if tc.kind != ToolKind::Filament {
             return;
@@ -607,7 +426,7 @@ impl Machine<'_> {
     }
 
     fn check_flow(&mut self, line: usize, de: f64, length: f64) {
-        let tc = self.p.tool(self.tool);
+        let tc = self.p.tool(self.replay.tool());
         if tc.kind != ToolKind::Filament || length < self.p.flow_check_min_length {
             return;
         }
@@ -629,7 +448,7 @@ impl Machine<'_> {
         }
     }
 
-    fn check_bounds(&mut self, line: usize, path: &[[Option<f64>; 3]], extruding: bool) {
+    fn check_bounds(&mut self, line: usize, path: &[Position], extruding: bool) {
         let p = self.p;
         let m = p.bed_margin;
         let mut outside = None;
@@ -727,21 +546,8 @@ impl Machine<'_> {
     }
 }
 
-fn distance(a: [Option<f64>; 3], b: [Option<f64>; 3]) -> Option<f64> {
-    let mut sum = 0.0;
-    for i in 0..3 {
-        match (a[i], b[i]) {
-            (Some(p), Some(q)) => sum += (q - p) * (q - p),
-            (None, None) => {}
-            // Moving from or to an unknown position: the length is unknown.
-            _ => return None,
-        }
-    }
-    Some(sum.sqrt())
-}
-
 /// Unit vector from `a` to `b`, zero when either is unknown or they coincide.
-fn direction(a: Option<&[Option<f64>; 3]>, b: Option<&[Option<f64>; 3]>) -> [f64; 3] {
+fn direction(a: Option<&Position>, b: Option<&Position>) -> [f64; 3] {
     let (Some(a), Some(b)) = (a, b) else {
         return [0.0; 3];
     };

@@ -49,9 +49,18 @@
 //! changes. Dwells count; heating waits do not (their length is unknown). With `jerk = 0` every
 //! move starts and ends at standstill: `L/v + v/a`, or `2·√(L/a)` for moves too short to reach
 //! `v`.
+//!
+//! # Moves
+//!
+//! The motion replay is shared: [`moves`] returns every move of a file (ends, path, E change,
+//! tool, feature role, width, layer, line) for other consumers such as
+//! [`emit::preview`](crate::emit::preview), and the checker steps the same [`Replay`].
 
 mod machine;
+mod replay;
 mod time;
+
+pub use replay::{Move, Moves, Position, Replay, moves};
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -26,6 +26,8 @@ pub enum Command {
     Check(CheckArgs),
     /// Print or check configuration files.
     Config(ConfigArgs),
+    /// Draw a G-code file (conduit's or another slicer's): one SVG per layer and a PNG contact sheet.
+    Preview(PreviewArgs),
 }
 
 /// Where settings come from: a config file plus `--set` overrides.
@@ -69,6 +71,23 @@ pub struct CheckArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Arguments of `conduit preview`.
+#[derive(Debug, Args)]
+pub struct PreviewArgs {
+    /// G-code file to draw.
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    /// Folder for `layer_0001.svg`... and `contact_sheet.png` (created if missing).
+    #[arg(short, long = "out-dir", value_name = "DIR")]
+    pub out_dir: PathBuf,
+    /// Contact sheet: every Nth layer (default: the smallest N giving at most 36 tiles).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub every: Option<u32>,
+    /// Contact sheet tile size, pixels.
+    #[arg(long, value_name = "PX", default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=4096))]
+    pub tile: u32,
 }
 
 /// Arguments of `conduit config`.

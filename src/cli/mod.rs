@@ -6,6 +6,7 @@ mod check;
 mod config;
 mod convert;
 mod info;
+mod preview;
 mod progress;
 mod slice;
 
@@ -50,6 +51,7 @@ pub fn run() -> ExitCode {
         args::Command::Slice(a) => slice::run(a),
         args::Command::Check(a) => check::run(a),
         args::Command::Config(a) => config::run(a),
+        args::Command::Preview(a) => preview::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -9,3 +9,4 @@
 //! [`Program`]: crate::program::Program
 
 pub mod gcode;
+pub mod preview;

@@ -1,0 +1,574 @@
+//! Previews of a G-code file: one SVG per printed layer and a PNG contact sheet.
+//!
+//! Place in the pipeline: the end of the line, beside `check`. It reads the [`Moves`] that
+//! [`check::moves`](crate::check::moves) replays from any G-code (conduit's own or another
+//! slicer's) and never reaches back into the pipeline.
+//!
+//! - [`Preview::from_moves`] groups the moves of each layer into polylines: extrusions by
+//!   feature role (the latest `;TYPE:` / `; FEATURE:` comment), tool and width (the latest
+//!   `;WIDTH:` comment, else [`DEFAULT_WIDTH`]), and travels (XY moves that do not extrude).
+//! - [`svg`] draws one layer: the view box covers the extrusions of every layer so the files
+//!   line up, +Y is up, extrusions are stroked at their width in a colour per role (a darker or
+//!   lighter tint per tool), travels as [`TRAVEL_WIDTH`] grey lines, with a legend below.
+//! - [`png`] rasterises every Nth layer into a grid of square tiles with `tiny-skia`
+//!   (extrusions only; a bar under each tile shows how far up the print the layer is).
+//! - [`write()`] writes `layer_0001.svg`… and [`CONTACT_SHEET`] into a folder, each file
+//!   atomically.
+//!
+//! Output bytes depend only on the input: SVG numbers have a fixed 3 decimals and the PNG
+//! encoder writes no timestamp.
+
+pub mod png;
+pub mod svg;
+
+use std::path::{Path, PathBuf};
+
+use crate::check::Moves;
+
+/// Stroke width of extrusions without a `;WIDTH:` comment, mm.
+pub const DEFAULT_WIDTH: f64 = 0.4;
+/// Stroke width of travels in the SVGs, mm.
+pub const TRAVEL_WIDTH: f64 = 0.05;
+/// Colour of travels, RGB.
+pub const TRAVEL_COLOUR: [u8; 3] = [0x99, 0x99, 0x99];
+/// Most tiles the default `every` gives the contact sheet.
+pub const MAX_DEFAULT_TILES: usize = 36;
+/// File name of the contact sheet.
+pub const CONTACT_SHEET: &str = "contact_sheet.png";
+/// Role name of extrusions before any role comment.
+pub const UNNAMED_ROLE: &str = "Extrusion";
+
+/// Options of [`write()`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PreviewParams {
+    /// Contact sheet: every Nth layer (layers 1, 1 + N, 1 + 2N…). `None`: the smallest N that
+    /// keeps the sheet at [`MAX_DEFAULT_TILES`] tiles or fewer.
+    pub every: Option<usize>,
+    /// Contact sheet tile size, pixels (tiles are square). Default 256.
+    pub tile_px: u32,
+}
+
+impl Default for PreviewParams {
+    fn default() -> Self {
+        Self {
+            every: None,
+            tile_px: 256,
+        }
+    }
+}
+
+/// Why a preview could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum PreviewError {
+    /// Nothing extrudes, so there is no layer to draw.
+    ///
+    /// How to fix: check that the file is a print (E increases on moves with X or Y); a file
+    /// of travels only has no layers.
+    #[error("no extruding moves with known positions: nothing to preview")]
+    NoExtrusion,
+    /// `every` or `tile_px` is zero.
+    #[error("invalid preview option: {0}")]
+    InvalidParams(&'static str),
+    /// The contact sheet would be too large for one image.
+    #[error("contact sheet of {width}×{height} pixels is too large; use a smaller --tile")]
+    SheetTooLarge {
+        /// Pixels across.
+        width: u64,
+        /// Pixels down.
+        height: u64,
+    },
+    /// PNG encoding failed.
+    #[error("encoding the contact sheet as PNG")]
+    Png(#[source] Box<dyn std::error::Error + Send + Sync>),
+    /// A file or folder could not be written.
+    #[error("{}: cannot write", path.display())]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// What one polyline draws.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StrokeKind {
+    /// XY moves that do not extrude.
+    Travel,
+    /// Extruding moves.
+    Extrusion {
+        /// Index into [`Preview::roles`].
+        role: usize,
+        /// Tool number.
+        tool: usize,
+        /// Extrusion width, mm.
+        width: f64,
+    },
+}
+
+/// A run of consecutive moves of one kind: a polyline in mm.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stroke {
+    /// Travel or extrusion (role, tool, width).
+    pub kind: StrokeKind,
+    /// Points [X, Y], mm; at least two.
+    pub points: Vec<[f64; 2]>,
+}
+
+/// The strokes of one printed layer, in file order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayerStrokes {
+    /// Layer height, mm.
+    pub z: f64,
+    /// Polylines.
+    pub strokes: Vec<Stroke>,
+}
+
+/// Everything the SVG and PNG writers draw.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Preview {
+    /// One entry per printed layer (see [`Moves`] for how layers are numbered).
+    pub layers: Vec<LayerStrokes>,
+    /// Role names in order of first appearance ([`UNNAMED_ROLE`] for extrusions before any
+    /// role comment).
+    pub roles: Vec<String>,
+    /// (role, tool) pairs that extrude anywhere, sorted: the legend.
+    pub styles: Vec<(usize, usize)>,
+    /// Extent of the extrusions of all layers: [min X, min Y, max X, max Y], mm.
+    pub bounds: [f64; 4],
+}
+
+impl Preview {
+    /// Groups `moves` into per-layer polylines. Moves from or to an unknown XY position and
+    /// moves without X or Y (Z lifts, retractions) are not drawn.
+    pub fn from_moves(moves: &Moves) -> Result<Self, PreviewError> {
+        let mut layers: Vec<LayerStrokes> = moves
+            .layer_z
+            .iter()
+            .map(|&z| LayerStrokes {
+                z,
+                strokes: Vec::new(),
+            })
+            .collect();
+        let mut roles: Vec<String> = Vec::new();
+        let mut styles = Vec::new();
+        let mut bounds: Option<[f64; 4]> = None;
+        for m in &moves.moves {
+            if !m.has_xy {
+                continue;
+            }
+            let Some(points) = m
+                .path
+                .iter()
+                .map(|p| Some([p[0]?, p[1]?]))
+                .collect::<Option<Vec<[f64; 2]>>>()
+            else {
+                continue;
+            };
+            let Some(layer) = layers.get_mut(m.layer) else {
+                continue;
+            };
+            let kind = if m.extruding {
+                let name = m.role.as_deref().unwrap_or(UNNAMED_ROLE);
+                let role = match roles.iter().position(|r| r == name) {
+                    Some(i) => i,
+                    None => {
+                        roles.push(name.to_owned());
+                        roles.len() - 1
+                    }
+                };
+                if !styles.contains(&(role, m.tool)) {
+                    styles.push((role, m.tool));
+                }
+                for p in &points {
+                    let b = bounds.get_or_insert([p[0], p[1], p[0], p[1]]);
+                    *b = [
+                        b[0].min(p[0]),
+                        b[1].min(p[1]),
+                        b[2].max(p[0]),
+                        b[3].max(p[1]),
+                    ];
+                }
+                StrokeKind::Extrusion {
+                    role,
+                    tool: m.tool,
+                    width: m.width.unwrap_or(DEFAULT_WIDTH),
+                }
+            } else {
+                StrokeKind::Travel
+            };
+            match layer.strokes.last_mut() {
+                Some(s) if s.kind == kind && s.points.last() == points.first() => {
+                    s.points.extend_from_slice(&points[1..]);
+                }
+                _ => layer.strokes.push(Stroke { kind, points }),
+            }
+        }
+        let bounds = bounds.ok_or(PreviewError::NoExtrusion)?;
+        styles.sort_unstable();
+        Ok(Self {
+            layers,
+            roles,
+            styles,
+            bounds,
+        })
+    }
+
+    /// The colour of extrusions of `role` (an index into [`Preview::roles`]) by `tool`, RGB.
+    pub fn colour(&self, role: usize, tool: usize) -> [u8; 3] {
+        let name = self.roles.get(role).map_or(UNNAMED_ROLE, String::as_str);
+        tint(role_colour(name, role), tool)
+    }
+
+    /// The contact sheet's `every` for `params`: the given one, or the smallest that keeps the
+    /// sheet at [`MAX_DEFAULT_TILES`] tiles or fewer.
+    pub fn every(&self, params: &PreviewParams) -> usize {
+        params
+            .every
+            .unwrap_or_else(|| self.layers.len().div_ceil(MAX_DEFAULT_TILES))
+            .max(1)
+    }
+}
+
+/// The colour of a role, RGB: PrusaSlicer's preview colours for its roles and the matching
+/// Cura and OrcaSlicer names (a darker yellow for perimeters, to show on white), conduit's own
+/// roles, and a fixed palette by order of appearance for any other name.
+pub fn role_colour(name: &str, index: usize) -> [u8; 3] {
+    const PALETTE: [[u8; 3]; 8] = [
+        [0x1f, 0x77, 0xb4],
+        [0xd6, 0x27, 0x28],
+        [0x2c, 0xa0, 0x2c],
+        [0x94, 0x67, 0xbd],
+        [0x8c, 0x56, 0x4b],
+        [0xe3, 0x77, 0xc2],
+        [0x7f, 0x7f, 0x7f],
+        [0xbc, 0xbd, 0x22],
+    ];
+    match name.to_ascii_lowercase().as_str() {
+        "external perimeter" | "wall-outer" | "outer wall" => [0xff, 0x7d, 0x38],
+        "perimeter" | "wall-inner" | "inner wall" => [0xe6, 0xb8, 0x00],
+        "overhang perimeter" | "overhang wall" => [0x1f, 0x1f, 0xff],
+        "internal infill" | "fill" | "sparse infill" => [0xb0, 0x30, 0x29],
+        "solid infill" | "skin" | "internal solid infill" | "bottom surface" => [0x96, 0x54, 0xcc],
+        "top solid infill" | "top surface" => [0xf0, 0x40, 0x40],
+        "bridge infill" | "bridge" | "internal bridge" => [0x4d, 0x80, 0xba],
+        "gap fill" | "gap infill" => [0x3d, 0xb8, 0xb8],
+        "skirt/brim" | "skirt" | "brim" => [0x00, 0x87, 0x6e],
+        "support material" | "support" => [0x00, 0xc0, 0x00],
+        "support material interface" | "support-interface" | "support interface" => {
+            [0x00, 0x80, 0x00]
+        }
+        "wipe tower" | "prime-tower" | "prime tower" => [0xb3, 0xe3, 0xab],
+        "ironing" => [0xff, 0x8c, 0x69],
+        "custom" => [0x5e, 0xd1, 0x94],
+        "conductive trace" => [0x00, 0xa0, 0xe0],
+        "conductive drop" => [0x00, 0x50, 0xa0],
+        "scaffold" => [0xa0, 0xa0, 0xa0],
+        "buffer" => [0xc8, 0xa0, 0xc8],
+        _ => PALETTE[index % PALETTE.len()],
+    }
+}
+
+/// `rgb` tinted for `tool`: tool 0 as is, then darker, lighter, much darker, much lighter,
+/// repeating every five tools.
+pub fn tint(rgb: [u8; 3], tool: usize) -> [u8; 3] {
+    // Positive: mix towards white; negative: towards black.
+    let amount: f64 = match tool % 5 {
+        0 => 0.0,
+        1 => -0.35,
+        2 => 0.4,
+        3 => -0.6,
+        _ => 0.65,
+    };
+    rgb.map(|c| {
+        let c = f64::from(c);
+        let v = if amount >= 0.0 {
+            c + (255.0 - c) * amount
+        } else {
+            c * (1.0 + amount)
+        };
+        v.round().clamp(0.0, 255.0) as u8
+    })
+}
+
+/// File name of layer `index` (0-based): `layer_0001.svg` for index 0.
+pub fn layer_file_name(index: usize) -> String {
+    format!("layer_{:04}.svg", index + 1)
+}
+
+/// What [`write()`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PreviewFiles {
+    /// One SVG per layer, in layer order.
+    pub svgs: Vec<PathBuf>,
+    /// The contact sheet.
+    pub contact_sheet: PathBuf,
+    /// Every how many layers the contact sheet shows.
+    pub every: usize,
+    /// Tiles on the contact sheet.
+    pub tiles: usize,
+}
+
+/// Writes the preview of `moves` into `dir` (created if missing): one SVG per layer and
+/// [`CONTACT_SHEET`], each atomically.
+pub fn write(
+    moves: &Moves,
+    dir: &Path,
+    params: &PreviewParams,
+) -> Result<PreviewFiles, PreviewError> {
+    if params.every == Some(0) {
+        return Err(PreviewError::InvalidParams("every must be at least 1"));
+    }
+    if params.tile_px == 0 {
+        return Err(PreviewError::InvalidParams(
+            "tile size must be at least 1 pixel",
+        ));
+    }
+    let preview = Preview::from_moves(moves)?;
+    // Render the sheet first: a sheet that is too large fails before any file is written.
+    let every = preview.every(params);
+    let sheet = png::contact_sheet(&preview, every, params.tile_px)?;
+    std::fs::create_dir_all(dir).map_err(|source| PreviewError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut svgs = Vec::with_capacity(preview.layers.len());
+    for i in 0..preview.layers.len() {
+        let path = dir.join(layer_file_name(i));
+        write_file(&path, svg::layer(&preview, i).as_bytes())?;
+        svgs.push(path);
+    }
+    let contact_sheet = dir.join(CONTACT_SHEET);
+    write_file(&contact_sheet, &sheet)?;
+    Ok(PreviewFiles {
+        svgs,
+        contact_sheet,
+        every,
+        tiles: preview.layers.len().div_ceil(every),
+    })
+}
+
+fn write_file(path: &Path, bytes: &[u8]) -> Result<(), PreviewError> {
+    use std::io::Write;
+    crate::scene::write_atomically(path, |f| f.write_all(bytes)).map_err(|source| {
+        PreviewError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::moves;
+    use crate::config::Flavor;
+
+    /// Two layers: a 10 mm square (External perimeter, no width comment, tool 0) at Z 0.2
+    /// after a travel from the origin, a travel out and back, then the same square (Perimeter,
+    /// `;WIDTH:0.45`, tool 1) at Z 0.4.
+    const TWO_LAYERS: &str = "M104 S210\nM109 S210\nG28\nG90\nM82\nG92 E0\nG1 Z0.2 F600\n\
+        G1 X10 Y10 F6000\n;TYPE:External perimeter\n\
+        G1 X20 Y10 E1 F1200\nG1 X20 Y20 E2\nG1 X10 Y20 E3\nG1 X10 Y10 E4\n\
+        G1 E3 F2400\nG1 X30 Y30 F6000\nG1 Z0.4\nG1 X10 Y10\nT1\nG1 E4 F2400\n\
+        ;TYPE:Perimeter\n;WIDTH:0.45\nG1 X20 Y10 E5 F1200\nG1 X20 Y20 E6\nG1 X10 Y20 E7\nG1 X10 Y10 E8\n";
+
+    const SQUARE: &str =
+        "10.000,-10.000 20.000,-10.000 20.000,-20.000 10.000,-20.000 10.000,-10.000";
+
+    fn two_layers() -> Moves {
+        match conduit_gcode::parse(TWO_LAYERS.as_bytes()) {
+            Ok(g) => moves(&g, Flavor::Marlin),
+            Err(e) => panic!("test G-code does not parse: {e}"),
+        }
+    }
+
+    fn preview() -> Preview {
+        Preview::from_moves(&two_layers()).expect("the test program extrudes")
+    }
+
+    fn polylines(svg: &str) -> Vec<&str> {
+        svg.lines().filter(|l| l.starts_with("<polyline")).collect()
+    }
+
+    #[test]
+    fn moves_are_grouped_into_layers_and_polylines() {
+        let m = two_layers();
+        assert_eq!(m.layer_z, vec![0.2, 0.4]);
+        let p = preview();
+        assert_eq!(p.bounds, [10.0, 10.0, 20.0, 20.0]);
+        assert_eq!(p.roles, vec!["External perimeter", "Perimeter"]);
+        assert_eq!(p.styles, vec![(0, 0), (1, 1)]);
+        assert_eq!(p.layers.len(), 2);
+        let kinds: Vec<StrokeKind> = p.layers[0].strokes.iter().map(|s| s.kind).collect();
+        assert_eq!(
+            kinds,
+            vec![
+                StrokeKind::Travel,
+                StrokeKind::Extrusion {
+                    role: 0,
+                    tool: 0,
+                    width: 0.4
+                }
+            ]
+        );
+        // The travel out and back leads to layer 2, so it is drawn there.
+        assert_eq!(
+            p.layers[1].strokes[0].points,
+            vec![[10.0, 10.0], [30.0, 30.0], [10.0, 10.0]]
+        );
+        assert_eq!(p.every(&PreviewParams::default()), 1);
+    }
+
+    #[test]
+    fn layer_svg_has_the_flipped_square_and_a_thin_travel() {
+        let p = preview();
+        let svg = svg::layer(&p, 0);
+        let lines = polylines(&svg);
+        assert_eq!(lines.len(), 2, "{svg}");
+        assert_eq!(
+            lines[0],
+            format!(
+                r#"<polyline data-role="External perimeter" data-tool="0" stroke="{}" stroke-width="0.400" points="{SQUARE}"/>"#,
+                "#ff7d38"
+            )
+        );
+        assert_eq!(
+            lines[1],
+            r#"<polyline points="0.000,0.000 10.000,-10.000"/>"#
+        );
+        assert!(
+            svg.contains(
+                r##"<g class="travels" fill="none" stroke="#999999" stroke-width="0.050""##
+            )
+        );
+        // View box: extrusions (10..20 both ways, y flipped) plus the 2 mm margin, then legend.
+        assert!(svg.contains(r#"viewBox="8.000 -22.000 14.000 "#), "{svg}");
+        assert!(svg.contains("<title>layer 1 of 2, Z 0.200 mm</title>"));
+        assert!(svg.contains(">External perimeter (T0)</text>"));
+        assert!(svg.contains(">Perimeter (T1)</text>"));
+
+        let svg2 = svg::layer(&p, 1);
+        let lines = polylines(&svg2);
+        assert_eq!(lines.len(), 2, "{svg2}");
+        let tool1 = hex_of(tint(role_colour("Perimeter", 1), 1));
+        assert_eq!(
+            lines[0],
+            format!(
+                r#"<polyline data-role="Perimeter" data-tool="1" stroke="{tool1}" stroke-width="0.450" points="{SQUARE}"/>"#
+            )
+        );
+        assert_ne!(tool1, "#e6b800");
+        assert_eq!(
+            lines[1],
+            r#"<polyline points="10.000,-10.000 30.000,-30.000 10.000,-10.000"/>"#
+        );
+    }
+
+    fn hex_of(c: [u8; 3]) -> String {
+        format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2])
+    }
+
+    #[test]
+    fn contact_sheet_shows_the_square_on_background() {
+        let p = preview();
+        let bytes = png::contact_sheet(&p, 1, 64).expect("the sheet renders");
+        let img = tiny_skia::Pixmap::decode_png(&bytes).expect("the PNG decodes");
+        assert_eq!((img.width(), img.height()), (128, 64));
+        let rgb = |x: u32, y: u32| {
+            let c = img.pixel(x, y).expect("inside the image").demultiply();
+            [c.red(), c.green(), c.blue()]
+        };
+        // Scale 5.6 px/mm inside a 4 px padding: the square's edges run at 4 and 60 px.
+        for tile in [0, 64] {
+            for (x, y) in [(4, 32), (60, 32), (32, 4), (32, 60), (4, 4), (60, 60)] {
+                assert_ne!(
+                    rgb(tile + x, y),
+                    png::BACKGROUND,
+                    "edge at ({}, {y})",
+                    tile + x
+                );
+            }
+            for (x, y) in [(32, 32), (16, 16), (48, 40), (20, 12)] {
+                assert_eq!(
+                    rgb(tile + x, y),
+                    png::BACKGROUND,
+                    "inside at ({}, {y})",
+                    tile + x
+                );
+            }
+        }
+        assert_eq!(rgb(4, 32), [0xff, 0x7d, 0x38]);
+        assert_eq!(rgb(64 + 4, 32), tint(role_colour("Perimeter", 1), 1));
+    }
+
+    #[test]
+    fn write_makes_one_svg_per_layer_and_a_sheet_deterministically() {
+        let m = two_layers();
+        let params = PreviewParams {
+            every: None,
+            tile_px: 64,
+        };
+        let dirs = [tempfile::tempdir(), tempfile::tempdir()].map(|d| d.expect("a temp dir"));
+        let mut outputs = Vec::new();
+        for d in &dirs {
+            let out = d.path().join("new");
+            let files = write(&m, &out, &params).expect("the preview is written");
+            assert_eq!(files.svgs.len(), 2);
+            assert_eq!(files.svgs[0], out.join("layer_0001.svg"));
+            assert_eq!(files.svgs[1], out.join("layer_0002.svg"));
+            assert_eq!((files.every, files.tiles), (1, 2));
+            let mut names: Vec<String> = std::fs::read_dir(&out)
+                .expect("the folder exists")
+                .map(|e| {
+                    e.expect("an entry")
+                        .file_name()
+                        .to_string_lossy()
+                        .into_owned()
+                })
+                .collect();
+            names.sort();
+            assert_eq!(
+                names,
+                ["contact_sheet.png", "layer_0001.svg", "layer_0002.svg"]
+            );
+            let bytes: Vec<Vec<u8>> = names
+                .iter()
+                .map(|n| std::fs::read(out.join(n)).expect("readable"))
+                .collect();
+            outputs.push(bytes);
+        }
+        assert_eq!(outputs[0], outputs[1]);
+    }
+
+    #[test]
+    fn default_every_keeps_the_sheet_at_36_tiles() {
+        let mut p = preview();
+        let layer = p.layers[0].clone();
+        p.layers = vec![layer; 100];
+        assert_eq!(p.every(&PreviewParams::default()), 3);
+        assert_eq!(100usize.div_ceil(3), 34);
+        p.layers.truncate(36);
+        assert_eq!(p.every(&PreviewParams::default()), 1);
+        assert_eq!(png::grid(34), (6, 6));
+        assert_eq!(png::grid(2), (2, 1));
+        assert_eq!(png::grid(1), (1, 1));
+    }
+
+    #[test]
+    fn travels_only_is_an_error() {
+        let g = conduit_gcode::parse(b"G28\nG1 X10 Y10\n").expect("parses");
+        assert!(matches!(
+            Preview::from_moves(&moves(&g, Flavor::Marlin)),
+            Err(PreviewError::NoExtrusion)
+        ));
+    }
+
+    #[test]
+    fn numbers_have_three_decimals_and_no_negative_zero() {
+        assert_eq!(svg::num(-0.0001), "0.000");
+        assert_eq!(svg::num(1.23456), "1.235");
+        assert_eq!(svg::num(-20.0), "-20.000");
+    }
+}
