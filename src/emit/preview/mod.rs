@@ -151,9 +151,13 @@ impl Preview {
                 strokes: Vec::new(),
             })
             .collect();
+        const CUSTOM_ROLE: &str = "Custom";
         let mut roles: Vec<String> = Vec::new();
         let mut styles = Vec::new();
+        // The view frames the part: extrusions of the start/end G-code (role `Custom`, e.g. a
+        // prime line at the bed's edge) are drawn but only frame the view when nothing else does.
         let mut bounds: Option<[f64; 4]> = None;
+        let mut custom_bounds: Option<[f64; 4]> = None;
         for m in &moves.moves {
             if !m.has_xy {
                 continue;
@@ -181,8 +185,9 @@ impl Preview {
                 if !styles.contains(&(role, m.tool)) {
                     styles.push((role, m.tool));
                 }
+                let frame = if name == CUSTOM_ROLE { &mut custom_bounds } else { &mut bounds };
                 for p in &points {
-                    let b = bounds.get_or_insert([p[0], p[1], p[0], p[1]]);
+                    let b = frame.get_or_insert([p[0], p[1], p[0], p[1]]);
                     *b = [
                         b[0].min(p[0]),
                         b[1].min(p[1]),
@@ -205,7 +210,7 @@ impl Preview {
                 _ => layer.strokes.push(Stroke { kind, points }),
             }
         }
-        let bounds = bounds.ok_or(PreviewError::NoExtrusion)?;
+        let bounds = bounds.or(custom_bounds).ok_or(PreviewError::NoExtrusion)?;
         styles.sort_unstable();
         Ok(Self {
             layers,
