@@ -202,3 +202,32 @@ fn convert_output_is_deterministic() {
         );
     }
 }
+
+#[cfg(unix)]
+#[test]
+fn outputs_get_ordinary_file_permissions_and_keep_existing_ones() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = temp_dir();
+    let mode =
+        |p: &std::path::Path| std::fs::metadata(p).expect("exists").permissions().mode() & 0o777;
+    let control = dir.path().join("control");
+    std::fs::File::create(&control).expect("create");
+    let out = dir.path().join("out.stl");
+    let run = || {
+        conduit([
+            "convert".as_ref(),
+            sample("cube_20mm.stl").as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ])
+    };
+    assert!(run().status.success());
+    assert_eq!(
+        mode(&out),
+        mode(&control),
+        "a new output has the permissions of a new file"
+    );
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).expect("chmod");
+    assert!(run().status.success());
+    assert_eq!(mode(&out), 0o640, "a replaced output keeps its permissions");
+}

@@ -76,10 +76,17 @@ where
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".conduit-")
-        .suffix(".tmp")
-        .tempfile_in(&dir)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".conduit-").suffix(".tmp");
+    // Temporary files are private (0600) by default; the output should get the permissions of
+    // an ordinary new file (0666 less the umask), or keep those of the file it replaces.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(path).map_or(0o666, |m| m.permissions().mode() & 0o7777);
+        builder.permissions(std::fs::Permissions::from_mode(mode));
+    }
+    let mut tmp = builder.tempfile_in(&dir)?;
     fill(tmp.as_file_mut())?;
     tmp.as_file_mut().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
