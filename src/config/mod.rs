@@ -650,11 +650,40 @@ impl Config {
                 ));
             }
         }
+        warnings.extend(self.unsupported_settings());
         if problems.is_empty() {
             Ok(warnings)
         } else {
             Err(ConfigError::Invalid { problems })
         }
+    }
+
+    /// Settings the planar pipeline does not apply yet, when they ask for something other than
+    /// what it does: each is named so a profile's intent is never dropped silently.
+    /// (`slice.top_solid_infill_width` is not applied either — top surfaces use
+    /// `slice.solid_infill_width` — but PrusaSlicer profiles set it implicitly to the nozzle
+    /// diameter, so warning about it would only be noise.)
+    fn unsupported_settings(&self) -> Vec<String> {
+        let s = &self.slice;
+        let mut out = Vec::new();
+        if s.support_material {
+            out.push("slice.support_material: support structures are not generated yet".to_owned());
+        }
+        if s.brim_width > 0.0 {
+            out.push(format!(
+                "slice.brim_width = {}: brims are not generated yet",
+                s.brim_width
+            ));
+        }
+        let external = s.region.external_perimeter_width;
+        if (s.first_layer_width - external).abs() > 1e-9 {
+            out.push(format!(
+                "slice.first_layer_width = {} is not applied yet: the first layer uses the regular \
+                 widths (e.g. {external} for the external perimeter)",
+                s.first_layer_width
+            ));
+        }
+        out
     }
 
     /// The tool that prints scene object `object` (see [`SliceSettings::object_tools`]).
