@@ -9,11 +9,14 @@ use conduit::config::{self, Config};
 /// validates it; warnings go to stderr.
 pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
     let (mut cfg, mut warnings) = match &src.config {
-        Some(path) => config::load(path).with_context(|| format!("loading config {}", path.display()))?,
+        Some(path) => {
+            config::load(path).with_context(|| format!("loading config {}", path.display()))?
+        }
         None => (Config::default(), Vec::new()),
     };
     for kv in &src.set {
-        cfg.apply_set(kv).map_err(|e| Failure::Usage(e.to_string()))?;
+        cfg.apply_set(kv)
+            .map_err(|e| Failure::Usage(e.to_string()))?;
     }
     warnings.extend(cfg.validate().context("invalid configuration")?);
     for w in warnings {
@@ -28,7 +31,10 @@ pub(crate) fn run(args: ConfigArgs) -> Result<(), Failure> {
         return Ok(());
     }
     if let Some(path) = &args.check {
-        let cfg = resolve(&ConfigSource { config: Some(path.clone()), set: Vec::new() })?;
+        let cfg = resolve(&ConfigSource {
+            config: Some(path.clone()),
+            set: Vec::new(),
+        })?;
         print!("{}", cfg.to_toml_string());
     }
     Ok(())

@@ -185,7 +185,11 @@ impl Preview {
                 if !styles.contains(&(role, m.tool)) {
                     styles.push((role, m.tool));
                 }
-                let frame = if name == CUSTOM_ROLE { &mut custom_bounds } else { &mut bounds };
+                let frame = if name == CUSTOM_ROLE {
+                    &mut custom_bounds
+                } else {
+                    &mut bounds
+                };
                 for p in &points {
                     let b = frame.get_or_insert([p[0], p[1], p[0], p[1]]);
                     *b = [
