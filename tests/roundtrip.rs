@@ -97,38 +97,11 @@ fn obj_to_stl_keeps_triangles_and_volume() {
 }
 
 fn two_object_scene() -> Scene {
-    let cube = |name: &str, s: f64, dx: f64| {
-        let p = |x: f64, y: f64, z: f64| Point3::new(x * s + dx, y * s, z * s);
-        let c = [
-            p(0., 0., 0.),
-            p(1., 0., 0.),
-            p(1., 1., 0.),
-            p(0., 1., 0.),
-            p(0., 0., 1.),
-            p(1., 0., 1.),
-            p(1., 1., 1.),
-            p(0., 1., 1.),
-        ];
-        let f: [[usize; 3]; 12] = [
-            [0, 2, 1],
-            [0, 3, 2],
-            [4, 5, 6],
-            [4, 6, 7],
-            [0, 1, 5],
-            [0, 5, 4],
-            [1, 2, 6],
-            [1, 6, 5],
-            [2, 3, 7],
-            [2, 7, 6],
-            [3, 0, 4],
-            [3, 4, 7],
-        ];
-        SceneObject {
-            name: name.into(),
-            mesh: Mesh::from_triangle_soup(name, f.iter().map(|t| t.map(|i| c[i]))),
-            transform: Transform::identity(),
-            tool: None,
-        }
+    let cube = |name: &str, s: f64, dx: f64| SceneObject {
+        name: name.into(),
+        mesh: Mesh::cuboid(name, Point3::new(dx, 0.0, 0.0), Point3::new(dx + s, s, s)),
+        transform: Transform::identity(),
+        tool: None,
     };
     Scene {
         objects: vec![cube("small", 0.1, 0.0), cube("large", 12.5, 30.0)],

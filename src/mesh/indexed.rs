@@ -45,6 +45,35 @@ impl Mesh {
         mesh
     }
 
+    /// An axis-aligned box between two corners: 8 vertices, 12 outward-facing triangles. Used for
+    /// part bodies and cavities, and as the standard test solid.
+    pub fn cuboid(name: impl Into<String>, min: Point3, max: Point3) -> Mesh {
+        let corner = |i: usize| {
+            Point3::new(
+                if i & 1 == 0 { min.x } else { max.x },
+                if i & 2 == 0 { min.y } else { max.y },
+                if i & 4 == 0 { min.z } else { max.z },
+            )
+        };
+        // Corner i has x from bit 0, y from bit 1, z from bit 2; each face counter-clockwise from
+        // outside.
+        const FACES: [[usize; 3]; 12] = [
+            [0, 3, 1],
+            [0, 2, 3],
+            [4, 5, 7],
+            [4, 7, 6],
+            [0, 1, 5],
+            [0, 5, 4],
+            [1, 3, 7],
+            [1, 7, 5],
+            [3, 2, 6],
+            [3, 6, 7],
+            [2, 0, 4],
+            [2, 4, 6],
+        ];
+        Mesh::from_triangle_soup(name, FACES.iter().map(|f| f.map(corner)))
+    }
+
     /// The three corner positions of triangle `i`.
     pub fn corners(&self, i: usize) -> [Point3; 3] {
         self.triangles[i].map(|v| self.vertices[v as usize])
@@ -119,32 +148,7 @@ pub(crate) mod tests {
 
     /// An axis-aligned cube of side `s` with its minimum corner at the origin, outward-facing.
     pub(crate) fn cube(s: f64) -> Mesh {
-        let v = |x: f64, y: f64, z: f64| Point3::new(x * s, y * s, z * s);
-        let p = [
-            v(0., 0., 0.),
-            v(1., 0., 0.),
-            v(1., 1., 0.),
-            v(0., 1., 0.),
-            v(0., 0., 1.),
-            v(1., 0., 1.),
-            v(1., 1., 1.),
-            v(0., 1., 1.),
-        ];
-        let faces: [[usize; 3]; 12] = [
-            [0, 2, 1],
-            [0, 3, 2],
-            [4, 5, 6],
-            [4, 6, 7],
-            [0, 1, 5],
-            [0, 5, 4],
-            [1, 2, 6],
-            [1, 6, 5],
-            [2, 3, 7],
-            [2, 7, 6],
-            [3, 0, 4],
-            [3, 4, 7],
-        ];
-        Mesh::from_triangle_soup("cube", faces.iter().map(|f| f.map(|i| p[i])))
+        Mesh::cuboid("cube", Point3::origin(), Point3::new(s, s, s))
     }
 
     #[test]
