@@ -32,7 +32,13 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage in order.
-    pub const ALL: [Stage; 5] = [Stage::Place, Stage::Slice, Stage::Regions, Stage::Program, Stage::Emit];
+    pub const ALL: [Stage; 5] = [
+        Stage::Place,
+        Stage::Slice,
+        Stage::Regions,
+        Stage::Program,
+        Stage::Emit,
+    ];
 
     /// A short human name.
     pub fn name(self) -> &'static str {
@@ -53,7 +59,9 @@ pub enum PipelineError {
     #[error("the scene has no triangles to slice")]
     EmptyScene,
     /// An object does not fit the printer.
-    #[error("object '{object}' is {size:.1} mm along {axis}, larger than the printer's {limit:.1} mm")]
+    #[error(
+        "object '{object}' is {size:.1} mm along {axis}, larger than the printer's {limit:.1} mm"
+    )]
     TooLarge {
         /// The object's name.
         object: String,
@@ -116,7 +124,11 @@ pub struct SliceSummary {
 /// object is dropped so its lowest point touches the bed.
 pub fn place_on_bed(scene: &Scene, cfg: &Config) -> Vec<Mesh> {
     let mut meshes = placed_meshes(scene);
-    let Some(all) = meshes.iter().filter_map(Mesh::bounding_box).reduce(|a, b| a.union(&b)) else {
+    let Some(all) = meshes
+        .iter()
+        .filter_map(Mesh::bounding_box)
+        .reduce(|a, b| a.union(&b))
+    else {
         return meshes;
     };
     let p = &cfg.printer;
@@ -154,26 +166,45 @@ pub fn slice_scene(
     progress(Stage::Slice);
     let params = SliceParams::new(cfg.slice.region.layer_height, cfg.slice.first_layer_height)?;
     let sliced: Vec<_> = meshes.iter().map(|m| slice_mesh(m, &params)).collect();
+    // The meshes are not needed past slicing: keep only what the report says about them.
+    let placed: Vec<(String, Option<BoundingBox>)> = meshes
+        .into_iter()
+        .map(|m| (m.name.clone(), m.bounding_box()))
+        .collect();
     lap(Stage::Slice, &mut times);
 
     progress(Stage::Regions);
     let mut objects = Vec::with_capacity(sliced.len());
     let mut summaries = Vec::with_capacity(sliced.len());
-    for (i, ((layers, report), mesh)) in sliced.into_iter().zip(&meshes).enumerate() {
+    for (i, ((layers, report), (name, bbox))) in sliced.into_iter().zip(placed).enumerate() {
         let tool = cfg.tool_for_object(i);
         if tool >= cfg.tools.len() {
-            return Err(PipelineError::UnknownTool { object: mesh.name.clone(), tool, tools: cfg.tools.len() });
+            return Err(PipelineError::UnknownTool {
+                object: name,
+                tool,
+                tools: cfg.tools.len(),
+            });
         }
-        let islands: Vec<_> = layers.iter().map(|l| l.islands.clone()).collect();
         let heights: Vec<f64> = layers.iter().map(|l| l.z.height()).collect();
+        let (zs, islands): (Vec<_>, Vec<_>) = layers.into_iter().map(|l| (l.z, l.islands)).unzip();
         let regions = make_regions_with_heights(&islands, &heights, &cfg.slice.region)?;
-        objects.push(ObjectLayers { tool, layers: layers.into_iter().map(|l| l.z).zip(regions).collect() });
-        summaries.push(ObjectSummary { name: mesh.name.clone(), tool, bbox: mesh.bounding_box(), slice: report });
+        drop(islands);
+        objects.push(ObjectLayers {
+            tool,
+            layers: zs.into_iter().zip(regions).collect(),
+        });
+        summaries.push(ObjectSummary {
+            name,
+            tool,
+            bbox,
+            slice: report,
+        });
     }
     lap(Stage::Regions, &mut times);
 
     progress(Stage::Program);
     let program = build_program(&objects, &ProgramParams::from_config(cfg));
+    drop(objects);
     lap(Stage::Program, &mut times);
 
     progress(Stage::Emit);
@@ -181,19 +212,33 @@ pub fn slice_scene(
     let stats = write_gcode(&program, cfg, &mut gcode)?;
     lap(Stage::Emit, &mut times);
 
-    let summary = SliceSummary { objects: summaries, layers: program.layers.len(), gcode: stats, stage_seconds: times };
+    let summary = SliceSummary {
+        objects: summaries,
+        layers: program.layers.len(),
+        gcode: stats,
+        stage_seconds: times,
+    };
     Ok((gcode, program, summary))
 }
 
 fn check_fits(meshes: &[Mesh], cfg: &Config) -> Result<(), PipelineError> {
     let p = &cfg.printer;
-    let limits = [("x", p.bed_size[0]), ("y", p.bed_size[1]), ("z", p.max_height)];
+    let limits = [
+        ("x", p.bed_size[0]),
+        ("y", p.bed_size[1]),
+        ("z", p.max_height),
+    ];
     for m in meshes {
         let Some(bb) = m.bounding_box() else { continue };
         let size = bb.size();
         for (k, (axis, limit)) in limits.iter().enumerate() {
             if size[k] > *limit {
-                return Err(PipelineError::TooLarge { object: m.name.clone(), axis, size: size[k], limit: *limit });
+                return Err(PipelineError::TooLarge {
+                    object: m.name.clone(),
+                    axis,
+                    size: size[k],
+                    limit: *limit,
+                });
             }
         }
     }

@@ -11,7 +11,8 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     let cfg = resolve(&args.config)?;
     let mut scene = Scene::default();
     for path in &args.models {
-        let (s, warnings) = load_scene(path, &LoadOptions::default()).map_err(anyhow::Error::from)?;
+        let (s, warnings) =
+            load_scene(path, &LoadOptions::default()).map_err(anyhow::Error::from)?;
         for w in warnings {
             eprintln!("warning: {}: {w}", path.display());
         }

@@ -6,7 +6,8 @@
 //! turns them into 3D toolpaths with widths, heights, speeds and tools.
 //!
 //! [`make_regions`] runs three steps, each parallel over layers where the layers are independent
-//! (the output does not depend on the thread count):
+//! (the output does not depend on the thread count), on islands first [`simplify`]-ed to
+//! [`simplify::RESOLUTION_MM`]:
 //!
 //! 1. [`perimeters`]: loops by inward offsets of each island, and the infill area inside them;
 //! 2. [`skins`]: the infill area split into top, bottom, internal solid and sparse areas by
@@ -19,6 +20,7 @@
 pub mod infill;
 pub mod params;
 pub mod perimeters;
+pub mod simplify;
 pub mod skins;
 pub mod skirt;
 #[cfg(test)]
@@ -133,6 +135,11 @@ pub fn make_regions_with_heights(
 
 /// The three steps of the module docs; `heights` has one entry per layer.
 fn regions(layers: &[Vec<ExPolygon>], heights: &[f64], params: &RegionParams) -> Vec<LayerRegions> {
+    let simplified: Vec<Vec<ExPolygon>> = layers
+        .par_iter()
+        .map(|islands| simplify::simplify_islands(islands, simplify::RESOLUTION_MM))
+        .collect();
+    let layers = simplified.as_slice();
     let perimeters: Vec<Perimeters> = layers
         .par_iter()
         .zip(heights)

@@ -25,7 +25,8 @@
 //! infill spacing.
 
 use super::params::RegionParams;
-use crate::geom::{ExPolygon, Join, Polygon, offset};
+use super::simplify::cleaned;
+use crate::geom::{ExPolygon, Join, Polygon, offset, scaled, unscaled};
 
 /// How far (mm) the opening that removes too-thin loops reaches, as a fraction of the spacing:
 /// `(1 − INSET_OVERLAP_TOLERANCE) / 2` with PrusaSlicer's tolerance of 0.4.
@@ -70,17 +71,45 @@ pub(crate) fn oriented(mut polygon: Polygon, ccw: bool) -> Polygon {
     polygon
 }
 
+/// [`offset`] with [`PERIMETER_JOIN`], its result [`cleaned`] of nearly collinear points so that
+/// further offsets of it stay cheap.
+pub(crate) fn offset_cleaned(area: &[ExPolygon], delta_mm: f64) -> Vec<ExPolygon> {
+    cleaned(offset(area, delta_mm, PERIMETER_JOIN))
+}
+
 /// `area` shrunk by `depth` mm with parts thinner than `2·radius` around the result removed
 /// (a morphological opening after the offset).
 pub(crate) fn shrink_opened(area: &[ExPolygon], depth: f64, radius: f64) -> Vec<ExPolygon> {
     if radius <= 0.0 {
-        return offset(area, -depth, PERIMETER_JOIN);
+        return offset_cleaned(area, -depth);
     }
-    let shrunk = offset(area, -(depth + radius), PERIMETER_JOIN);
+    let shrunk = offset_cleaned(area, -(depth + radius));
     if shrunk.is_empty() {
         return shrunk;
     }
-    offset(&shrunk, radius, PERIMETER_JOIN)
+    offset_cleaned(&shrunk, radius)
+}
+
+/// `island` shrunk by `depth` mm, starting from `base` (an area already shrunk by `base.0` nm) when
+/// it is not deeper than `depth`: inward mitred offsets compose, so this is the same region as
+/// shrinking the island itself, at the cost of a shorter (cheaper) offset. The remaining distance
+/// is taken in whole nanometres, so the total depth is exactly `scaled(depth)`.
+fn shrink_from(
+    island: &[ExPolygon],
+    base: Option<&(i64, Vec<ExPolygon>)>,
+    depth: f64,
+) -> Vec<ExPolygon> {
+    let target = scaled(depth);
+    match base {
+        Some((from, area)) if *from <= target => {
+            if *from == target || area.is_empty() {
+                area.clone()
+            } else {
+                offset_cleaned(area, -unscaled(target - from))
+            }
+        }
+        _ => offset_cleaned(island, -depth),
+    }
 }
 
 /// Depth (mm from the island edge to the centreline), width and spacing of loop `k`, for every
@@ -130,8 +159,17 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
     for (island_index, island) in islands.iter().enumerate() {
         let island = std::slice::from_ref(island);
         let mut island_loops: Vec<PerimeterLoop> = Vec::new();
+        // The deepest shrunk area so far: (depth in nm, area). Each deeper shrink starts from it.
+        let mut base: Option<(i64, Vec<ExPolygon>)> = None;
         for (k, &(depth, width, spacing)) in plan.iter().enumerate() {
-            let area = shrink_opened(island, depth, OPENING_FRACTION * spacing);
+            let radius = OPENING_FRACTION * spacing;
+            let shrunk = shrink_from(island, base.as_ref(), depth + radius);
+            let area = if shrunk.is_empty() || radius <= 0.0 {
+                shrunk.clone()
+            } else {
+                offset_cleaned(&shrunk, radius)
+            };
+            base = Some((scaled(depth + radius), shrunk));
             for ex in area {
                 let make = |polygon: Polygon, is_hole: bool| PerimeterLoop {
                     polygon: oriented(polygon, !is_hole),
@@ -153,7 +191,7 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
         }
         out.loops.extend(island_loops);
         out.infill_area
-            .extend(offset(island, -inset, PERIMETER_JOIN));
+            .extend(shrink_from(island, base.as_ref(), inset));
     }
     out
 }

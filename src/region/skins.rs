@@ -31,8 +31,8 @@
 //! first `N_b`, the last `N_t`) are taken whole.
 
 use super::params::RegionParams;
-use super::perimeters::{PERIMETER_JOIN, infill_inset, shrink_opened};
-use crate::geom::{ExPolygon, difference, intersection, offset, union};
+use super::perimeters::{infill_inset, offset_cleaned, shrink_opened};
+use crate::geom::{ExPolygon, difference, intersection, union};
 use rayon::prelude::*;
 
 /// What a solid area is for, which decides its speed and cooling downstream.
@@ -72,19 +72,46 @@ impl SkinAreas {
     }
 }
 
-/// Intersection of all of `layers`; empty if `layers` is empty.
-fn intersect_all(layers: &[Vec<ExPolygon>]) -> Vec<ExPolygon> {
-    let Some((first, rest)) = layers.split_first() else {
-        return Vec::new();
-    };
-    let mut acc = first.clone();
-    for layer in rest {
-        if acc.is_empty() {
-            break;
+/// Intersections of runs of consecutive layers, each computed once and shared by the bottom and
+/// top windows of every layer (the top window of layer `i` is the bottom window of layer
+/// `i + N + 1`).
+struct Windows<'a> {
+    islands: &'a [Vec<ExPolygon>],
+    /// `runs[k - 2][j]` is `islands[j] ∩ … ∩ islands[j + k − 1]` (runs of `k ≥ 2` layers).
+    runs: Vec<Vec<Vec<ExPolygon>>>,
+}
+
+impl<'a> Windows<'a> {
+    /// Runs of up to `longest` layers. Each run is folded left to right from the run one layer
+    /// shorter, so it is exactly what intersecting the layers one by one in order gives.
+    fn new(islands: &'a [Vec<ExPolygon>], longest: usize) -> Self {
+        let mut runs: Vec<Vec<Vec<ExPolygon>>> = Vec::new();
+        for k in 2..=longest.min(islands.len()) {
+            let shorter: &[Vec<ExPolygon>] = runs.last().map_or(islands, Vec::as_slice);
+            let next = (0..=islands.len() - k)
+                .into_par_iter()
+                .map(|j| {
+                    let acc = &shorter[j];
+                    if acc.is_empty() {
+                        Vec::new()
+                    } else {
+                        intersection(acc, &islands[j + k - 1])
+                    }
+                })
+                .collect();
+            runs.push(next);
         }
-        acc = intersection(&acc, layer);
+        Self { islands, runs }
     }
-    acc
+
+    /// Intersection of `islands[range]`; empty if the range is empty.
+    fn get(&self, range: std::ops::Range<usize>) -> &[ExPolygon] {
+        match range.len() {
+            0 => &[],
+            1 => &self.islands[range.start],
+            k => &self.runs[k - 2][range.start],
+        }
+    }
 }
 
 /// Skin areas of every layer. `islands[i]` are layer `i`'s sliced islands, `infill[i]` its
@@ -97,11 +124,16 @@ pub fn detect_skins(
     heights: &[f64],
     params: &RegionParams,
 ) -> Vec<SkinAreas> {
-    (0..infill.len().min(islands.len()))
+    let count = infill.len().min(islands.len());
+    let windows = Windows::new(
+        &islands[..count],
+        params.bottom_solid_layers.max(params.top_solid_layers),
+    );
+    (0..count)
         .into_par_iter()
         .map(|i| {
             let height = heights.get(i).copied().unwrap_or(params.layer_height);
-            layer_skins(i, islands, infill, height, params)
+            layer_skins(i, islands, infill, &windows, height, params)
         })
         .collect()
 }
@@ -111,6 +143,7 @@ fn layer_skins(
     i: usize,
     islands: &[Vec<ExPolygon>],
     infill: &[Vec<ExPolygon>],
+    windows: &Windows<'_>,
     height: f64,
     params: &RegionParams,
 ) -> SkinAreas {
@@ -132,7 +165,7 @@ fn layer_skins(
         if opened.is_empty() || grow <= 0.0 {
             return opened;
         }
-        intersection(&offset(&opened, grow, PERIMETER_JOIN), area)
+        intersection(&offset_cleaned(&opened, grow), area)
     };
     let empty = || (Vec::new(), false);
 
@@ -149,15 +182,12 @@ fn layer_skins(
     let (zone_bottom, zone_bottom_whole) = match nb {
         0 => empty(),
         _ if i < nb => (Vec::new(), true),
-        _ => (difference(area, &intersect_all(&islands[i - nb..i])), false),
+        _ => (difference(area, windows.get(i - nb..i)), false),
     };
     let (zone_top, zone_top_whole) = match nt {
         0 => empty(),
         _ if i + nt > last => (Vec::new(), true),
-        _ => (
-            difference(area, &intersect_all(&islands[i + 1..=i + nt])),
-            false,
-        ),
+        _ => (difference(area, windows.get(i + 1..i + nt + 1)), false),
     };
 
     let bottom = if bottom_whole || !exposed_bottom.is_empty() {
