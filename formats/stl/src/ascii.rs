@@ -634,27 +634,8 @@ mod tests {
 
     #[test]
     fn round_trip_is_bit_exact_over_random_bit_patterns() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
-        let mut triangles: Vec<[[f32; 3]; 3]> = Vec::new();
-        while triangles.len() < 20_000 {
-            let mut t = [[0.0_f32; 3]; 3];
-            for c in t.iter_mut().flatten() {
-                loop {
-                    let v = f32::from_bits(next() as u32);
-                    if v.is_finite() {
-                        *c = v;
-                        break;
-                    }
-                }
-            }
-            triangles.push(t);
-        }
+        let mut triangles =
+            crate::tests::random_finite_triangles(0x2545_f491_4f6c_dd1d_u64, 20_000);
         // Edge values: signed zeros, the extremes, subnormals, values near the format switch.
         let edges = [
             0.0,

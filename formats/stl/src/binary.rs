@@ -328,27 +328,7 @@ mod tests {
 
     #[test]
     fn round_trip_is_bit_exact_over_random_bit_patterns() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
-        let mut triangles = Vec::new();
-        while triangles.len() < 5000 {
-            let mut t = [[0.0_f32; 3]; 3];
-            for c in t.iter_mut().flatten() {
-                loop {
-                    let v = f32::from_bits(next() as u32);
-                    if v.is_finite() {
-                        *c = v;
-                        break;
-                    }
-                }
-            }
-            triangles.push(t);
-        }
+        let triangles = crate::tests::random_finite_triangles(0x9e37_79b9_7f4a_7c15_u64, 5000);
         let mut bytes = Vec::new();
         write_binary(&mut bytes, "random", &triangles).expect("write to Vec");
         assert_eq!(bytes.len(), 84 + 50 * 5000, "several write chunks");

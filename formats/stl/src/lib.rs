@@ -256,6 +256,32 @@ fn excerpt(bytes: &[u8]) -> String {
 
 #[cfg(test)]
 mod tests {
+    /// `count` triangles whose coordinates are random finite `f32` bit patterns (xorshift64 from
+    /// `seed`), for bit-exact round-trip tests of both encodings.
+    pub(crate) fn random_finite_triangles(seed: u64, count: usize) -> Vec<[[f32; 3]; 3]> {
+        let mut state = seed;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut triangles = Vec::with_capacity(count);
+        while triangles.len() < count {
+            let mut t = [[0.0_f32; 3]; 3];
+            for c in t.iter_mut().flatten() {
+                *c = loop {
+                    let v = f32::from_bits(next() as u32);
+                    if v.is_finite() {
+                        break v;
+                    }
+                };
+            }
+            triangles.push(t);
+        }
+        triangles
+    }
+
     use super::*;
 
     #[test]
