@@ -197,55 +197,38 @@ fn threemf_mesh(mesh: &Mesh) -> conduit_3mf::Mesh {
 
 /// Writes a scene to `path` in `format`, atomically.
 pub fn save(scene: &Scene, path: &Path, format: MeshFormat) -> Result<(), SaveError> {
-    let err = |kind| SaveError {
-        path: path.to_path_buf(),
-        kind,
-    };
-    match format {
-        MeshFormat::Stl | MeshFormat::StlAscii => {
-            let meshes = placed_meshes(scene);
-            let tris = f32_triangles(&meshes).map_err(err)?;
-            let name = stl_name(scene);
-            write_atomically(path, |f| -> Result<(), SaveErrorKind> {
-                let mut w = BufWriter::new(f);
+    write_atomically(path, |f| -> Result<(), SaveErrorKind> {
+        let mut w = BufWriter::new(f);
+        match format {
+            MeshFormat::Stl | MeshFormat::StlAscii => {
+                let tris = f32_triangles(&placed_meshes(scene))?;
+                let name = stl_name(scene);
                 if format == MeshFormat::Stl {
                     conduit_stl::write_binary(&mut w, &name, &tris)?;
                 } else {
                     conduit_stl::write_ascii(&mut w, &name, &tris)?;
                 }
-                w.flush()?;
-                Ok(())
-            })
-            .map_err(err)
-        }
-        MeshFormat::ThreeMf => {
-            let model = to_3mf_model(scene);
-            write_atomically(path, |f| -> Result<(), SaveErrorKind> {
-                let mut w = BufWriter::new(f);
-                conduit_3mf::write(&mut w, &model)?;
-                w.flush()?;
-                Ok(())
-            })
-            .map_err(err)
-        }
-        MeshFormat::Obj => {
-            let objects: Vec<conduit_obj::ObjObject> = placed_meshes(scene)
-                .into_iter()
-                .map(|m| conduit_obj::ObjObject {
-                    name: m.name.clone(),
-                    vertices: m.vertices.iter().map(|p| [p.x, p.y, p.z]).collect(),
-                    triangles: m.triangles,
-                })
-                .collect();
-            write_atomically(path, |f| -> Result<(), SaveErrorKind> {
-                let mut w = BufWriter::new(f);
+            }
+            MeshFormat::ThreeMf => conduit_3mf::write(&mut w, &to_3mf_model(scene))?,
+            MeshFormat::Obj => {
+                let objects: Vec<conduit_obj::ObjObject> = placed_meshes(scene)
+                    .into_iter()
+                    .map(|m| conduit_obj::ObjObject {
+                        name: m.name,
+                        vertices: m.vertices.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                        triangles: m.triangles,
+                    })
+                    .collect();
                 conduit_obj::write(&mut w, &objects)?;
-                w.flush()?;
-                Ok(())
-            })
-            .map_err(err)
+            }
         }
-    }
+        w.flush()?;
+        Ok(())
+    })
+    .map_err(|kind| SaveError {
+        path: path.to_path_buf(),
+        kind,
+    })
 }
 
 fn stl_name(scene: &Scene) -> String {
