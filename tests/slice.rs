@@ -589,6 +589,7 @@ fn cube_bottom_and_top_layers_are_solid() {
         "Top solid infill",
         "Bottom solid infill",
         "Bottom",
+        "Bridge infill",
     ];
     // Defaults: 3 bottom and 3 top solid layers.
     for k in [1, 2, 3, 98, 99, 100] {
@@ -598,7 +599,8 @@ fn cube_bottom_and_top_layers_are_solid() {
             "layer {k} has roles {rs:?}"
         );
         assert!(
-            rs.iter().any(|r| r.contains("olid infill")),
+            rs.iter()
+                .any(|r| r.contains("olid infill") || r == "Bridge infill"),
             "layer {k} is filled solid: {rs:?}"
         );
     }
@@ -607,6 +609,8 @@ fn cube_bottom_and_top_layers_are_solid() {
         "the last layer is a top surface: {:?}",
         roles(200 * 100)
     );
+    // The first solid layer over the sparse ones bridges the sparse lines.
+    assert!(roles(200 * 98).contains(&"Bridge infill".to_owned()));
     for k in 4..=97 {
         let rs = roles(200 * k);
         assert!(
@@ -632,7 +636,13 @@ fn cube_extrusion_per_mm_follows_the_bead_formula() {
     {
         let w = m.width.expect(";WIDTH: before extruding");
         let h = m.height.expect(";HEIGHT: before extruding");
-        let per_mm = ((w - h) * h + std::f64::consts::PI * (h / 2.0).powi(2)) / filament_area;
+        // Flat beads are rounded rectangles; bridges are round threads of diameter w.
+        let bead = if m.role == "Bridge infill" {
+            std::f64::consts::PI * w * w / 4.0
+        } else {
+            (w - h) * h + std::f64::consts::PI * (h / 2.0).powi(2)
+        };
+        let per_mm = bead / filament_area;
         let expected = m.xy_len() * per_mm;
         // What the file's rounding allows: E has 5 decimals, so a difference of two written
         // values is off by up to 1e-5; X and Y have 3, so each end may sit up to
@@ -664,8 +674,6 @@ fn cube_extrusion_per_mm_follows_the_bead_formula() {
 }
 
 #[test]
-#[ignore = "bug: slice.first_layer_width and slice.top_solid_infill_width are read and validated \
-            but never used (src/program/build.rs takes widths from RegionParams only)"]
 fn first_layer_and_top_solid_widths_take_effect() {
     let dir = temp_dir();
     let s = slice(

@@ -285,6 +285,16 @@ const KEYS: &[KeyDoc] = &[
     ),
     k(
         "slice",
+        "solid_infill_below_area",
+        "Sparse areas smaller than this are filled solid, mm²; 0 = never.",
+    ),
+    k(
+        "slice",
+        "gap_fill",
+        "Fill strips too narrow for another perimeter with variable-width lines.",
+    ),
+    k(
+        "slice",
         "top_fill_pattern",
         "Top solid infill pattern: \"rectilinear\".",
     ),
@@ -360,6 +370,12 @@ const KEYS: &[KeyDoc] = &[
         "top_solid_infill_speed",
         "Speed of top solid infill, mm/s.",
     ),
+    k(
+        "slice",
+        "bridge_speed",
+        "Speed of bridge infill (threads over air), mm/s.",
+    ),
+    k("slice", "gap_fill_speed", "Speed of gap fill, mm/s."),
     k(
         "slice",
         "first_layer_speed",

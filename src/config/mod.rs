@@ -214,18 +214,15 @@ pub enum SolidPattern {
 pub struct SliceSettings {
     /// Perimeters, infill, widths, layer height and nozzle diameter of the regions stage: the keys
     /// `perimeters`, `external_perimeter_width`, `perimeter_width`, `infill_width`,
-    /// `solid_infill_width`, `top_solid_layers`, `bottom_solid_layers`, `infill_density`,
-    /// `infill_pattern`, `infill_angle_deg`, `infill_overlap`, `solid_infill_margin`,
+    /// `solid_infill_width`, `top_solid_infill_width`, `first_layer_width`, `top_solid_layers`,
+    /// `bottom_solid_layers`, `infill_density`, `infill_pattern`, `infill_angle_deg`,
+    /// `infill_overlap`, `solid_infill_margin`, `solid_infill_below_area`, `gap_fill`,
     /// `external_perimeters_first`, `skirt_loops`, `skirt_distance`, `nozzle_diameter`,
     /// `layer_height` sit directly in `[slice]`.
     #[serde(flatten)]
     pub region: RegionParams,
     /// Height of the first layer, mm. Default 0.2.
     pub first_layer_height: f64,
-    /// Extrusion width on the first layer, mm (all roles). Default 0.45.
-    pub first_layer_width: f64,
-    /// Extrusion width of top solid infill, mm. Default 0.45.
-    pub top_solid_infill_width: f64,
     /// Pattern of top solid infill. Default `"rectilinear"`.
     pub top_fill_pattern: SolidPattern,
     /// Pattern of bottom solid infill. Default `"rectilinear"`.
@@ -244,6 +241,10 @@ pub struct SliceSettings {
     pub solid_infill_speed: f64,
     /// Speed of top solid infill, mm/s. Default 30.
     pub top_solid_infill_speed: f64,
+    /// Speed of bridge infill (threads over air), mm/s. Default 60.
+    pub bridge_speed: f64,
+    /// Speed of gap fill, mm/s. Default 20.
+    pub gap_fill_speed: f64,
     /// Speed of every printing move on the first layer, mm/s. Default 20.
     pub first_layer_speed: f64,
     /// Speed of skirt and brim, mm/s. Default 30.
@@ -375,8 +376,6 @@ impl Default for SliceSettings {
         Self {
             region: RegionParams::default(),
             first_layer_height: 0.2,
-            first_layer_width: 0.45,
-            top_solid_infill_width: 0.45,
             top_fill_pattern: SolidPattern::Rectilinear,
             bottom_fill_pattern: SolidPattern::Rectilinear,
             support_material: false,
@@ -386,6 +385,8 @@ impl Default for SliceSettings {
             infill_speed: 80.0,
             solid_infill_speed: 40.0,
             top_solid_infill_speed: 30.0,
+            bridge_speed: 60.0,
+            gap_fill_speed: 20.0,
             first_layer_speed: 20.0,
             skirt_speed: 30.0,
             conductive_speed: 10.0,
@@ -609,13 +610,13 @@ impl Config {
         let p = &self.printer;
         for (key, v) in [
             ("slice.first_layer_height", s.first_layer_height),
-            ("slice.first_layer_width", s.first_layer_width),
-            ("slice.top_solid_infill_width", s.top_solid_infill_width),
             ("slice.perimeter_speed", s.perimeter_speed),
             ("slice.external_perimeter_speed", s.external_perimeter_speed),
             ("slice.infill_speed", s.infill_speed),
             ("slice.solid_infill_speed", s.solid_infill_speed),
             ("slice.top_solid_infill_speed", s.top_solid_infill_speed),
+            ("slice.bridge_speed", s.bridge_speed),
+            ("slice.gap_fill_speed", s.gap_fill_speed),
             ("slice.first_layer_speed", s.first_layer_speed),
             ("slice.skirt_speed", s.skirt_speed),
             ("slice.conductive_speed", s.conductive_speed),
@@ -660,9 +661,6 @@ impl Config {
 
     /// Settings the planar pipeline does not apply yet, when they ask for something other than
     /// what it does: each is named so a profile's intent is never dropped silently.
-    /// (`slice.top_solid_infill_width` is not applied either — top surfaces use
-    /// `slice.solid_infill_width` — but PrusaSlicer profiles set it implicitly to the nozzle
-    /// diameter, so warning about it would only be noise.)
     fn unsupported_settings(&self) -> Vec<String> {
         let s = &self.slice;
         let mut out = Vec::new();
@@ -673,14 +671,6 @@ impl Config {
             out.push(format!(
                 "slice.brim_width = {}: brims are not generated yet",
                 s.brim_width
-            ));
-        }
-        let external = s.region.external_perimeter_width;
-        if (s.first_layer_width - external).abs() > 1e-9 {
-            out.push(format!(
-                "slice.first_layer_width = {} is not applied yet: the first layer uses the regular \
-                 widths (e.g. {external} for the external perimeter)",
-                s.first_layer_width
             ));
         }
         out
@@ -834,6 +824,8 @@ struct SliceSpec {
     perimeter_width: Option<f64>,
     infill_width: Option<f64>,
     solid_infill_width: Option<f64>,
+    top_solid_infill_width: Option<f64>,
+    first_layer_width: Option<f64>,
     top_solid_layers: Option<usize>,
     bottom_solid_layers: Option<usize>,
     infill_density: Option<f64>,
@@ -841,14 +833,14 @@ struct SliceSpec {
     infill_angle_deg: Option<f64>,
     infill_overlap: Option<f64>,
     solid_infill_margin: Option<f64>,
+    solid_infill_below_area: Option<f64>,
+    gap_fill: Option<bool>,
     external_perimeters_first: Option<bool>,
     skirt_loops: Option<usize>,
     skirt_distance: Option<f64>,
     nozzle_diameter: Option<f64>,
     layer_height: Option<f64>,
     first_layer_height: Option<f64>,
-    first_layer_width: Option<f64>,
-    top_solid_infill_width: Option<f64>,
     top_fill_pattern: Option<SolidPattern>,
     bottom_fill_pattern: Option<SolidPattern>,
     support_material: Option<bool>,
@@ -858,6 +850,8 @@ struct SliceSpec {
     infill_speed: Option<f64>,
     solid_infill_speed: Option<f64>,
     top_solid_infill_speed: Option<f64>,
+    bridge_speed: Option<f64>,
+    gap_fill_speed: Option<f64>,
     first_layer_speed: Option<f64>,
     skirt_speed: Option<f64>,
     conductive_speed: Option<f64>,
@@ -874,8 +868,9 @@ impl<'de> Deserialize<'de> for SliceSettings {
             };
         }
         take!(region: perimeters, external_perimeter_width, perimeter_width, infill_width,
-            solid_infill_width, top_solid_layers, bottom_solid_layers, infill_density,
-            infill_pattern, infill_angle_deg, infill_overlap, solid_infill_margin,
+            solid_infill_width, top_solid_infill_width, first_layer_width, top_solid_layers,
+            bottom_solid_layers, infill_density, infill_pattern, infill_angle_deg,
+            infill_overlap, solid_infill_margin, solid_infill_below_area, gap_fill,
             external_perimeters_first, skirt_loops, skirt_distance, nozzle_diameter,
             layer_height);
         macro_rules! take_top {
@@ -885,8 +880,6 @@ impl<'de> Deserialize<'de> for SliceSettings {
         }
         take_top!(
             first_layer_height,
-            first_layer_width,
-            top_solid_infill_width,
             top_fill_pattern,
             bottom_fill_pattern,
             support_material,
@@ -896,6 +889,8 @@ impl<'de> Deserialize<'de> for SliceSettings {
             infill_speed,
             solid_infill_speed,
             top_solid_infill_speed,
+            bridge_speed,
+            gap_fill_speed,
             first_layer_speed,
             skirt_speed,
             conductive_speed,

@@ -28,8 +28,8 @@
 //! - slice: `layer_height`, `first_layer_height` (mm, or % of `layer_height`), `perimeters`,
 //!   `top_solid_layers`, `bottom_solid_layers`, `fill_density` (`20%` → 0.2), `fill_pattern`,
 //!   `top_fill_pattern` / `bottom_fill_pattern` (Slic3r: `top_infill_pattern`, …), `fill_angle`,
-//!   `infill_overlap`, `external_perimeters_first`, `support_material`, `skirts`,
-//!   `skirt_distance`, `brim_width`, `perimeter_generator` (classic; arachne gives a warning
+//!   `infill_overlap`, `solid_infill_below_area`, `gap_fill_enabled`, `external_perimeters_first`, `support_material`, `skirts`,
+//!   `skirt_distance`, `brim_width`, `bridge_speed`, `gap_fill_speed`, `perimeter_generator` (classic; arachne gives a warning
 //!   that classic perimeters are printed), the speeds (a `%` speed is relative to its
 //!   PrusaSlicer parent: external perimeter → perimeter, solid infill → infill, top solid →
 //!   solid infill, first layer → perimeter, support → perimeter), `support_material_speed` (→
@@ -464,6 +464,12 @@ fn convert(
         };
         s.region.infill_density = d.map_err(|_| p.err("fill_density", "expected a percentage"))?;
     }
+    if let Some(v) = p.num("solid_infill_below_area")? {
+        s.region.solid_infill_below_area = v;
+    }
+    if let Some(v) = p.flag("gap_fill_enabled")? {
+        s.region.gap_fill = v;
+    }
     if let Some(pat) = p.raw("fill_pattern").map(str::to_owned) {
         s.region.infill_pattern = match pat.trim() {
             "rectilinear" => InfillPatternKind::Rectilinear,
@@ -559,7 +565,7 @@ fn convert(
         (
             "top_infill_extrusion_width",
             1.0,
-            &mut s.top_solid_infill_width,
+            &mut s.region.top_solid_infill_width,
         ),
     ] {
         if let Some(w) = width(&mut p, key, auto)? {
@@ -567,8 +573,8 @@ fn convert(
         }
     }
     match p.abs_or_percent("first_layer_extrusion_width", nozzle)? {
-        Some(w) if w > 0.0 => s.first_layer_width = w,
-        _ => s.first_layer_width = s.region.perimeter_width,
+        Some(w) if w > 0.0 => s.region.first_layer_width = w,
+        _ => s.region.first_layer_width = s.region.perimeter_width,
     }
 
     // Speeds; a percentage is of the parent PrusaSlicer uses.
@@ -586,6 +592,12 @@ fn convert(
     }
     if let Some(v) = p.abs_or_percent("top_solid_infill_speed", s.solid_infill_speed)? {
         s.top_solid_infill_speed = v;
+    }
+    if let Some(v) = p.num("bridge_speed")? {
+        s.bridge_speed = v;
+    }
+    if let Some(v) = p.num("gap_fill_speed")? {
+        s.gap_fill_speed = v;
     }
     if let Some(v) = p.abs_or_percent("first_layer_speed", s.perimeter_speed)? {
         s.first_layer_speed = v;
@@ -664,12 +676,12 @@ mod tests {
         assert_eq!(p.first_layer_bed_temperature, 60.0);
         assert_eq!(s.region.layer_height, 0.2);
         assert_eq!(s.first_layer_height, 0.2);
-        assert_eq!(s.first_layer_width, 0.45);
+        assert_eq!(s.region.first_layer_width, 0.45);
         assert_eq!(s.region.perimeter_width, 0.45);
         assert_eq!(s.region.external_perimeter_width, 0.45);
         assert_eq!(s.region.infill_width, 0.45);
         assert_eq!(s.region.solid_infill_width, 0.45);
-        assert_eq!(s.top_solid_infill_width, 0.45);
+        assert_eq!(s.region.top_solid_infill_width, 0.45);
         assert_eq!(s.region.perimeters, 2);
         assert_eq!(s.region.top_solid_layers, 3);
         assert_eq!(s.region.bottom_solid_layers, 3);
@@ -745,8 +757,8 @@ gcode_comments = 0
         let s = &cfg.slice;
         assert!((s.region.perimeter_width - 0.72).abs() < 1e-12);
         assert!((s.region.external_perimeter_width - 0.675).abs() < 1e-12);
-        assert!((s.top_solid_infill_width - 0.6).abs() < 1e-12);
-        assert_eq!(s.first_layer_width, s.region.perimeter_width);
+        assert!((s.region.top_solid_infill_width - 0.6).abs() < 1e-12);
+        assert_eq!(s.region.first_layer_width, s.region.perimeter_width);
         assert_eq!(s.external_perimeter_speed, 30.0);
         assert_eq!(s.solid_infill_speed, 40.0);
         assert_eq!(s.top_solid_infill_speed, 20.0);

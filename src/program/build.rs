@@ -32,11 +32,13 @@
 
 use std::collections::BTreeMap;
 
+use super::extrusion::BeadShape;
 use super::order::{Group, OrderParams, order_groups};
 use super::toolpath::{Event, Layer, LayerItem, Program, Role, Toolpath};
 use crate::config::{Config, ToolKind};
 use crate::geom::{Point2, Point3, Polygon, scaled, unscaled};
-use crate::region::{LayerRegions, RegionParams, SolidRole};
+use crate::region::gapfill::split_by_width;
+use crate::region::{LayerRegions, SolidRole};
 use crate::slice::LayerZ;
 
 /// The layers of one object (or one material of an object), printed with one tool.
@@ -61,6 +63,10 @@ pub struct RoleSpeeds {
     pub top_solid_infill: f64,
     /// Sparse infill, scaffold and buffer. Default 80.
     pub sparse_infill: f64,
+    /// Bridge infill. Default 60.
+    pub bridge: f64,
+    /// Gap fill. Default 20.
+    pub gap_fill: f64,
     /// Skirt and brim. Default 30.
     pub skirt: f64,
     /// Conductive traces and drops. Default 10.
@@ -76,6 +82,8 @@ impl Default for RoleSpeeds {
             solid_infill: 40.0,
             top_solid_infill: 30.0,
             sparse_infill: 80.0,
+            bridge: 60.0,
+            gap_fill: 20.0,
             skirt: 30.0,
             conductive: 10.0,
         }
@@ -89,6 +97,8 @@ impl RoleSpeeds {
             Role::ExternalPerimeter => self.external_perimeter,
             Role::Perimeter | Role::Custom => self.perimeter,
             Role::SolidInfill | Role::BottomSolidInfill => self.solid_infill,
+            Role::BridgeInfill => self.bridge,
+            Role::GapFill => self.gap_fill,
             Role::TopSolidInfill => self.top_solid_infill,
             Role::SparseInfill | Role::Scaffold | Role::Buffer => self.sparse_infill,
             Role::Skirt => self.skirt,
@@ -104,6 +114,8 @@ impl RoleSpeeds {
             solid_infill: self.solid_infill.min(max),
             top_solid_infill: self.top_solid_infill.min(max),
             sparse_infill: self.sparse_infill.min(max),
+            bridge: self.bridge.min(max),
+            gap_fill: self.gap_fill.min(max),
             skirt: self.skirt.min(max),
             conductive: self.conductive.min(max),
         }
@@ -113,13 +125,6 @@ impl RoleSpeeds {
 /// How one tool's regions become toolpaths.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ToolPathParams {
-    /// Width of sparse infill lines, mm (the width the regions stage spaced them for).
-    /// Default 0.45.
-    pub infill_width: f64,
-    /// Width of solid infill lines (bottom, internal, top), mm. Default 0.45.
-    pub solid_infill_width: f64,
-    /// Width of skirt loops, mm. Default 0.45.
-    pub skirt_width: f64,
     /// Speeds per role.
     pub speeds: RoleSpeeds,
     /// Speed of every path on the program's first layer, mm/s. Default 20.
@@ -130,19 +135,9 @@ pub struct ToolPathParams {
 }
 
 impl Default for ToolPathParams {
+    /// Default speeds, no role override.
     fn default() -> Self {
-        Self::from_region(&RegionParams::default())
-    }
-}
-
-impl ToolPathParams {
-    /// Widths from the regions stage's parameters (so extrusion matches the spacing it used),
-    /// default speeds, no role override.
-    pub fn from_region(region: &RegionParams) -> Self {
         Self {
-            infill_width: region.infill_width,
-            solid_infill_width: region.solid_infill_width,
-            skirt_width: region.perimeter_width,
             speeds: RoleSpeeds::default(),
             first_layer_speed: 20.0,
             role: None,
@@ -246,8 +241,7 @@ fn segment_distance2(p: Point2, a: Point2, b: Point2) -> f64 {
 }
 
 impl ProgramParams {
-    /// Parameters from a run's configuration: widths from `[slice]` (the regions stage's), role
-    /// speeds and the first-layer speed from `[slice]` limited to `printer.max_print_speed`;
+    /// Parameters from a run's configuration: role speeds and the first-layer speed from `[slice]` limited to `printer.max_print_speed`;
     /// paste tools print every path as [`Role::ConductiveTrace`] at `slice.conductive_speed`
     /// (also on the first layer, if that is slower than `first_layer_speed`). Ordering and
     /// start position take their defaults.
@@ -260,6 +254,8 @@ impl ProgramParams {
             solid_infill: s.solid_infill_speed,
             top_solid_infill: s.top_solid_infill_speed,
             sparse_infill: s.infill_speed,
+            bridge: s.bridge_speed,
+            gap_fill: s.gap_fill_speed,
             skirt: s.skirt_speed,
             conductive: s.conductive_speed,
         }
@@ -271,7 +267,7 @@ impl ProgramParams {
                 let base = ToolPathParams {
                     speeds,
                     first_layer_speed: s.first_layer_speed.min(max),
-                    ..ToolPathParams::from_region(&s.region)
+                    ..ToolPathParams::default()
                 };
                 match t.kind {
                     ToolKind::Filament => base,
@@ -316,6 +312,10 @@ fn inside(polygon: &Polygon, p: Point2) -> bool {
 fn point3(p: Point2, z: f64) -> Point3 {
     Point3::new(unscaled(p.x), unscaled(p.y), z)
 }
+
+/// Largest thickness difference (mm) within one gap-fill path: a printer changes flow only per
+/// move, and PrusaSlicer's `variable_width` splits at about the same step.
+const GAP_WIDTH_TOLERANCE_MM: f64 = 0.05;
 
 /// One object's layer, with what is needed to make its toolpaths.
 struct Entry<'a> {
@@ -376,11 +376,10 @@ impl PathMaker {
 /// The skirt groups and island groups of one object layer.
 fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
     let r = e.regions;
-    let p = maker.params;
     let skirt: Vec<Group> = r
         .skirt
         .iter()
-        .filter_map(|s| maker.closed(s, Role::Skirt, p.skirt_width))
+        .filter_map(|s| maker.closed(s, Role::Skirt, r.skirt_width))
         .map(|path| Group {
             first: vec![path],
             rest: Vec::new(),
@@ -417,18 +416,28 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
             None => loose.rest.push(path),
         }
     };
+    for gap in &r.gap_fill {
+        // One path per run of nearly constant thickness; the runs of a line share their ends,
+        // so the travel ordering strings them together again.
+        for (points, thickness) in split_by_width(gap, GAP_WIDTH_TOLERANCE_MM) {
+            let width =
+                BeadShape::RoundedRectangle.width_for_area(thickness * maker.height, maker.height);
+            add_line(&points, Role::GapFill, width);
+        }
+    }
     for fill in &r.solid_infill {
         let role = match fill.role {
             SolidRole::Top => Role::TopSolidInfill,
             SolidRole::Bottom => Role::BottomSolidInfill,
+            SolidRole::Bridge | SolidRole::InternalBridge => Role::BridgeInfill,
             SolidRole::Internal => Role::SolidInfill,
         };
         for line in &fill.lines {
-            add_line(&line.points, role, p.solid_infill_width);
+            add_line(&line.points, role, fill.width);
         }
     }
     for line in &r.sparse_infill {
-        add_line(&line.points, Role::SparseInfill, p.infill_width);
+        add_line(&line.points, Role::SparseInfill, r.sparse_width);
     }
     let mut groups: Vec<Group> = islands.into_values().collect();
     if !loose.rest.is_empty() {
@@ -511,7 +520,7 @@ pub fn build_program(objects: &[ObjectLayers], params: &ProgramParams) -> Progra
 mod tests {
     use super::*;
     use crate::geom::{ExPolygon, Polyline};
-    use crate::region::{make_regions, make_regions_with_heights};
+    use crate::region::{RegionParams, make_regions, make_regions_with_heights};
     use crate::slice::{SliceParams, layer_schedule};
 
     fn square(x0: f64, y0: f64, side: f64) -> ExPolygon {

@@ -13,7 +13,9 @@
 //! the same model as the extrusion spacing of [`crate::region::spacing`]. A bead narrower than it
 //! is high (`w < h`, only for odd inputs) is taken as an ellipse `π·w·h/4`, which meets the
 //! rounded rectangle at `w = h`. [`BeadShape::Rectangle`] (`A = w·h`) is there for processes
-//! that print square beads (e.g. some paste dispensers with a flat nozzle).
+//! that print square beads (e.g. some paste dispensers with a flat nozzle). A bridge thread hangs
+//! in air with nothing to flatten it against, so it is [`BeadShape::Round`], a circle of
+//! diameter `w`: `A = π·w²/4`, whatever the layer height.
 //!
 //! # Filament tools
 //!
@@ -42,6 +44,8 @@ pub enum BeadShape {
     RoundedRectangle,
     /// Plain rectangle: `w·h`.
     Rectangle,
+    /// Circle of diameter `w` (a thread in air, as bridges are drawn): `π·w²/4`.
+    Round,
 }
 
 impl BeadShape {
@@ -53,10 +57,27 @@ impl BeadShape {
         }
         match self {
             BeadShape::Rectangle => width * height,
+            BeadShape::Round => PI * width * width / 4.0,
             BeadShape::RoundedRectangle if width >= height => {
                 (width - height) * height + PI * (height / 2.0).powi(2)
             }
             BeadShape::RoundedRectangle => PI * width * height / 4.0,
+        }
+    }
+
+    /// The width whose bead of height `height` has cross-section `area` (the inverse of
+    /// [`BeadShape::area`] in the width); 0 for a non-positive area or height.
+    pub fn width_for_area(self, area: f64, height: f64) -> f64 {
+        if !(area > 0.0 && height > 0.0) {
+            return 0.0;
+        }
+        match self {
+            BeadShape::Rectangle => area / height,
+            BeadShape::Round => (4.0 * area / PI).sqrt(),
+            BeadShape::RoundedRectangle if area >= PI * height * height / 4.0 => {
+                area / height + height * (1.0 - PI / 4.0)
+            }
+            BeadShape::RoundedRectangle => 4.0 * area / (PI * height),
         }
     }
 }
@@ -121,6 +142,26 @@ mod tests {
         assert_eq!(BeadShape::Rectangle.area(0.45, 0.2), 0.45 * 0.2);
         assert_eq!(bead_area(0.0, 0.2), 0.0);
         assert_eq!(bead_area(0.45, f64::NAN), 0.0);
+        assert!((BeadShape::Round.area(0.4, 0.2) - PI * 0.04).abs() < 1e-15);
+    }
+
+    #[test]
+    fn width_for_area_inverts_area() {
+        for shape in [
+            BeadShape::RoundedRectangle,
+            BeadShape::Rectangle,
+            BeadShape::Round,
+        ] {
+            for w in [0.05, 0.1, 0.2, 0.45, 0.9] {
+                let back = shape.width_for_area(shape.area(w, 0.2), 0.2);
+                assert!((back - w).abs() < 1e-12, "{shape:?} {w} {back}");
+            }
+        }
+        // A gap of thickness t takes t·h: the spacing model's width t + h·(1 − π/4).
+        let w = BeadShape::RoundedRectangle.width_for_area(0.3 * 0.2, 0.2);
+        assert!((w - crate::region::spacing(w, 0.2) - 0.2 * (1.0 - PI / 4.0)).abs() < 1e-15);
+        assert!((crate::region::spacing(w, 0.2) - 0.3).abs() < 1e-12);
+        assert_eq!(BeadShape::Round.width_for_area(-1.0, 0.2), 0.0);
     }
 
     #[test]

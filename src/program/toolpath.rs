@@ -14,8 +14,12 @@ pub enum Role {
     SolidInfill,
     /// Solid infill of an upward-facing (visible) surface.
     TopSolidInfill,
-    /// Solid infill of a downward-facing surface (on the bed or over air).
+    /// Solid infill of a downward-facing surface on the bed.
     BottomSolidInfill,
+    /// Solid infill over air: round threads spanning from anchor to anchor.
+    BridgeInfill,
+    /// Variable-width fill of the strips between perimeter loops.
+    GapFill,
     /// Sparse infill.
     SparseInfill,
     /// Skirt (or brim) loops around the first layer.
@@ -34,12 +38,14 @@ pub enum Role {
 
 impl Role {
     /// Every role, in declaration order.
-    pub const ALL: [Role; 12] = [
+    pub const ALL: [Role; 14] = [
         Role::ExternalPerimeter,
         Role::Perimeter,
         Role::SolidInfill,
         Role::TopSolidInfill,
         Role::BottomSolidInfill,
+        Role::BridgeInfill,
+        Role::GapFill,
         Role::SparseInfill,
         Role::Skirt,
         Role::Scaffold,
@@ -54,8 +60,7 @@ impl Role {
     /// PrusaSlicer's names (`ExtrusionEntity.cpp`, `ExtrusionEntity::role_to_string`) where
     /// PrusaSlicer has the role, so its G-code viewer and post-processors understand the
     /// output: bottom solid infill is `Solid infill` as in PrusaSlicer, which has no separate
-    /// bottom role (it calls bottom infill over air `Bridge infill`, which conduit does not
-    /// detect). The conduit-only roles use names in the same style: `Scaffold`, `Buffer`,
+    /// role for it. The conduit-only roles use names in the same style: `Scaffold`, `Buffer`,
     /// `Conductive trace`, `Conductive drop`.
     pub fn type_name(self) -> &'static str {
         match self {
@@ -63,6 +68,8 @@ impl Role {
             Role::Perimeter => "Perimeter",
             Role::SolidInfill | Role::BottomSolidInfill => "Solid infill",
             Role::TopSolidInfill => "Top solid infill",
+            Role::BridgeInfill => "Bridge infill",
+            Role::GapFill => "Gap fill",
             Role::SparseInfill => "Internal infill",
             Role::Skirt => "Skirt/Brim",
             Role::Scaffold => "Scaffold",
@@ -80,6 +87,15 @@ impl Role {
             .into_iter()
             .filter(|r| *r != Role::BottomSolidInfill)
             .find(|r| r.type_name() == name)
+    }
+
+    /// The cross-section of this role's beads: bridges are round threads in air, everything
+    /// else is pressed onto the layer below (see [`super::extrusion`]).
+    pub fn bead_shape(self) -> super::extrusion::BeadShape {
+        match self {
+            Role::BridgeInfill => super::extrusion::BeadShape::Round,
+            _ => super::extrusion::BeadShape::RoundedRectangle,
+        }
     }
 
     /// Whether the role deposits conductive material.

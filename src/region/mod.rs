@@ -9,14 +9,21 @@
 //! (the output does not depend on the thread count), on islands first [`simplify`]-ed to
 //! [`simplify::RESOLUTION_MM`]:
 //!
-//! 1. [`perimeters`]: loops by inward offsets of each island, and the infill area inside them;
-//! 2. [`skins`]: the infill area split into top, bottom, internal solid and sparse areas by
-//!    comparing neighbouring layers;
-//! 3. [`infill`]: solid areas filled with [`infill::Rectilinear`] at 100 %, sparse areas with the
-//!    configured pattern at `spacing / density`; plus the [`skirt`] on the first layer.
+//! 1. [`perimeters`]: loops by inward offsets of each island, the strips between them too narrow
+//!    for another loop (filled by [`gapfill`]), and the infill area inside them;
+//! 2. [`skins`]: the infill area split into top, bottom, bridge, internal solid and sparse areas
+//!    by comparing neighbouring layers;
+//! 3. [`infill`]: solid areas filled with [`infill::Rectilinear`] at 100 % (bridges in the
+//!    direction [`bridge`] picks, at the bridge spacing), sparse areas with the configured
+//!    pattern at `spacing / density`; plus the [`skirt`] on the first layer.
+//!
+//! The first layer is made with every width set to `first_layer_width`
+//! ([`RegionParams::for_layer`]).
 //!
 //! Spacings follow the flow model documented in [`params`].
 
+pub mod bridge;
+pub mod gapfill;
 pub mod infill;
 pub mod params;
 pub mod perimeters;
@@ -32,6 +39,8 @@ pub use skins::{SkinAreas, SolidRole, detect_skins};
 pub use skirt::make_skirt;
 
 use crate::geom::{ExPolygon, Polygon, Polyline};
+use gapfill::ThickPolyline;
+use infill::lines::{LineFamily, fill_family};
 use infill::{InfillPattern, Rectilinear};
 use rayon::prelude::*;
 
@@ -42,6 +51,9 @@ pub struct Fill {
     pub lines: Vec<Polyline>,
     /// What the lines are for.
     pub role: SolidRole,
+    /// Extrusion width the lines are spaced for, mm (for [`SolidRole::Bridge`] the diameter of
+    /// the round thread, see [`RegionParams::bridge_flow`]).
+    pub width: f64,
 }
 
 /// Everything to print on one layer of one object.
@@ -53,12 +65,19 @@ pub struct LayerRegions {
     pub height: f64,
     /// Perimeter loops in print order (see [`Perimeters::loops`]).
     pub perimeters: Vec<PerimeterLoop>,
-    /// Solid infill in print order: bottom, internal, top; roles without area are left out.
+    /// Solid infill in print order: bottom, bridge, internal bridge, internal, top; roles
+    /// without area are left out.
     pub solid_infill: Vec<Fill>,
     /// Sparse infill centrelines.
     pub sparse_infill: Vec<Polyline>,
+    /// Extrusion width of the sparse infill lines, mm.
+    pub sparse_width: f64,
+    /// Variable-width centrelines filling the gaps between perimeter loops.
+    pub gap_fill: Vec<ThickPolyline>,
     /// Skirt loops, outermost first; only on layer 0.
     pub skirt: Vec<Polygon>,
+    /// Extrusion width of the skirt loops, mm.
+    pub skirt_width: f64,
     /// Where infill centrelines may go (inside the innermost perimeters), for routing and
     /// cavities.
     pub infill_area: Vec<ExPolygon>,
@@ -143,15 +162,15 @@ fn regions(layers: &[Vec<ExPolygon>], heights: &[f64], params: &RegionParams) ->
     let perimeters: Vec<Perimeters> = layers
         .par_iter()
         .zip(heights)
-        .map(|(islands, &h)| make_perimeters(islands, params, h))
+        .enumerate()
+        .map(|(index, (islands, &h))| make_perimeters(islands, &params.for_layer(index), h))
         .collect();
     let infill_areas: Vec<Vec<ExPolygon>> =
         perimeters.iter().map(|p| p.infill_area.clone()).collect();
     let skins = detect_skins(layers, &infill_areas, heights, params);
-    let solid_pattern = Rectilinear::new(params.infill_angle_deg);
-    let sparse_pattern = infill::pattern(params.infill_pattern, params.infill_angle_deg);
+    let first = params.for_layer(0);
     let skirt = match (layers.first(), heights.first()) {
-        (Some(first), Some(&h)) => make_skirt(first, params, h),
+        (Some(islands), Some(&h)) => make_skirt(islands, &first, h),
         _ => Vec::new(),
     };
     perimeters
@@ -160,39 +179,114 @@ fn regions(layers: &[Vec<ExPolygon>], heights: &[f64], params: &RegionParams) ->
         .zip(heights)
         .enumerate()
         .map(|(index, ((per, skins), &height))| {
-            let sp = params.spacings(height);
-            let solid_infill = skins
-                .solid()
-                .into_iter()
-                .filter(|(_, area)| !area.is_empty())
-                .map(|(role, area)| Fill {
-                    lines: solid_pattern.fill(area, sp.solid_infill, index),
-                    role,
-                })
-                .filter(|f| !f.lines.is_empty())
-                .collect();
-            let density = params.infill_density.min(1.0);
-            let sparse_infill = if density > 0.0 && !skins.sparse.is_empty() {
-                sparse_pattern.fill(&skins.sparse, sp.infill / density, index)
-            } else {
+            let lp = params.for_layer(index);
+            let below = index
+                .checked_sub(1)
+                .map_or(&[][..], |i| layers[i].as_slice());
+            let gap_fill = if per.gaps.is_empty() {
                 Vec::new()
+            } else {
+                let sp = lp.spacings(height);
+                gapfill::gap_fill(
+                    &per.gaps,
+                    perimeters::GAP_MIN_FRACTION * lp.perimeter_width,
+                    2.0 * sp.perimeter,
+                )
             };
             LayerRegions {
                 index,
                 height,
                 perimeters: per.loops,
-                solid_infill,
-                sparse_infill,
+                solid_infill: solid_fills(&skins, below, &lp, index, height),
+                sparse_infill: sparse_fill(&skins, &lp, index, height),
+                sparse_width: lp.infill_width,
+                gap_fill,
                 skirt: if index == 0 {
                     skirt.clone()
                 } else {
                     Vec::new()
                 },
+                skirt_width: lp.perimeter_width,
                 infill_area: per.infill_area,
                 skins,
             }
         })
         .collect()
+}
+
+/// Solid infill of one layer, role by role in print order: bottom and internal solid at the
+/// solid spacing, top at the top spacing, internal bridges at the bridge spacing, all turning
+/// 90° a layer; each bridge over air in its own direction ([`bridge::bridge_angle`] against the
+/// islands `below`), at the bridge spacing.
+fn solid_fills(
+    skins: &SkinAreas,
+    below: &[ExPolygon],
+    params: &RegionParams,
+    index: usize,
+    height: f64,
+) -> Vec<Fill> {
+    let sp = params.spacings(height);
+    let pattern = Rectilinear::new(params.infill_angle_deg);
+    let (bridge_width, bridge_spacing) = params.bridge_flow();
+    let mut fills = Vec::new();
+    for (role, area) in skins.solid() {
+        if area.is_empty() {
+            continue;
+        }
+        let (lines, width) = match role {
+            SolidRole::Bridge => {
+                // The default when nothing anchors: the direction sparse infill would take.
+                let turn = if index % 2 == 1 { 90.0 } else { 0.0 };
+                let default = params.infill_angle_deg + turn;
+                let lines = area
+                    .iter()
+                    .flat_map(|ex| {
+                        let angle =
+                            bridge::bridge_angle(ex, below, bridge_spacing).unwrap_or(default);
+                        let family = LineFamily {
+                            angle_rad: angle.to_radians(),
+                            spacing_mm: bridge_spacing,
+                            phase: 0.5,
+                        };
+                        fill_family(std::slice::from_ref(ex), family, true)
+                    })
+                    .collect();
+                (lines, bridge_width)
+            }
+            SolidRole::Top => (
+                pattern.fill(area, sp.top_solid_infill, index),
+                params.top_solid_infill_width,
+            ),
+            SolidRole::InternalBridge => (pattern.fill(area, bridge_spacing, index), bridge_width),
+            SolidRole::Bottom | SolidRole::Internal => (
+                pattern.fill(area, sp.solid_infill, index),
+                params.solid_infill_width,
+            ),
+        };
+        if !lines.is_empty() {
+            fills.push(Fill { lines, role, width });
+        }
+    }
+    fills
+}
+
+/// Sparse infill of one layer: the configured pattern at `spacing / density`.
+fn sparse_fill(
+    skins: &SkinAreas,
+    params: &RegionParams,
+    index: usize,
+    height: f64,
+) -> Vec<Polyline> {
+    let density = params.infill_density.min(1.0);
+    if density <= 0.0 || skins.sparse.is_empty() {
+        return Vec::new();
+    }
+    let pattern = infill::pattern(params.infill_pattern, params.infill_angle_deg);
+    pattern.fill(
+        &skins.sparse,
+        params.spacings(height).infill / density,
+        index,
+    )
 }
 
 #[cfg(test)]
@@ -238,6 +332,116 @@ mod tests {
         // Sparse infill at 20 %.
         let sparse = total_length(&regions[5].sparse_infill) * sp / area;
         assert!((sparse - 0.2).abs() < 0.04, "{sparse}");
+    }
+
+    #[test]
+    fn narrow_strip_gets_one_loop_and_a_gap_fill_line_of_the_strip_width() {
+        // 1.3 mm: one loop, then a 0.443 mm strip no second loop fits in (see perimeters).
+        let params = RegionParams::default();
+        let layers = vec![vec![crate::region::test_util::rect_island(0.0, 0.0, 20.0, 1.3)]; 5];
+        let r = make_regions(&layers, &params);
+        let half = params.spacings(0.2).perimeter / 2.0;
+        let thickness = 1.3 - 2.0 * (0.225 + half);
+        let gap_area = thickness * (20.0 - 2.0 * (0.225 + half));
+        for layer in &r {
+            assert_eq!(layer.perimeters.len(), 1);
+            assert!(layer.solid_infill.is_empty() && layer.sparse_infill.is_empty());
+            let filled: f64 = layer
+                .gap_fill
+                .iter()
+                .flat_map(|g| g.points.windows(2).zip(&g.widths))
+                .map(|(w, t)| {
+                    let d = ((w[1].x - w[0].x) as f64).hypot((w[1].y - w[0].y) as f64) / 1e6;
+                    d * t
+                })
+                .sum();
+            assert!(
+                (filled - gap_area).abs() < 0.03 * gap_area,
+                "{filled} vs {gap_area}"
+            );
+            let long: Vec<f64> = layer
+                .gap_fill
+                .iter()
+                .flat_map(|g| g.widths.clone())
+                .collect();
+            assert!(
+                long.iter().any(|t| (t - thickness).abs() < 0.01),
+                "{long:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_slab_over_two_legs_bridges_across_the_gap() {
+        // Legs x ∈ [0, 5] and [15, 20] for layers 0–4, a 20 × 20 slab on layers 5–9.
+        let mut layers = vec![
+            vec![
+                crate::region::test_util::rect_island(0.0, 0.0, 5.0, 20.0),
+                crate::region::test_util::rect_island(15.0, 0.0, 20.0, 20.0),
+            ];
+            5
+        ];
+        layers.extend(vec![vec![square_island(0.0, 0.0, 20.0)]; 5]);
+        let r = make_regions(&layers, &RegionParams::default());
+        let bridge = r[5]
+            .solid_infill
+            .iter()
+            .find(|f| f.role == SolidRole::Bridge)
+            .expect("layer 5 bridges");
+        assert_eq!(bridge.width, 0.4);
+        // Lines run along x, from leg to leg: every long segment is horizontal.
+        let mut spans = 0;
+        for line in &bridge.lines {
+            for w in line.points.windows(2) {
+                let (dx, dy) = ((w[1].x - w[0].x) as f64, (w[1].y - w[0].y) as f64);
+                if dx.hypot(dy) > 5e6 {
+                    assert!(dy.abs() < 1e-3 * dx.abs(), "{:?}", w);
+                    spans += 1;
+                }
+            }
+        }
+        // About 20 mm / 0.45 mm lines.
+        assert!((35..=50).contains(&spans), "{spans} spans");
+        // No bridge anywhere else.
+        for (i, layer) in r.iter().enumerate().filter(|(i, _)| *i != 5) {
+            assert!(layer.skins.bridge.is_empty(), "layer {i}");
+        }
+    }
+
+    #[test]
+    fn small_sparse_areas_are_filled_solid() {
+        // An 8 mm square: its sparse area (≈ 6.2² = 38 mm²) is below 70 mm².
+        let layers = vec![vec![square_island(0.0, 0.0, 8.0)]; 10];
+        let r = make_regions(&layers, &RegionParams::default());
+        assert!(r.iter().all(|l| l.sparse_infill.is_empty()));
+        let off = RegionParams {
+            solid_infill_below_area: 0.0,
+            ..Default::default()
+        };
+        let r = make_regions(&layers, &off);
+        assert!(!r[5].sparse_infill.is_empty());
+        assert!(r[5].solid_infill.is_empty());
+    }
+
+    #[test]
+    fn first_layer_and_top_widths_are_used() {
+        let params = RegionParams {
+            first_layer_width: 0.6,
+            top_solid_infill_width: 0.4,
+            skirt_loops: 1,
+            ..Default::default()
+        };
+        let r = make_regions(&cube_layers(), &params);
+        assert!(r[0].perimeters.iter().all(|l| l.width == 0.6));
+        assert!(r[0].solid_infill.iter().all(|f| f.width == 0.6));
+        assert_eq!((r[0].sparse_width, r[0].skirt_width), (0.6, 0.6));
+        assert!(r[1].perimeters.iter().all(|l| l.width == 0.45));
+        let top = &r[9].solid_infill[0];
+        assert_eq!((top.role, top.width), (SolidRole::Top, 0.4));
+        // Top lines are spaced for 0.4 mm: length ≈ area / spacing(0.4).
+        let area: f64 = r[9].infill_area.iter().map(ExPolygon::area_mm2).sum();
+        let ratio = total_length(&top.lines) * spacing(0.4, 0.2) / area;
+        assert!(ratio > 0.95 && ratio < 1.1, "{ratio}");
     }
 
     #[test]
@@ -300,7 +504,7 @@ mod tests {
         assert!(
             r[5].solid_infill
                 .iter()
-                .any(|f| f.role == SolidRole::Bottom)
+                .any(|f| f.role == SolidRole::Bridge)
         );
         assert!(r[3].solid_infill.iter().any(|f| f.role == SolidRole::Top));
     }

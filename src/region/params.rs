@@ -47,8 +47,13 @@ pub struct RegionParams {
     pub perimeter_width: f64,
     /// Extrusion width of sparse infill lines, mm. Default 0.45.
     pub infill_width: f64,
-    /// Extrusion width of solid (top, bottom, internal solid) infill lines, mm. Default 0.45.
+    /// Extrusion width of solid (bottom and internal solid) infill lines, mm. Default 0.45.
     pub solid_infill_width: f64,
+    /// Extrusion width of top solid infill lines (the visible upper surfaces), mm. Default 0.45.
+    pub top_solid_infill_width: f64,
+    /// Extrusion width of every extrusion on the first layer (loops, infill, gap fill, skirt),
+    /// mm; a wider first layer sticks better and evens out an uneven bed. Default 0.45.
+    pub first_layer_width: f64,
     /// Number of solid layers under every upward-facing surface. Default 3.
     pub top_solid_layers: usize,
     /// Number of solid layers over every downward-facing surface (and at the bed). Default 3.
@@ -66,8 +71,18 @@ pub struct RegionParams {
     /// How far solid areas are grown into the neighbouring sparse area (mm) so they are anchored
     /// on the infill around them. Internal solid zones are grown by the perimeter band width on
     /// top of this, so they reach under the perimeters of a part standing on them (see
-    /// `region::skins`). Default 0.5.
+    /// `region::skins`). Default 3, PrusaSlicer's `EXTERNAL_INFILL_MARGIN`: a top skin that
+    /// ends flush with the sparse infill below it sags into the gaps at its edge, and a bridge
+    /// needs its lines anchored well beyond the edge of the air it spans.
     pub solid_infill_margin: f64,
+    /// Sparse areas smaller than this (mm²) are filled solid instead: in a small area sparse
+    /// lines are short, mostly turns and anchors, and add little stiffness, while a solid fill
+    /// is barely more material. Default 70 (PrusaSlicer's `solid_infill_below_area`); 0 = off.
+    pub solid_infill_below_area: f64,
+    /// Fill the strips left between perimeter loops that are too narrow for another loop with
+    /// variable-width centrelines ([`crate::region::gapfill`]), so thin walls and the corners of
+    /// the perimeter band are solid. Default true.
+    pub gap_fill: bool,
     /// Print the external loop of each island first (better dimensional accuracy, worse
     /// overhangs). Default false: inner loops first.
     pub external_perimeters_first: bool,
@@ -91,13 +106,17 @@ impl Default for RegionParams {
             perimeter_width: 0.45,
             infill_width: 0.45,
             solid_infill_width: 0.45,
+            top_solid_infill_width: 0.45,
+            first_layer_width: 0.45,
             top_solid_layers: 3,
             bottom_solid_layers: 3,
             infill_density: 0.2,
             infill_pattern: InfillPatternKind::Rectilinear,
             infill_angle_deg: 45.0,
             infill_overlap: 0.25,
-            solid_infill_margin: 0.5,
+            solid_infill_margin: 3.0,
+            solid_infill_below_area: 70.0,
+            gap_fill: true,
             external_perimeters_first: false,
             skirt_loops: 0,
             skirt_distance: 6.0,
@@ -193,6 +212,8 @@ impl RegionParams {
             ("perimeter_width", self.perimeter_width),
             ("infill_width", self.infill_width),
             ("solid_infill_width", self.solid_infill_width),
+            ("top_solid_infill_width", self.top_solid_infill_width),
+            ("first_layer_width", self.first_layer_width),
         ] {
             if !(width.is_finite() && width >= self.nozzle_diameter && width > self.layer_height) {
                 errors.push(ParamError::BadWidth {
@@ -213,6 +234,7 @@ impl RegionParams {
         }
         for (field, value) in [
             ("solid_infill_margin", self.solid_infill_margin),
+            ("solid_infill_below_area", self.solid_infill_below_area),
             ("skirt_distance", self.skirt_distance),
         ] {
             if !(value.is_finite() && value >= 0.0) {
@@ -235,7 +257,33 @@ impl RegionParams {
             perimeter: spacing(self.perimeter_width, height),
             infill: spacing(self.infill_width, height),
             solid_infill: spacing(self.solid_infill_width, height),
+            top_solid_infill: spacing(self.top_solid_infill_width, height),
         }
+    }
+
+    /// The parameters layer `index` is made with: on the first layer every width is
+    /// `first_layer_width`; other layers use these parameters unchanged.
+    pub fn for_layer(&self, index: usize) -> RegionParams {
+        if index > 0 {
+            return self.clone();
+        }
+        let w = self.first_layer_width;
+        RegionParams {
+            external_perimeter_width: w,
+            perimeter_width: w,
+            infill_width: w,
+            solid_infill_width: w,
+            top_solid_infill_width: w,
+            ..self.clone()
+        }
+    }
+
+    /// Width (mm) and centreline spacing of bridge lines: a bridge is drawn in air as a round
+    /// thread of the nozzle's diameter (it cannot be squashed flat against anything), and the
+    /// threads are laid 0.05 mm further apart than they are thick (PrusaSlicer's
+    /// `BRIDGE_EXTRA_SPACING`) so a thread does not land on its neighbour and pull it down.
+    pub fn bridge_flow(&self) -> (f64, f64) {
+        (self.nozzle_diameter, self.nozzle_diameter + 0.05)
     }
 }
 
@@ -250,6 +298,8 @@ pub struct Spacings {
     pub infill: f64,
     /// Spacing of solid infill lines.
     pub solid_infill: f64,
+    /// Spacing of top solid infill lines.
+    pub top_solid_infill: f64,
 }
 
 #[cfg(test)]

@@ -15,22 +15,36 @@
 //!
 //! **Thin parts.** Each loop area is *opened* (shrunk by `d_k + r`, grown back by `r`, with
 //! `r = 0.3 · spacing`, PrusaSlicer's `INSET_OVERLAP_TOLERANCE` of 0.4), so a loop that would run
-//! over itself is not made. Parts too thin for a loop are simply absent: there is no gap fill or
-//! thin-wall medial-axis extrusion yet.
+//! over itself is not made.
+//!
+//! **Gaps.** Where a loop is missing or pinched by that opening, a strip between two loops is
+//! left without material. Between loop `k−1` (centreline area `C_(k−1)`) and loop `k` at distance
+//! `δ` the strip is `C_(k−1) ⊖ δ/2 − C_k ⊕ δ/2`: what loop `k`'s bead should have covered and
+//! did not. After the last loop the same is done for a virtual next loop one perimeter spacing
+//! further in, so the strip between the perimeters and the infill is found too (PrusaSlicer's
+//! classic perimeter generator). Strips are kept between `0.12 · perimeter_width` and twice the
+//! perimeter spacing wide ([`GAP_MIN_FRACTION`]); they are filled by [`super::gapfill`] and cut
+//! from the infill area.
 //!
 //! **Infill area.** The area inside the innermost loop where infill *centrelines* may go: the
 //! island shrunk by `d_last + (last_spacing + solid_infill_spacing) / 2 − infill_overlap ·
 //! perimeter_width`, so infill lines clipped to it sit one spacing inside the innermost loop, less
-//! the overlap that bonds them. With zero perimeters it is the island shrunk by half a solid
-//! infill spacing.
+//! the overlap that bonds them, then opened by `0.3 · solid spacing` so no infill is laid in a
+//! sliver the nozzle cannot fill with whole lines (the gap fill takes it). With zero perimeters
+//! it is the island shrunk by half a solid infill spacing.
 
 use super::params::RegionParams;
 use super::simplify::cleaned;
-use crate::geom::{ExPolygon, Join, Polygon, offset, scaled, unscaled};
+use crate::geom::{ExPolygon, Join, Polygon, difference, offset, scaled, unscaled};
 
 /// How far (mm) the opening that removes too-thin loops reaches, as a fraction of the spacing:
 /// `(1 − INSET_OVERLAP_TOLERANCE) / 2` with PrusaSlicer's tolerance of 0.4.
 const OPENING_FRACTION: f64 = 0.3;
+
+/// Narrowest gap filled, as a fraction of `perimeter_width`: PrusaSlicer's
+/// `0.2 · width · (1 − INSET_OVERLAP_TOLERANCE)`. Narrower strips are within the beads' own
+/// squish and would only be over-filled.
+pub const GAP_MIN_FRACTION: f64 = 0.2 * (1.0 - 0.4);
 
 /// Join used for every perimeter offset: mitred, so straight walls and square corners stay exact.
 /// The miter limit (3) is PrusaSlicer's for perimeters.
@@ -61,6 +75,9 @@ pub struct Perimeters {
     pub loops: Vec<PerimeterLoop>,
     /// Where infill centrelines may go, over all islands of the layer.
     pub infill_area: Vec<ExPolygon>,
+    /// Strips between loops too narrow for another loop, to be gap-filled (empty unless
+    /// `gap_fill` is on); see the module docs.
+    pub gaps: Vec<ExPolygon>,
 }
 
 /// Returns `polygon` with its vertices running counter-clockwise when `ccw`, clockwise otherwise.
@@ -155,12 +172,16 @@ pub fn infill_inset(params: &RegionParams, height: f64) -> f64 {
 pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64) -> Perimeters {
     let plan = loop_plan(params, height);
     let inset = infill_inset(params, height);
+    let solid_spacing = params.spacings(height).solid_infill;
     let mut out = Perimeters::default();
+    let mut gaps: Vec<ExPolygon> = Vec::new();
     for (island_index, island) in islands.iter().enumerate() {
         let island = std::slice::from_ref(island);
         let mut island_loops: Vec<PerimeterLoop> = Vec::new();
         // The deepest shrunk area so far: (depth in nm, area). Each deeper shrink starts from it.
         let mut base: Option<(i64, Vec<ExPolygon>)> = None;
+        // The previous loop's centreline area and spacing, for the gaps.
+        let mut previous: Option<(Vec<ExPolygon>, f64)> = None;
         for (k, &(depth, width, spacing)) in plan.iter().enumerate() {
             let radius = OPENING_FRACTION * spacing;
             let shrunk = shrink_from(island, base.as_ref(), depth + radius);
@@ -170,6 +191,13 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
                 offset_cleaned(&shrunk, radius)
             };
             base = Some((scaled(depth + radius), shrunk));
+            if params.gap_fill
+                && let Some((prev, prev_spacing)) = &previous
+            {
+                let distance = (prev_spacing + spacing) / 2.0;
+                gaps.extend(gap_between(prev, &area, distance));
+            }
+            previous = Some((area.clone(), spacing));
             for ex in area {
                 let make = |polygon: Polygon, is_hole: bool| PerimeterLoop {
                     polygon: oriented(polygon, !is_hole),
@@ -190,10 +218,57 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
             island_loops.sort_by_key(|l| std::cmp::Reverse(l.depth));
         }
         out.loops.extend(island_loops);
-        out.infill_area
-            .extend(shrink_from(island, base.as_ref(), inset));
+        if params.gap_fill
+            && let Some((last, spacing)) = &previous
+        {
+            // The strip a further loop would have filled, next to the infill.
+            let next = shrink_opened(last, *spacing, OPENING_FRACTION * spacing);
+            gaps.extend(gap_between(last, &next, *spacing));
+        }
+        let radius = OPENING_FRACTION * solid_spacing;
+        let shrunk = shrink_from(island, base.as_ref(), inset + radius);
+        if !shrunk.is_empty() {
+            out.infill_area.extend(offset_cleaned(&shrunk, radius));
+        }
+    }
+    if !gaps.is_empty() {
+        let sp = params.spacings(height);
+        let min = GAP_MIN_FRACTION * params.perimeter_width;
+        let max = 2.0 * sp.perimeter;
+        // Drop what is thinner than `min` everywhere and what is wider than `max` (an area a
+        // loop or infill covers).
+        let kept = shrink_opened(&gaps, 0.0, min / 2.0);
+        let wide = shrink_opened(&kept, 0.0, max / 2.0);
+        out.gaps = if wide.is_empty() {
+            kept
+        } else {
+            difference(&kept, &offset_cleaned(&wide, SAFETY_MM))
+        };
+        if !out.gaps.is_empty() && !out.infill_area.is_empty() {
+            out.infill_area = difference(&out.infill_area, &out.gaps);
+        }
     }
     out
+}
+
+/// A small extra growth (mm) so that boundaries meeting exactly do not leave hairline slivers in
+/// a difference (PrusaSlicer's `ClipperSafetyOffset`, 10 nm, doubled).
+const SAFETY_MM: f64 = 2e-5;
+
+/// The part of the strip `outer ⊖ distance/2` not covered by the beads of the loops on the
+/// boundary of `inner` (a centreline area `distance` further in) or anything inside them.
+fn gap_between(outer: &[ExPolygon], inner: &[ExPolygon], distance: f64) -> Vec<ExPolygon> {
+    let expected = offset_cleaned(outer, -distance / 2.0);
+    if expected.is_empty() {
+        return expected;
+    }
+    if inner.is_empty() {
+        return expected;
+    }
+    difference(
+        &expected,
+        &offset_cleaned(inner, distance / 2.0 + SAFETY_MM),
+    )
 }
 
 #[cfg(test)]
@@ -301,6 +376,59 @@ mod tests {
         assert_eq!(per.loops.len(), 2);
         assert!(per.loops.iter().all(|l| l.island == 1));
         assert_eq!(per.infill_area.len(), 1);
+    }
+
+    #[test]
+    fn a_strip_too_narrow_for_the_second_loop_leaves_a_centred_gap() {
+        // 1.3 mm wide: the external loop fits (its centreline area is 0.85 mm wide), the second
+        // loop does not (it needs 2 · (0.632 + 0.122) = 1.508 mm).
+        let strip = crate::region::test_util::rect_island(0.0, 0.0, 20.0, 1.3);
+        let params = RegionParams::default();
+        let per = make_perimeters(&[strip], &params, 0.2);
+        assert_eq!(per.loops.len(), 1);
+        assert!(per.infill_area.is_empty());
+        // The gap: the external loop's centreline area shrunk by half the loop distance.
+        let half = params.spacings(0.2).perimeter / 2.0;
+        let (x0, y0) = (0.225 + half, 0.225 + half);
+        assert_eq!(per.gaps.len(), 1);
+        assert_square_rect(&per.gaps[0], [x0, y0, 20.0 - x0, 1.3 - y0]);
+        // Without gap fill there is no gap.
+        let off = RegionParams {
+            gap_fill: false,
+            ..params
+        };
+        assert!(make_perimeters(&[per_strip()], &off, 0.2).gaps.is_empty());
+        // A wide square has none either: every loop is whole.
+        assert!(
+            make_perimeters(&[island_20()], &params, 0.2)
+                .gaps
+                .is_empty()
+        );
+    }
+
+    fn per_strip() -> ExPolygon {
+        crate::region::test_util::rect_island(0.0, 0.0, 20.0, 1.3)
+    }
+
+    /// `ex` is the axis-aligned rectangle `[x0, y0, x1, y1]` (mm) within 1 µm, without holes.
+    fn assert_square_rect(ex: &ExPolygon, r: [f64; 4]) {
+        assert!(ex.holes.is_empty());
+        let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+        for p in &ex.contour.points {
+            let (x, y) = (crate::geom::unscaled(p.x), crate::geom::unscaled(p.y));
+            lo = [lo[0].min(x), lo[1].min(y)];
+            hi = [hi[0].max(x), hi[1].max(y)];
+        }
+        let got = [lo[0], lo[1], hi[0], hi[1]];
+        for (g, w) in got.iter().zip(r) {
+            assert!((g - w).abs() < 1e-3, "{got:?} vs {r:?}");
+        }
+        let area = (r[2] - r[0]) * (r[3] - r[1]);
+        assert!(
+            (ex.area_mm2() - area).abs() < 1e-3,
+            "{} vs {area}",
+            ex.area_mm2()
+        );
     }
 
     #[test]

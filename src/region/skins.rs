@@ -9,9 +9,19 @@
 //! - **top zone** likewise with `I_(i+1) … I_(i+N_t)`, so the last `N_t` layers are solid.
 //!
 //! Roles: the part of `A_i` outside `I_(i+1)` (exposed to the top) is [`SolidRole::Top`]; the
-//! part outside `I_(i−1)` (over air or the bed) is [`SolidRole::Bottom`], which wins where both
-//! apply (it is printed on nothing and must bridge); the rest of the zones is
-//! [`SolidRole::Internal`].
+//! part outside `I_(i−1)` is [`SolidRole::Bridge`] (over air), or [`SolidRole::Bottom`] on the
+//! first layer (on the bed); bridges and bottoms win where top also applies (they are printed
+//! on nothing and must bridge); the rest of the zones is [`SolidRole::Internal`].
+//!
+//! **Small sparse areas.** Whatever sparse area is left in pieces smaller than
+//! `solid_infill_below_area` becomes internal solid (see [`RegionParams`]).
+//!
+//! **Internal bridges.** Internal solid infill directly over the sparse infill of the layer below
+//! spans the gaps between sparse lines (2 mm at 20 %) like a bridge. It becomes
+//! [`SolidRole::InternalBridge`]: round threads at the bridge spacing, as PrusaSlicer's
+//! "bridge over infill", so the first solid layer does not droop between the lines and the top
+//! surface above it comes out flat. Its lines keep the layer's own direction, which crosses the
+//! rectilinear sparse lines below at 90°.
 //!
 //! **Why islands, not infill areas, as cover.** Comparing infill areas would also count the ring
 //! under the perimeters of the layers above as "uncovered". On a sloped wall that ring is there on
@@ -41,31 +51,44 @@ use rayon::prelude::*;
 pub enum SolidRole {
     /// Visible upward-facing surface.
     Top,
-    /// Downward-facing surface over air or on the bed.
+    /// Downward-facing surface on the bed (the first layer).
     Bottom,
+    /// Downward-facing surface over air: drawn as threads spanning it, in the direction that
+    /// anchors them ([`super::bridge`]).
+    Bridge,
     /// Solid layers between a surface and sparse infill.
     Internal,
+    /// The internal solid directly over sparse infill, drawn as threads spanning the sparse
+    /// lines below.
+    InternalBridge,
 }
 
-/// A layer's infill area split by role. The four parts are disjoint and together make the infill
+/// A layer's infill area split by role. The six parts are disjoint and together make the infill
 /// area (up to the margins explained in the module docs).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SkinAreas {
-    /// Solid areas over air or the bed.
+    /// Solid areas on the bed (first layer only).
     pub bottom: Vec<ExPolygon>,
+    /// Solid areas over air.
+    pub bridge: Vec<ExPolygon>,
     /// Solid areas with nothing above.
     pub top: Vec<ExPolygon>,
     /// Other solid areas within the top/bottom solid layer counts.
     pub internal_solid: Vec<ExPolygon>,
+    /// Internal solid areas over the sparse infill of the layer below.
+    pub internal_bridge: Vec<ExPolygon>,
     /// The rest, filled with the sparse pattern.
     pub sparse: Vec<ExPolygon>,
 }
 
 impl SkinAreas {
-    /// The solid areas with their roles, in print order: bottom, internal, top.
-    pub fn solid(&self) -> [(SolidRole, &[ExPolygon]); 3] {
+    /// The solid areas with their roles, in print order: bottom, bridge, internal bridge,
+    /// internal, top.
+    pub fn solid(&self) -> [(SolidRole, &[ExPolygon]); 5] {
         [
             (SolidRole::Bottom, &self.bottom),
+            (SolidRole::Bridge, &self.bridge),
+            (SolidRole::InternalBridge, &self.internal_bridge),
             (SolidRole::Internal, &self.internal_solid),
             (SolidRole::Top, &self.top),
         ]
@@ -129,13 +152,48 @@ pub fn detect_skins(
         &islands[..count],
         params.bottom_solid_layers.max(params.top_solid_layers),
     );
-    (0..count)
+    let mut skins: Vec<SkinAreas> = (0..count)
         .into_par_iter()
         .map(|i| {
             let height = heights.get(i).copied().unwrap_or(params.layer_height);
             layer_skins(i, islands, infill, &windows, height, params)
         })
-        .collect()
+        .collect();
+    if params.infill_density > 0.0 && params.infill_density < 1.0 {
+        let split: Vec<Option<(Vec<ExPolygon>, Vec<ExPolygon>)>> = (1..skins.len())
+            .into_par_iter()
+            .map(|i| internal_bridge(&skins[i].internal_solid, &skins[i - 1].sparse, params))
+            .collect();
+        for (i, parts) in split.into_iter().enumerate() {
+            if let Some((bridge, rest)) = parts {
+                skins[i + 1].internal_bridge = bridge;
+                skins[i + 1].internal_solid = rest;
+            }
+        }
+    }
+    skins
+}
+
+/// `internal_solid` split into (the part over `sparse_below`, the rest), slivers under a
+/// quarter solid width left solid; `None` when nothing is over sparse infill.
+fn internal_bridge(
+    internal_solid: &[ExPolygon],
+    sparse_below: &[ExPolygon],
+    params: &RegionParams,
+) -> Option<(Vec<ExPolygon>, Vec<ExPolygon>)> {
+    if internal_solid.is_empty() || sparse_below.is_empty() {
+        return None;
+    }
+    let over = intersection(internal_solid, sparse_below);
+    if over.is_empty() {
+        return None;
+    }
+    let bridge = shrink_opened(&over, 0.0, params.solid_infill_width / 4.0);
+    if bridge.is_empty() {
+        return None;
+    }
+    let rest = difference(internal_solid, &bridge);
+    Some((bridge, rest))
 }
 
 /// Skin areas of layer `i` (< both lengths), `height` mm high; see [`detect_skins`].
@@ -203,6 +261,12 @@ fn layer_skins(
     if !top.is_empty() && !bottom.is_empty() {
         top = difference(&top, &bottom);
     }
+    let (bottom, bridge) = if i == 0 {
+        (bottom, Vec::new())
+    } else {
+        (Vec::new(), bottom)
+    };
+    let below: Vec<ExPolygon> = [bottom.as_slice(), bridge.as_slice()].concat();
     let zone_whole = zone_bottom_whole || zone_top_whole;
     let zone = if zone_whole {
         Vec::new()
@@ -214,7 +278,7 @@ fn layer_skins(
             (false, false) => union(&[zone_bottom, zone_top].concat()),
         }
     };
-    let surfaces: Vec<ExPolygon> = [bottom.as_slice(), top.as_slice()].concat();
+    let surfaces: Vec<ExPolygon> = [below.as_slice(), top.as_slice()].concat();
     let mut internal_solid = if zone_whole || !zone.is_empty() {
         limit(zone, zone_whole, band + margin)
     } else {
@@ -224,15 +288,30 @@ fn layer_skins(
         internal_solid = difference(&internal_solid, &surfaces);
     }
     let solid: Vec<ExPolygon> = [surfaces.as_slice(), internal_solid.as_slice()].concat();
-    let sparse = if solid.is_empty() {
+    let mut sparse = if solid.is_empty() {
         area.clone()
     } else {
         difference(area, &solid)
     };
+    let threshold = params.solid_infill_below_area;
+    if threshold > 0.0 && params.infill_density < 1.0 {
+        let (small, large): (Vec<ExPolygon>, Vec<ExPolygon>) =
+            sparse.into_iter().partition(|ex| ex.area_mm2() < threshold);
+        sparse = large;
+        if !small.is_empty() {
+            internal_solid = if internal_solid.is_empty() {
+                small
+            } else {
+                union(&[internal_solid, small].concat())
+            };
+        }
+    }
     SkinAreas {
         bottom,
+        bridge,
         top,
         internal_solid,
+        internal_bridge: Vec::new(),
         sparse,
     }
 }
@@ -261,7 +340,10 @@ mod tests {
         let skins = skins_of(&stack, &params);
         let infill_area = total_area(&make_perimeters(&stack[0], &params, 0.2).infill_area);
         for (i, s) in skins.iter().enumerate() {
-            let solid = total_area(&s.bottom) + total_area(&s.top) + total_area(&s.internal_solid);
+            let solid = total_area(&s.bottom)
+                + total_area(&s.top)
+                + total_area(&s.internal_solid)
+                + total_area(&s.internal_bridge);
             let sparse = total_area(&s.sparse);
             if (3..=6).contains(&i) {
                 assert!(
@@ -277,24 +359,40 @@ mod tests {
         }
         assert!((total_area(&skins[0].bottom) - infill_area).abs() < 1e-6);
         assert!((total_area(&skins[9].top) - infill_area).abs() < 1e-6);
-        for i in [1, 2, 7, 8] {
+        for i in [1, 2, 8] {
             assert!(
                 (total_area(&skins[i].internal_solid) - infill_area).abs() < 1e-6,
                 "{i}"
             );
         }
+        // The first solid layer over the sparse ones bridges the sparse lines.
+        assert!((total_area(&skins[7].internal_bridge) - infill_area).abs() < 1e-6);
+        assert!(
+            skins
+                .iter()
+                .enumerate()
+                .all(|(i, s)| s.internal_bridge.is_empty() == (i != 7))
+        );
     }
 
     #[test]
     fn step_makes_the_top_of_the_big_part_solid_up_to_under_the_step_edge() {
-        let params = RegionParams::default();
+        // A narrow margin and no small-area rule, so the ring's edges are measurable.
+        let params = RegionParams {
+            solid_infill_margin: 0.5,
+            solid_infill_below_area: 0.0,
+            ..Default::default()
+        };
         // Big 20 mm square for layers 0–5, small 10 mm square (5..15) for layers 6–11.
         let mut stack = vec![vec![square_island(0.0, 0.0, 20.0)]; 6];
         stack.extend(vec![vec![square_island(5.0, 5.0, 10.0)]; 6]);
         let skins = skins_of(&stack, &params);
         let at = |a: &[ExPolygon], x: f64, y: f64| contains(a, Point2::from_mm(x, y));
         let solid = |s: &SkinAreas, x, y| {
-            at(&s.top, x, y) || at(&s.internal_solid, x, y) || at(&s.bottom, x, y)
+            at(&s.top, x, y)
+                || at(&s.internal_solid, x, y)
+                || at(&s.internal_bridge, x, y)
+                || at(&s.bottom, x, y)
         };
         // The last big layer: the uncovered ring is a top surface.
         assert!(at(&skins[5].top, 2.0, 10.0));

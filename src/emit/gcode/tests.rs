@@ -583,10 +583,21 @@ fn built_program_round_trips_through_the_writer() {
     assert_eq!(stats.layers, 10);
     assert_eq!(text.matches(";LAYER_CHANGE\n").count(), 10);
     let (_, moves) = replay(&text);
+    // Flat beads 0.45 × 0.2, or round 0.4 mm threads on the internal bridge over the sparse
+    // infill (layer 7).
     let k = e_per_mm(0.45, 0.2, 1.75);
+    let k_bridge = 0.4 * 0.4 / (1.75 * 1.75);
+    let mut bridged = 0;
     for m in moves.iter().filter(|m| m.de > 0.0 && m.xy_len() > 0.5) {
-        assert!((m.de / m.xy_len() - k).abs() < 1e-4, "line {}", m.line);
+        let rate = m.de / m.xy_len();
+        if (rate - k_bridge).abs() < 1e-4 {
+            bridged += 1;
+            assert!((m.to[2] - 1.6).abs() < 1e-9, "line {}", m.line);
+        } else {
+            assert!((rate - k).abs() < 1e-4, "line {}", m.line);
+        }
     }
+    assert!(bridged > 10, "{bridged} bridge moves");
     // Everything stays inside the island.
     assert!(
         moves

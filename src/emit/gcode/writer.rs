@@ -8,7 +8,7 @@ use super::sink::{GcodeSink, Motion, MotionKind};
 use super::{EmitError, GcodeStats, ToolStats};
 use crate::config::{Config, ConfigError, ToolKind};
 use crate::geom::Point3;
-use crate::program::{BeadShape, Event, Feed, Layer, LayerItem, Program, Toolpath};
+use crate::program::{Event, Feed, Layer, LayerItem, Program, Toolpath};
 
 /// Layers printed faster than this (s) get the fan at `fan_max_speed` (PrusaSlicer's default
 /// `slowdown_below_layer_time`).
@@ -670,7 +670,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         let ts = &self.tools[tool];
         let e_per_mm = ts
             .feed
-            .e_per_mm(BeadShape::RoundedRectangle, path.width, path.height)
+            .e_per_mm(path.role.bead_shape(), path.width, path.height)
             .map(|e| e * ts.multiplier);
         let paste_on = ts.paste_on.clone();
         let paste_off = ts.paste_off.clone();
