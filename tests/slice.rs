@@ -1182,6 +1182,40 @@ fn bench_cube_with_prusaslicer_ini_matches_prusaslicer_filament() {
         (ours_mm - theirs_mm).abs() <= 0.05 * theirs_mm,
         "conduit uses {ours_mm:.1} mm, PrusaSlicer {theirs_mm:.1} mm"
     );
+
+    // Role by role (filament on moves with XY motion, so (de)retractions do not count): the
+    // same walls, the same skins grown 3 mm into the sparse infill, the same internal bridge
+    // over the sparse infill with round-thread flow, and sparse infill within 5 %.
+    let ours_text = std::fs::read_to_string(&ours_path).expect("our G-code readable");
+    let by_role = |text: &str| -> BTreeMap<String, f64> {
+        let mut sums = BTreeMap::new();
+        for m in replay(text)
+            .moves
+            .iter()
+            .filter(|m| m.extrudes() && m.xy_len() > 0.0)
+        {
+            *sums.entry(m.role.clone()).or_insert(0.0) += m.de;
+        }
+        sums
+    };
+    let (ours_roles, theirs_roles) = (by_role(&ours_text), by_role(&peer_text));
+    for (role, tolerance) in [
+        ("External perimeter", 0.01),
+        ("Perimeter", 0.01),
+        ("Solid infill", 0.01),
+        ("Top solid infill", 0.01),
+        ("Bridge infill", 0.01),
+        ("Internal infill", 0.05),
+    ] {
+        let (a, b) = (ours_roles.get(role), theirs_roles.get(role));
+        let (Some(&a), Some(&b)) = (a, b) else {
+            panic!("{role}: conduit {a:?} mm, PrusaSlicer {b:?} mm");
+        };
+        assert!(
+            (a - b).abs() <= tolerance * b,
+            "{role}: conduit {a:.1} mm, PrusaSlicer {b:.1} mm"
+        );
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

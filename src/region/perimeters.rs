@@ -221,9 +221,20 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
         if params.gap_fill
             && let Some((last, spacing)) = &previous
         {
-            // The strip a further loop would have filled, next to the infill.
-            let next = shrink_opened(last, *spacing, OPENING_FRACTION * spacing);
-            gaps.extend(gap_between(last, &next, *spacing));
+            // The strip a further loop would have filled, next to the infill: that loop's
+            // centreline area would be `last` shrunk by a spacing and opened by `r`, and its
+            // bead would cover that grown by half a spacing; both growths are taken at once.
+            let expected = offset_cleaned(last, -spacing / 2.0);
+            if !expected.is_empty() {
+                let r = OPENING_FRACTION * spacing;
+                let core = offset_cleaned(&expected, -(spacing / 2.0 + r));
+                if core.is_empty() {
+                    gaps.extend(expected);
+                } else {
+                    let covered = offset_cleaned(&core, r + spacing / 2.0 + SAFETY_MM);
+                    gaps.extend(difference(&expected, &covered));
+                }
+            }
         }
         let radius = OPENING_FRACTION * solid_spacing;
         let shrunk = shrink_from(island, base.as_ref(), inset + radius);
