@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Read throughput of the STL and 3MF readers on the 3DBenchy benchmark model.
+# Read throughput of the STL and 3MF readers on the 3DBenchy benchmark model, and the time of
+# the mesh topology check and repair.
 # usage: bench/read_throughput.sh [MODEL.stl]   (default ../shared/corpus/bench-models/3DBenchy.stl)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,9 +1,11 @@
 //! Read throughput of conduit's loaders: `cargo run --release --example read_throughput -- FILE...`.
 //!
 //! For each file: the bytes are read once into memory (page cache warm), then the format reader runs
-//! repeatedly on them; prints MB/s of the parse alone and of the full load (parse + indexed mesh).
+//! repeatedly on them; prints MB/s of the parse alone and of the full load (parse + indexed mesh),
+//! and for meshes the time of the topology check and of a repair (on a copy).
 
-use conduit::scene::{FileKind, LoadOptions, load};
+use conduit::geom::Tolerances;
+use conduit::scene::{FileKind, LoadOptions, load, load_scene};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -44,6 +46,20 @@ fn main() {
             mb / parse.as_secs_f64(),
             mb / full.as_secs_f64()
         );
+        if let Ok((scene, _)) = load_scene(&path, &LoadOptions::default()) {
+            for object in &scene.objects {
+                let mesh = &object.mesh;
+                let topology = time(|| mesh.topology());
+                let repair = time(|| mesh.clone().repair(&Tolerances::default()));
+                println!(
+                    "  {}: {} triangles, topology check {:.1} ms, repair (with a copy) {:.1} ms",
+                    object.name,
+                    mesh.triangles.len(),
+                    topology.as_secs_f64() * 1e3,
+                    repair.as_secs_f64() * 1e3
+                );
+            }
+        }
     }
 }
 

@@ -1245,49 +1245,6 @@ mod tests {
         assert!(compared > 0, "no reference was closed and outward");
     }
 
-    /// Times validation and repair on 3DBenchy (225 154 facets). Run with
-    /// `cargo test --release -p conduit --lib benchy -- --ignored --nocapture`.
-    #[test]
-    #[ignore = "timing; run in release"]
-    fn benchy_topology_timing() {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../shared/corpus/bench-models/3DBenchy.stl"
-        );
-        let Some(mesh) = load_stl(std::path::Path::new(path)) else {
-            println!("skipped: corpus not found");
-            return;
-        };
-        // Best of five: the machine may be busy with other builds.
-        let time = |f: &mut dyn FnMut()| {
-            (0..5)
-                .map(|_| {
-                    let start = std::time::Instant::now();
-                    f();
-                    start.elapsed()
-                })
-                .min()
-                .unwrap_or_default()
-        };
-        let report = mesh.topology();
-        let topology = time(&mut || {
-            std::hint::black_box(mesh.topology());
-        });
-        let mut repaired = mesh.clone();
-        let repair = repaired.repair(&Tolerances::default());
-        let repair_time = time(&mut || {
-            std::hint::black_box(mesh.clone().repair(&Tolerances::default()));
-        });
-        println!(
-            "{} triangles, {} vertices: topology {topology:?} {report:?}; repair (with a clone) \
-             {repair_time:?} {repair:?}; after {:?}",
-            mesh.triangles.len(),
-            mesh.vertices.len(),
-            repaired.topology()
-        );
-        assert_eq!(repaired.topology().orientation, Orientation::Outward);
-    }
-
     #[test]
     fn non_convex_hole_is_ear_clipped_inside_its_outline() {
         // An L-shaped hole in the top of an L-shaped prism: the fill must not cover the notch.
