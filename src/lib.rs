@@ -23,6 +23,7 @@
 //! The `conduit` binary (`src/main.rs`, `src/cli/`) turns command lines into calls of these modules.
 
 pub mod check;
+pub mod circuit;
 pub mod config;
 pub mod emit;
 pub mod geom;
@@ -30,5 +31,6 @@ pub mod mesh;
 pub mod pipeline;
 pub mod program;
 pub mod region;
+pub mod route;
 pub mod scene;
 pub mod slice;

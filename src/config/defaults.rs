@@ -48,6 +48,14 @@ const SECTION_DOCS: &[(&str, &str)] = &[
         "slice",
         "Slicing: layer heights, perimeters, infill, extrusion widths, speeds per role.",
     ),
+    (
+        "route",
+        "Electronics: part cavities, wire channels and conductive trace routing.",
+    ),
+    (
+        "pnp",
+        "Part placement: what the machine does to place a part.",
+    ),
 ];
 
 const KEYS: &[KeyDoc] = &[
@@ -392,6 +400,88 @@ const KEYS: &[KeyDoc] = &[
         "object_tools",
         "Tool of each scene object: object i prints with object_tools[i]; objects past the end \
          use tool 0.",
+    ),
+    k(
+        "route",
+        "conductive_tool",
+        "Tool that prints the conductive traces.",
+    ),
+    k(
+        "route",
+        "conductive_width",
+        "Width of a conductive trace, mm.",
+    ),
+    k(
+        "route",
+        "conductive_height",
+        "Height of a conductive trace, mm; 0 = the layer height.",
+    ),
+    k(
+        "route",
+        "channel_extra",
+        "Clearance of a channel beyond the trace width, mm.",
+    ),
+    k(
+        "route",
+        "cavity_offset",
+        "How far a part's cavity reaches beyond its pads and body, mm.",
+    ),
+    k(
+        "route",
+        "perimeters",
+        "Deflated perimeter traces the router may follow per layer.",
+    ),
+    k(
+        "route",
+        "perimeter_weights",
+        "Cost per mm on each deflated trace, outermost first (inner ones cheaper).",
+    ),
+    k(
+        "route",
+        "base_weight",
+        "Cost per mm of a straight section inside material.",
+    ),
+    k(
+        "route",
+        "outside_weight",
+        "Cost per mm of a straight section outside material or across a hole.",
+    ),
+    k(
+        "route",
+        "grid_step",
+        "Step of the grid explored in the infill area, mm.",
+    ),
+    k(
+        "route",
+        "interlayer_overlap",
+        "Overlap of the traces of two layers where a wire changes layer, mm.",
+    ),
+    k(
+        "route",
+        "layer_change_penalty",
+        "Extra cost of each layer change, mm of straight path.",
+    ),
+    k(
+        "route",
+        "pad_drops",
+        "A conductive drop on every pad, also on pins no net uses.",
+    ),
+    k(
+        "pnp",
+        "auto_gcode",
+        "G-code placing a part with the vacuum tool. Placeholders {id} {part} {x} {y} {z} \
+         {rotation}.",
+    ),
+    k(
+        "pnp",
+        "manual_gcode",
+        "G-code after `M117 Insert <part>` for a part inserted by hand; {pause} is the \
+         firmware's pause.",
+    ),
+    k(
+        "pnp",
+        "lift",
+        "How far the nozzle lifts above the layer before a part is placed, mm.",
     ),
 ];
 

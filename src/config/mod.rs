@@ -23,8 +23,9 @@
 //!
 //! Every key may be left out and takes its default; `conduit config --defaults` prints them all
 //! with their documentation ([`defaults_toml`]). Unknown keys are errors naming the key, so a
-//! typo never passes silently. Later sections (`[route]`, `[curve]`, `[conform]`, `[jet]`,
-//! `[pnp]`) will be added as fields of [`Config`] next to the three that exist now.
+//! typo never passes silently. `[route]` and `[pnp]` configure cavities, trace routing and part
+//! placement ([`RouteSettings`], [`PnpSettings`]); later sections (`[curve]`, `[conform]`,
+//! `[jet]`) will be added as fields of [`Config`] next to them.
 //!
 //! A `[tools.N]` table, when present, defines the tools: the tool numbers must run `0, 1, …`
 //! without gaps, and every key a table leaves out takes the default *of its kind*
@@ -37,10 +38,12 @@
 //! fan speeds in percent, densities in g/cm³, volumetric flows in mm³/s.
 
 mod defaults;
+mod electronics;
 pub mod prusa_ini;
 mod template;
 
 pub use defaults::defaults_toml;
+pub use electronics::{PnpSettings, RouteSettings};
 pub use prusa_ini::from_prusa_pairs;
 
 use std::collections::BTreeMap;
@@ -63,6 +66,10 @@ pub struct Config {
     pub tools: Vec<Tool>,
     /// Slicing settings (`[slice]`).
     pub slice: SliceSettings,
+    /// Cavities, channels and trace routing (`[route]`).
+    pub route: RouteSettings,
+    /// Part placement commands (`[pnp]`).
+    pub pnp: PnpSettings,
 }
 
 /// G-code dialect of the printer's firmware.
@@ -403,6 +410,8 @@ impl Default for Config {
             printer: Printer::default(),
             tools: vec![Tool::filament(), Tool::paste()],
             slice: SliceSettings::default(),
+            route: RouteSettings::default(),
+            pnp: PnpSettings::default(),
         }
     }
 }
@@ -598,6 +607,17 @@ impl Config {
                     self.tools.len()
                 ));
             }
+        }
+        problems.extend(self.route.problems());
+        if !(self.pnp.lift.is_finite() && self.pnp.lift >= 0.0) {
+            problems.push(format!("pnp.lift must be ≥ 0, got {}", self.pnp.lift));
+        }
+        if self.route.conductive_tool >= self.tools.len() {
+            problems.push(format!(
+                "route.conductive_tool = {}, but only tools 0..{} exist",
+                self.route.conductive_tool,
+                self.tools.len()
+            ));
         }
         problems.extend(
             self.slice

@@ -446,8 +446,32 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
     (skirt, groups)
 }
 
+/// What a layer gets besides its objects' regions: the part events that come before it and
+/// the paths printed after them (conductive traces, drops), keyed by the layer's print height on
+/// the nanometre grid (`scaled(z)`). Heights no object layer has are ignored.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LayerExtras {
+    /// Events at the start of the layer, in order (e.g. placing a part whose cavity is done).
+    pub events_before: BTreeMap<i64, Vec<Event>>,
+    /// Paths printed after the objects' paths, tool by tool in ascending order, each tool's in
+    /// the order given.
+    pub paths_after: BTreeMap<i64, Vec<Toolpath>>,
+}
+
 /// The [`Program`] printing `objects` (see the module docs).
 pub fn build_program(objects: &[ObjectLayers], params: &ProgramParams) -> Program {
+    build_program_with(objects, &LayerExtras::default(), params)
+}
+
+/// [`build_program`] plus `extras`: each layer starts with its events, then prints its objects
+/// as [`build_program`] does, then the extra paths. Extra paths come last so that a trace is
+/// laid into a channel whose walls are already printed; the next layer's plastic tool is
+/// selected again by a tool change as usual.
+pub fn build_program_with(
+    objects: &[ObjectLayers],
+    extras: &LayerExtras,
+    params: &ProgramParams,
+) -> Program {
     let mut by_z: BTreeMap<i64, Vec<Entry<'_>>> = BTreeMap::new();
     for (object, obj) in objects.iter().enumerate() {
         for (lz, regions) in &obj.layers {
@@ -462,7 +486,7 @@ pub fn build_program(objects: &[ObjectLayers], params: &ProgramParams) -> Progra
     let mut pos = params.start;
     let mut current_tool: Option<usize> = None;
     let mut layers = Vec::with_capacity(by_z.len());
-    for (index, entries) in by_z.into_values().enumerate() {
+    for (index, (z_key, entries)) in by_z.into_iter().enumerate() {
         let z = entries.first().map_or(0.0, |e| e.top);
         let height = entries.iter().map(|e| e.regions.height).fold(0.0, f64::max);
         let mut tools: Vec<usize> = entries.iter().map(|e| e.tool).collect();
@@ -474,7 +498,14 @@ pub fn build_program(objects: &[ObjectLayers], params: &ProgramParams) -> Progra
             let t = tools.remove(i);
             tools.insert(0, t);
         }
-        let mut items = Vec::new();
+        let mut items: Vec<LayerItem> = extras
+            .events_before
+            .get(&z_key)
+            .into_iter()
+            .flatten()
+            .cloned()
+            .map(LayerItem::Event)
+            .collect();
         for tool in tools {
             let tp = params.tool(tool);
             let mut skirts = Vec::new();
@@ -505,6 +536,23 @@ pub fn build_program(objects: &[ObjectLayers], params: &ProgramParams) -> Progra
             current_tool = Some(tool);
             pos = end;
             items.extend(paths.into_iter().map(LayerItem::Path));
+        }
+        if let Some(extra) = extras.paths_after.get(&z_key) {
+            let mut extra_tools: Vec<usize> = extra.iter().map(|p| p.tool).collect();
+            extra_tools.sort_unstable();
+            extra_tools.dedup();
+            for tool in extra_tools {
+                if current_tool.is_some_and(|c| c != tool) {
+                    items.push(LayerItem::Event(Event::ToolChange { tool }));
+                }
+                current_tool = Some(tool);
+                for path in extra.iter().filter(|p| p.tool == tool) {
+                    if let Some(end) = path.end() {
+                        pos = *end;
+                    }
+                    items.push(LayerItem::Path(path.clone()));
+                }
+            }
         }
         layers.push(Layer {
             index,

@@ -16,7 +16,10 @@ pub mod extrusion;
 pub mod order;
 pub mod toolpath;
 
-pub use build::{ObjectLayers, ProgramParams, RoleSpeeds, ToolPathParams, build_program};
+pub use build::{
+    LayerExtras, ObjectLayers, ProgramParams, RoleSpeeds, ToolPathParams, build_program,
+    build_program_with,
+};
 pub use extrusion::{BeadShape, Feed, bead_area, e_per_mm, filament_area};
 pub use order::{Group, OrderParams, SeamRule, order_groups, order_paths, travel_length};
 pub use toolpath::{Event, Layer, LayerItem, Program, Role, Toolpath};

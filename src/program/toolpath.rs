@@ -190,6 +190,8 @@ pub enum Event {
     },
     /// Pick part `part` and place it at the given pose (machine frame, before tool offsets).
     PickAndPlace {
+        /// 1-based number of the part in placement order (what `M361 P<id>` names).
+        id: usize,
         /// Part name (reference designator, e.g. `R1`).
         part: String,
         /// X of the part centre, mm.

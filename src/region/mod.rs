@@ -23,6 +23,7 @@
 //! Spacings follow the flow model documented in [`params`].
 
 pub mod bridge;
+pub mod cavity;
 pub mod gapfill;
 pub mod infill;
 pub mod params;

@@ -537,6 +537,7 @@ fn events_become_markers_pauses_and_dwells() {
         LayerItem::Event(Event::Comment("two\nlines".to_owned())),
         LayerItem::Event(Event::Dwell { seconds: 1.5 }),
         LayerItem::Event(Event::PickAndPlace {
+            id: 1,
             part: "R1".to_owned(),
             x: 12.5,
             y: 3.0,
@@ -550,9 +551,15 @@ fn events_become_markers_pauses_and_dwells() {
     ]);
     let (text, _) = write(&program, &test_config());
     assert!(text.contains("; two\n; lines\nG4 P1500\n"), "{text}");
-    assert!(text.contains(";PICK_AND_PLACE PART=R1 X=12.5 Y=3 Z=2.4 ROTATION=90\n"));
+    // Marker, lift 10 mm over the layer (0.2), the OctoPNP command, the tool again.
     assert!(
-        text.contains(";MANUAL_INSERT PART=U1\nM0 insert U1  pin 1 top-left\n"),
+        text.contains(
+            ";PICK_AND_PLACE PART=R1 X=12.5 Y=3 Z=2.4 ROTATION=90\nG1 E6.46488 F2100\nG1 Z10.2 F7800\nM361 P1\nT0\n"
+        ),
+        "{text}"
+    );
+    assert!(
+        text.contains(";MANUAL_INSERT PART=U1\nM117 Insert U1\nM0 insert U1  pin 1 top-left\nT0\n"),
         "{text}"
     );
 }

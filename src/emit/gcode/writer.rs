@@ -332,7 +332,22 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
     fn travel_to(&mut self, target: Point3) {
         let speed = self.cfg.printer.travel_speed;
         let Some(cur) = self.pos else {
-            // Position unknown after the start G-code: Z first, then XY.
+            // Position unknown (after the start G-code or a part placement). Above the target:
+            // XY first, then down, so the nozzle does not come down over a placed part.
+            if self.z.is_some_and(|z| z > target.z) {
+                let f = self.feed_word(speed).unwrap_or_default();
+                self.line(&format!(
+                    "G1 X{} Y{}{f}",
+                    fmt_xyz(target.x),
+                    fmt_xyz(target.y)
+                ));
+                let over = Point3::new(target.x, target.y, self.z.unwrap_or(target.z));
+                self.motion(MotionKind::Travel, over, 0.0, speed, None);
+                self.pos = Some(over);
+                self.move_z(target.z);
+                return;
+            }
+            // Otherwise Z first, then XY.
             self.move_z(target.z);
             let f = self.feed_word(speed).unwrap_or_default();
             self.line(&format!(
@@ -741,30 +756,44 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                 self.tool_change(*tool)?;
             }
             Event::PickAndPlace {
+                id,
                 part,
                 x,
                 y,
                 z,
                 rotation_deg,
             } => {
-                self.retract();
+                let name = one_line(part).replace(' ', "_");
                 self.line(&format!(
-                    ";PICK_AND_PLACE PART={} X={} Y={} Z={} ROTATION={}",
-                    one_line(part).replace(' ', "_"),
+                    ";PICK_AND_PLACE PART={name} X={} Y={} Z={} ROTATION={}",
                     fmt_xyz(*x),
                     fmt_xyz(*y),
                     fmt_xyz(*z),
                     fmt_xyz(*rotation_deg)
                 ));
+                let fill = |t: &str| {
+                    t.replace("{id}", &id.to_string())
+                        .replace("{part}", &name)
+                        .replace("{x}", &fmt_xyz(*x))
+                        .replace("{y}", &fmt_xyz(*y))
+                        .replace("{z}", &fmt_xyz(*z))
+                        .replace("{rotation}", &fmt_xyz(*rotation_deg))
+                };
+                let snippet = fill(&self.cfg.pnp.auto_gcode);
+                self.part_event(&snippet);
             }
             Event::ManualInsertPause { part, message } => {
-                self.retract();
-                self.line(&format!(
-                    ";MANUAL_INSERT PART={}",
-                    one_line(part).replace(' ', "_")
-                ));
-                let lines = self.dialect.pause(one_line(message).trim());
-                self.lines(&lines);
+                let name = one_line(part).replace(' ', "_");
+                self.line(&format!(";MANUAL_INSERT PART={name}"));
+                self.line(&format!("M117 Insert {name}"));
+                let pause = self.dialect.pause(one_line(message).trim()).join("\n");
+                let snippet = self
+                    .cfg
+                    .pnp
+                    .manual_gcode
+                    .replace("{part}", &name)
+                    .replace("{pause}", &pause);
+                self.part_event(&snippet);
             }
             Event::Comment(text) => {
                 for l in text.lines() {
@@ -779,6 +808,28 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             }
         }
         Ok(())
+    }
+
+    /// Around a part placement: retract, lift `pnp.lift` above the current layer, the
+    /// `snippet` (one line per `\n`), then the active tool selected again. The head's XY is
+    /// unknown afterwards, so the next travel goes over at the lifted height before coming down
+    /// (see [`Self::travel_to`]).
+    fn part_event(&mut self, snippet: &str) {
+        self.retract();
+        // Over the layer, never lower than the nozzle already is.
+        let lifted = (self.layer_z + self.cfg.pnp.lift.max(0.0)).max(self.z.unwrap_or(0.0));
+        self.move_z(lifted);
+        let lines: Vec<String> = snippet
+            .replace("{lift_z}", &fmt_xyz(lifted))
+            .split("\n")
+            .flat_map(|l| l.lines().map(str::to_owned).collect::<Vec<_>>())
+            .filter(|l| !l.trim().is_empty())
+            .collect();
+        self.lines(&lines);
+        if let Some(tool) = self.tool {
+            self.line(&format!("T{tool}"));
+        }
+        self.pos = None;
     }
 
     pub fn finish(&mut self, program: &Program) -> Result<GcodeStats, EmitError> {

@@ -1,0 +1,209 @@
+//! Pick-and-place files: KiCad position CSV and OpenPnP board XML.
+//!
+//! Part of conduit's `formats/` layer, used by the emit stage: beside the G-code, the pipeline
+//! writes where each component goes, so that the vacuum nozzle (or an assembly house) can place
+//! it. The crate only describes the files and has no dependency on the pipeline.
+//!
+//! - [`write_kicad_pos`] / [`read_kicad_pos`]: KiCad's "Generate Placement Files" CSV
+//!   (`Ref,Val,Package,PosX,PosY,Rot,Side`) plus conduit's trailing `PosZ` column for parts
+//!   seated inside a printed object. The reader also takes KiCad's own files without `PosZ`.
+//! - [`write_openpnp_board`] / [`read_openpnp_board`]: an OpenPnP `*.board.xml`
+//!   (`<openpnp-board version="1.1">`, placements version 1.4).
+//!
+//! Output is deterministic (same records, same bytes): `\n` line endings, every number with
+//! 4 decimals in millimetres or degrees, rotations normalised to `[0, 360)`. Writers refuse
+//! NaN and infinite numbers with [`std::io::ErrorKind::InvalidInput`]; readers never panic.
+//!
+//! ```
+//! use conduit_pnp::{PlacementRecord, Side};
+//! let r = PlacementRecord {
+//!     reference: "R1".into(), value: "10k".into(), package: "R_0603".into(),
+//!     x: 12.5, y: -3.0, z: 1.2, rotation_deg: -90.0, side: Side::Top,
+//! };
+//! let mut csv = Vec::new();
+//! conduit_pnp::write_kicad_pos(&[r], &mut csv)?;
+//! assert_eq!(
+//!     String::from_utf8_lossy(&csv),
+//!     "Ref,Val,Package,PosX,PosY,Rot,Side,PosZ\n\
+//!      \"R1\",\"10k\",\"R_0603\",12.5000,-3.0000,270.0000,top,1.2000\n"
+//! );
+//! # Ok::<(), std::io::Error>(())
+//! ```
+
+mod kicad;
+mod openpnp;
+#[cfg(test)]
+mod tests;
+
+pub use kicad::{read_kicad_pos, write_kicad_pos};
+pub use openpnp::{read_openpnp_board, write_openpnp_board};
+
+use std::io;
+
+/// One component placement, in millimetres and degrees.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlacementRecord {
+    /// Reference designator, e.g. `R1`.
+    pub reference: String,
+    /// Component value, e.g. `10k`.
+    pub value: String,
+    /// Package (footprint) name, e.g. `R_0603`.
+    pub package: String,
+    /// X of the component centre, mm.
+    pub x: f64,
+    /// Y of the component centre, mm (Y up, as in KiCad's placement files).
+    pub y: f64,
+    /// Z of the seating plane, mm (0 on a flat board; higher inside a printed object).
+    pub z: f64,
+    /// Rotation about Z, degrees counter-clockwise.
+    pub rotation_deg: f64,
+    /// Board side the component sits on.
+    pub side: Side,
+}
+
+impl PlacementRecord {
+    /// OpenPnP part id, `PACKAGE-VALUE`, as OpenPnP's own KiCad importer builds it.
+    pub fn part_id(&self) -> String {
+        format!("{}-{}", self.package, self.value)
+    }
+}
+
+/// Board side of a placement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// Top (front, `F.Cu`) side.
+    Top,
+    /// Bottom (back, `B.Cu`) side.
+    Bottom,
+}
+
+/// Errors of the readers. CSV errors carry the 1-based line of the row; XML errors name the
+/// element and the 1-based line of its start tag.
+///
+/// # How to fix
+/// The file is not one these writers (or KiCad / OpenPnP) produced, or was edited by hand:
+/// correct the named line or element, or export the file again.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PnpError {
+    /// The first CSV row is not KiCad's header (with or without `PosZ`).
+    #[error(
+        "line {line}: expected header `Ref,Val,Package,PosX,PosY,Rot,Side[,PosZ]`, found `{found}`"
+    )]
+    CsvHeader {
+        /// Line of the header row.
+        line: usize,
+        /// The header as found (fields joined with `,`).
+        found: String,
+    },
+    /// A CSV row has a different number of fields than the header.
+    #[error("line {line}: expected {expected} fields, found {found}")]
+    CsvFieldCount {
+        /// Line where the row starts.
+        line: usize,
+        /// Number of header columns.
+        expected: usize,
+        /// Number of fields in the row.
+        found: usize,
+    },
+    /// A quoted CSV field is not closed before the end of the input.
+    #[error("line {line}: quoted field is never closed")]
+    CsvUnclosedQuote {
+        /// Line where the row starts.
+        line: usize,
+    },
+    /// A CSV field has a value that its column does not accept.
+    #[error("line {line}: column {column}: invalid value `{value}`")]
+    CsvValue {
+        /// Line where the row starts.
+        line: usize,
+        /// Header name of the column.
+        column: &'static str,
+        /// The field as found.
+        value: String,
+    },
+    /// The XML is not well formed.
+    #[error("line {line}: XML error: {source}")]
+    Xml {
+        /// Line where the parser stopped.
+        line: usize,
+        /// The parser's error.
+        #[source]
+        source: quick_xml::Error,
+    },
+    /// The root element is not `<openpnp-board>`.
+    #[error("not an OpenPnP board: root element is <{found}>, expected <openpnp-board>")]
+    NotABoard {
+        /// Name of the root element found (empty if there is none).
+        found: String,
+    },
+    /// The input ends inside an element.
+    #[error("unexpected end of file inside <{element}>")]
+    UnexpectedEof {
+        /// The innermost open element.
+        element: String,
+    },
+    /// An element lacks a required attribute or child.
+    #[error("line {line}: <{element}> has no {missing}")]
+    Missing {
+        /// The element, e.g. `placement id="R1"`.
+        element: String,
+        /// Line of its start tag.
+        line: usize,
+        /// What is missing, e.g. `attribute \`side\`` or `<location>`.
+        missing: &'static str,
+    },
+    /// An attribute has a value that OpenPnP does not write.
+    #[error("line {line}: <{element}>: attribute `{attribute}` has invalid value `{value}`")]
+    InvalidAttribute {
+        /// The element, e.g. `location of R1`.
+        element: String,
+        /// Line of its start tag.
+        line: usize,
+        /// Attribute name.
+        attribute: &'static str,
+        /// The value as found.
+        value: String,
+    },
+}
+
+/// Formats a length or angle with the crate's fixed 4 decimals, refusing NaN and infinities.
+fn fixed4(v: f64) -> io::Result<String> {
+    if !v.is_finite() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("cannot write non-finite number {v} to a placement file"),
+        ));
+    }
+    let s = format!("{v:.4}");
+    // Values in (-0.00005, 0] round to "-0.0000"; write them as "0.0000".
+    Ok(match s.strip_prefix('-') {
+        Some(abs) if abs.bytes().all(|b| b == b'0' || b == b'.') => abs.to_owned(),
+        _ => s,
+    })
+}
+
+/// `deg` in `[0, 360)` after rounding to 4 decimals (so 359.99999 becomes 0, not 360).
+fn normalized_rotation(deg: f64) -> f64 {
+    let r = deg.rem_euclid(360.0);
+    if (r * 1e4).round() >= 360.0 * 1e4 {
+        0.0
+    } else {
+        r
+    }
+}
+
+/// Parses a finite number (`NaN` and `inf`, which Rust would accept, are refused).
+fn parse_finite(s: &str) -> Option<f64> {
+    s.trim().parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+/// 1-based line of byte offset `pos` in `text`.
+fn line_of(text: &str, pos: u64) -> usize {
+    let end = usize::try_from(pos).unwrap_or(usize::MAX).min(text.len());
+    text.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}

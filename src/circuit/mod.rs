@@ -1,0 +1,1 @@
+//! Circuits, part placement and rubberbands: the inputs of the route stage.

@@ -1,0 +1,137 @@
+//! The electronics sections of the configuration: `[route]` (cavities, channels and trace
+//! routing) and `[pnp]` (what the machine does to place a part).
+//!
+//! Place in the pipeline: read with the rest of [`super::Config`]; the pipeline hands `[route]`
+//! to the cavity and routing stages and `[pnp]` to the G-code writer's part events.
+
+use serde::{Deserialize, Serialize};
+
+/// Cavities, channels and trace routing (`[route]`). Lengths in mm.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RouteSettings {
+    /// Tool that prints the conductive traces. Default 1.
+    pub conductive_tool: usize,
+    /// Width of a conductive trace, mm. Default 0.6.
+    pub conductive_width: f64,
+    /// Height of a conductive trace, mm (the layer height when 0). Default 0.
+    pub conductive_height: f64,
+    /// Extra clearance of a channel beyond the trace width (Δ), mm: a channel is the trace grown
+    /// by `(conductive_width + channel_extra) / 2` on each side. Default 0.2.
+    pub channel_extra: f64,
+    /// How far a part's cavity reaches beyond its pads and body, mm. Default 0.3.
+    pub cavity_offset: f64,
+    /// Number of deflated perimeter traces the router may follow per layer. Default 3.
+    pub perimeters: usize,
+    /// Cost per mm on the deflated traces, outermost first; decreasing inward so inner traces
+    /// are preferred. Default [3, 2, 1].
+    pub perimeter_weights: Vec<f64>,
+    /// Cost per mm of a straight section inside material. Default 1.
+    pub base_weight: f64,
+    /// Cost per mm of a straight section outside material or across a hole. Default 100.
+    pub outside_weight: f64,
+    /// Step of the grid explored inside the infill area, mm. Default 1.
+    pub grid_step: f64,
+    /// Overlap of a trace with the one of the next layer where a wire changes layer, mm (the
+    /// "staircase" that connects them). Default 2.
+    pub interlayer_overlap: f64,
+    /// Extra cost of each layer change, in mm of base-weight path. Default 5.
+    pub layer_change_penalty: f64,
+    /// Put a conductive drop (a small disc of trace) on every pad, also on pins no net uses,
+    /// so a part's leads sit in paste. Default false.
+    pub pad_drops: bool,
+}
+
+impl Default for RouteSettings {
+    fn default() -> Self {
+        Self {
+            conductive_tool: 1,
+            conductive_width: 0.6,
+            conductive_height: 0.0,
+            channel_extra: 0.2,
+            cavity_offset: 0.3,
+            perimeters: 3,
+            perimeter_weights: vec![3.0, 2.0, 1.0],
+            base_weight: 1.0,
+            outside_weight: 100.0,
+            grid_step: 1.0,
+            interlayer_overlap: 2.0,
+            layer_change_penalty: 5.0,
+            pad_drops: false,
+        }
+    }
+}
+
+impl RouteSettings {
+    /// Every problem with these settings, as `route.<key>: ...` lines.
+    pub fn problems(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (key, v) in [
+            ("conductive_width", self.conductive_width),
+            ("grid_step", self.grid_step),
+            ("interlayer_overlap", self.interlayer_overlap),
+            ("base_weight", self.base_weight),
+            ("outside_weight", self.outside_weight),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                out.push(format!("route.{key} must be > 0, got {v}"));
+            }
+        }
+        for (key, v) in [
+            ("conductive_height", self.conductive_height),
+            ("channel_extra", self.channel_extra),
+            ("cavity_offset", self.cavity_offset),
+            ("layer_change_penalty", self.layer_change_penalty),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                out.push(format!("route.{key} must be ≥ 0, got {v}"));
+            }
+        }
+        if self.perimeter_weights.len() < self.perimeters {
+            out.push(format!(
+                "route.perimeter_weights has {} weights for {} perimeters",
+                self.perimeter_weights.len(),
+                self.perimeters
+            ));
+        }
+        if let Some(w) = self
+            .perimeter_weights
+            .iter()
+            .find(|w| !(w.is_finite() && **w > 0.0))
+        {
+            out.push(format!("route.perimeter_weights must all be > 0, got {w}"));
+        }
+        out
+    }
+}
+
+/// What the machine does to place a part (`[pnp]`).
+///
+/// Before either snippet the writer retracts and lifts the nozzle `lift` mm above the layer
+/// about to be printed; after it, it re-selects the active tool and comes back down only once it
+/// is over the next path.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PnpSettings {
+    /// G-code for a part placed by the vacuum tool (`method = "auto"`). Placeholders: `{id}`
+    /// (1-based part number in placement order), `{part}`, `{x}`, `{y}`, `{z}` (seating plane),
+    /// `{rotation}`. Default `M361 P{id}`, the command OctoPNP answers.
+    pub auto_gcode: String,
+    /// G-code after the `M117 Insert <part>` message of a part inserted by hand
+    /// (`method = "manual"`). Placeholders as in `auto_gcode`, plus `{pause}`: the firmware's
+    /// pause with the message (`M0` on Marlin, `M291` on RepRapFirmware, `PAUSE` on Klipper).
+    /// Default `{pause}`.
+    pub manual_gcode: String,
+    /// How far the nozzle lifts above the layer before a part is placed, mm. Default 10.
+    pub lift: f64,
+}
+
+impl Default for PnpSettings {
+    fn default() -> Self {
+        Self {
+            auto_gcode: "M361 P{id}".to_owned(),
+            manual_gcode: "{pause}".to_owned(),
+            lift: 10.0,
+        }
+    }
+}

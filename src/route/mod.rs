@@ -1,0 +1,1 @@
+//! Trace routing: weighted A* on per-layer perimeter graphs.
