@@ -123,23 +123,34 @@ pub struct SliceSummary {
 /// bed (objects keep their positions relative to each other, as a 3MF build arranges them) and each
 /// object is dropped so its lowest point touches the bed.
 pub fn place_on_bed(scene: &Scene, cfg: &Config) -> Vec<Mesh> {
+    place_on_bed_with_offsets(scene, cfg).0
+}
+
+/// [`place_on_bed`], also returning each object's translation from scene (build) coordinates to
+/// bed coordinates, mm: what part placements given in model coordinates must be moved by.
+pub fn place_on_bed_with_offsets(scene: &Scene, cfg: &Config) -> (Vec<Mesh>, Vec<[f64; 3]>) {
     let mut meshes = placed_meshes(scene);
     let Some(all) = meshes
         .iter()
         .filter_map(Mesh::bounding_box)
         .reduce(|a, b| a.union(&b))
     else {
-        return meshes;
+        let none = vec![[0.0; 3]; meshes.len()];
+        return (meshes, none);
     };
     let p = &cfg.printer;
     let dx = p.bed_origin[0] + p.bed_size[0] / 2.0 - (all.min[0] + all.max[0]) / 2.0;
     let dy = p.bed_origin[1] + p.bed_size[1] / 2.0 - (all.min[1] + all.max[1]) / 2.0;
+    let mut offsets = Vec::with_capacity(meshes.len());
     for m in &mut meshes {
-        if let Some(bb) = m.bounding_box() {
-            m.transform(&Transform::translation(dx, dy, -bb.min[2]));
-        }
+        let offset = match m.bounding_box() {
+            Some(bb) => [dx, dy, -bb.min[2]],
+            None => [dx, dy, 0.0],
+        };
+        m.transform(&Transform::translation(offset[0], offset[1], offset[2]));
+        offsets.push(offset);
     }
-    meshes
+    (meshes, offsets)
 }
 
 /// Runs the whole planar pipeline on a scene; `progress` is told when each stage starts.

@@ -456,6 +456,9 @@ pub struct LayerExtras {
     /// Paths printed after the objects' paths, tool by tool in ascending order, each tool's in
     /// the order given.
     pub paths_after: BTreeMap<i64, Vec<Toolpath>>,
+    /// Events at the end of the layer, after its paths (e.g. placing a part that stands above
+    /// the last layer).
+    pub events_after: BTreeMap<i64, Vec<Event>>,
 }
 
 /// The [`Program`] printing `objects` (see the module docs).
@@ -553,6 +556,9 @@ pub fn build_program_with(
                     items.push(LayerItem::Path(path.clone()));
                 }
             }
+        }
+        if let Some(events) = extras.events_after.get(&z_key) {
+            items.extend(events.iter().cloned().map(LayerItem::Event));
         }
         layers.push(Layer {
             index,
@@ -676,6 +682,60 @@ mod tests {
                 .iter()
                 .all(|l| l.items.iter().all(|i| matches!(i, LayerItem::Path(_))))
         );
+    }
+
+    #[test]
+    fn extras_come_before_and_after_the_layer_with_tool_changes_back_and_forth() {
+        let plastic = object(0, vec![square(0.0, 0.0, 20.0)], 3, &RegionParams::default());
+        let z1 = plastic.layers[1].0.top;
+        let trace = Toolpath {
+            points: vec![Point3::new(2.0, 10.0, z1), Point3::new(18.0, 10.0, z1)],
+            closed: false,
+            role: Role::ConductiveTrace,
+            tool: 1,
+            width: 0.6,
+            height: 0.2,
+            speed: 10.0,
+            tool_axis: None,
+        };
+        let mut extras = LayerExtras::default();
+        extras
+            .events_before
+            .insert(scaled(z1), vec![Event::Comment("before".to_owned())]);
+        extras.paths_after.insert(scaled(z1), vec![trace.clone()]);
+        extras
+            .events_after
+            .insert(scaled(z1), vec![Event::Comment("after".to_owned())]);
+        // A height no layer has is ignored.
+        extras.paths_after.insert(scaled(99.0), vec![trace.clone()]);
+        let program = build_program_with(&[plastic], &extras, &ProgramParams::default());
+        let items = &program.layers[1].items;
+        assert_eq!(
+            items.first(),
+            Some(&LayerItem::Event(Event::Comment("before".to_owned())))
+        );
+        let n = items.len();
+        assert_eq!(
+            items[n - 3..],
+            [
+                LayerItem::Event(Event::ToolChange { tool: 1 }),
+                LayerItem::Path(trace),
+                LayerItem::Event(Event::Comment("after".to_owned())),
+            ]
+        );
+        // The next layer goes back to the plastic tool before its first path.
+        assert_eq!(
+            program.layers[2].items.first(),
+            Some(&LayerItem::Event(Event::ToolChange { tool: 0 }))
+        );
+        assert_eq!(program.tools_used(), vec![0, 1]);
+        let changes = program
+            .layers
+            .iter()
+            .flat_map(|l| &l.items)
+            .filter(|i| matches!(i, LayerItem::Event(Event::ToolChange { .. })))
+            .count();
+        assert_eq!(changes, 2);
     }
 
     #[test]
