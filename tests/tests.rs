@@ -5,6 +5,7 @@
 
 mod cli;
 mod conformance;
+mod electronics;
 mod preview;
 mod roundtrip;
 mod slice;

@@ -54,9 +54,17 @@ pub struct SliceArgs {
     /// The G-code file to write.
     #[arg(short, long, value_name = "OUT.gcode")]
     pub output: PathBuf,
-    /// Also write a JSON report (objects, layers, filament, time, stage timings).
+    /// Also write a JSON report (objects, layers, filament, time, stage timings; with a circuit
+    /// also parts and, per wire, routed/length/lower bound/layer changes/perimeter crossings).
     #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
+    /// Circuit to build into the object: an EAGLE schematic or board (.sch, .brd). Needs
+    /// `--placement`. Also writes OUT.pos (KiCad position CSV with PosZ) and OUT.openpnp.xml.
+    #[arg(long, value_name = "X.sch|X.brd", requires = "placement")]
+    pub circuit: Option<PathBuf>,
+    /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.
+    #[arg(long, value_name = "P.toml|P.3de", requires = "circuit")]
+    pub placement: Option<PathBuf>,
 }
 
 /// Arguments of `conduit check`.

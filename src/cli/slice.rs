@@ -2,7 +2,9 @@
 
 use super::{Failure, args::SliceArgs, config::resolve};
 use anyhow::Context;
-use conduit::pipeline::{Stage, slice_scene};
+use conduit::circuit::{Circuit, Placement};
+use conduit::pipeline::electronics::pnp_records;
+use conduit::pipeline::{Electronics, Stage, slice_scene_with};
 use conduit::scene::{LoadOptions, Scene, load_scene, write_atomically};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{IsTerminal, Write};
@@ -18,15 +20,38 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         }
         scene.objects.extend(s.objects);
     }
+    let electronics = match (&args.circuit, &args.placement) {
+        (Some(c), Some(p)) => Some(Electronics {
+            circuit: Circuit::load(c).map_err(anyhow::Error::from)?,
+            placement: Placement::load(p).map_err(anyhow::Error::from)?,
+        }),
+        _ => None,
+    };
     let bar = stage_bar();
-    let (gcode, _program, summary) = slice_scene(&scene, &cfg, |stage| {
-        bar.set_position(stage as u64);
-        bar.set_message(stage.name());
-    })
-    .with_context(|| format!("slicing {}", args.models[0].display()))?;
+    let (gcode, _program, summary) =
+        slice_scene_with(&scene, &cfg, electronics.as_ref(), |stage| {
+            bar.set_position(stage as u64);
+            bar.set_message(stage.name());
+        })
+        .with_context(|| format!("slicing {}", args.models[0].display()))?;
     bar.finish_and_clear();
     write_atomically(&args.output, |f| f.write_all(&gcode))
         .with_context(|| format!("{}: cannot write G-code", args.output.display()))?;
+    if let Some(e) = &electronics {
+        let records = pnp_records(&e.circuit, &summary.parts);
+        let pos = args.output.with_extension("pos");
+        write_atomically(&pos, |f| conduit_pnp::write_kicad_pos(&records, f))
+            .with_context(|| format!("{}: cannot write positions", pos.display()))?;
+        let xml = args.output.with_extension("openpnp.xml");
+        let name = args
+            .output
+            .file_stem()
+            .map_or_else(|| "board".to_owned(), |s| s.to_string_lossy().into_owned());
+        write_atomically(&xml, |f| {
+            conduit_pnp::write_openpnp_board(&name, &records, f)
+        })
+        .with_context(|| format!("{}: cannot write OpenPnP board", xml.display()))?;
+    }
     if let Some(report) = &args.report {
         let json = serde_json::to_vec_pretty(&summary).context("serialising the report")?;
         write_atomically(report, |f| f.write_all(&json))
@@ -40,6 +65,19 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         total,
         summary.gcode.estimated_time_s / 60.0
     );
+    if let Some(r) = &summary.electronics {
+        eprintln!(
+            "{} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
+            r.parts.len(),
+            r.routed,
+            r.routed + r.unrouted,
+            r.total_length,
+            r.total_lower_bound
+        );
+        for w in r.wires.iter().filter(|w| !w.routed) {
+            eprintln!("warning: net {} could not be routed", w.net);
+        }
+    }
     Ok(())
 }
 

@@ -612,13 +612,6 @@ impl Config {
         if !(self.pnp.lift.is_finite() && self.pnp.lift >= 0.0) {
             problems.push(format!("pnp.lift must be ≥ 0, got {}", self.pnp.lift));
         }
-        if self.route.conductive_tool >= self.tools.len() {
-            problems.push(format!(
-                "route.conductive_tool = {}, but only tools 0..{} exist",
-                self.route.conductive_tool,
-                self.tools.len()
-            ));
-        }
         problems.extend(
             self.slice
                 .region

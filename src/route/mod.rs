@@ -1,1 +1,297 @@
-//! Trace routing: weighted A* on per-layer perimeter graphs.
+//! Conductive trace routing through a sliced object: weighted A* on per-layer perimeter graphs.
+//!
+//! Place in the pipeline: after slicing and regions (the object's islands per layer, with
+//! cavities for parts already removed), before the Program. Input is one [`RouteLayer`] per
+//! layer and the [`Wire`]s (rubberbands) of the circuit; output ([`RouteResult`]) is, per wire,
+//! the conductive trace as 3D polylines per layer, and, per layer, the channels the caller carves
+//! from the plastic regions before the conductive material is printed into them.
+//!
+//! The method is topology-aware routing for FDM-printed electronics:
+//!
+//! 1. **Routing graph per layer** (`graph.rs`): the layer islands shrunk by
+//!    `i·perimeter_width + (conductive_width + channel_extra)/2` for `i = 1..=perimeters` give the
+//!    *deflated perimeter traces*, closed chains of vertices weighted by `perimeter_weights[i-1]`
+//!    per mm (decreasing inward, so routes hug the inner traces and stay clear of the outer
+//!    walls); the wire's own rubberband projected into the layer (the *direct connection*) is
+//!    split where it meets those rings and weighted `base_weight` inside the material and
+//!    `outside_weight` across holes and notches; the innermost deflated area (the *infill
+//!    region*) is explored lazily on a grid of 45° steps during the search.
+//! 2. **Inter-layer connections** (`interlayer.rs`): a route may change layer where its last
+//!    `interlayer_overlap + grid_step` millimetres can be printed on the neighbour layer too; that
+//!    piece is printed on both layers (the staircase overlap), so the traces of consecutive layers
+//!    touch over at least `interlayer_overlap` mm.
+//! 3. **A\*** (`astar.rs`) per wire, steppable ([`Search::step`]), deterministic.
+//! 4. **Collisions and order** (`order.rs`, `channels.rs`): wires are routed one after another,
+//!    fewest rubberband collisions first, then shortest; each routed wire's channel becomes a hole
+//!    in the islands of the following wires of other nets (new perimeter traces form around it)
+//!    and a keep-out for their direct connections.
+//!
+//! Units: millimetres in the public types, nanometre integers ([`Point2`]) inside.
+
+mod astar;
+mod channels;
+mod graph;
+mod index;
+mod interlayer;
+mod order;
+mod trace;
+
+#[cfg(test)]
+mod tests;
+
+pub use astar::{Search, SearchState, route_wire};
+pub use channels::trace_channel;
+pub use order::{collision_counts, wire_order};
+
+use crate::geom::{ExPolygon, Point2, Point3, difference, union};
+use graph::LayerInput;
+
+/// One planar layer as the router sees it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteLayer {
+    /// Top of the layer, mm: traces are printed at this z.
+    pub z: f64,
+    /// Layer height, mm: the layer spans `z - height .. z`.
+    pub height: f64,
+    /// Material of this layer where a channel may be carved (cavities already removed).
+    pub islands: Vec<ExPolygon>,
+}
+
+/// One connection to route: a rubberband between two pads of one net.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Wire {
+    /// Net name. Wires of one net may touch each other; wires of different nets never do.
+    pub net: String,
+    /// Start pad, mm.
+    pub from: Point3,
+    /// End pad, mm.
+    pub to: Point3,
+}
+
+/// Parameters of the router. Lengths in mm; weights are cost multipliers per mm of trace.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteParams {
+    /// Number of deflated perimeter traces per layer (default 3).
+    pub perimeters: usize,
+    /// Perimeter extrusion width, mm (default 0.45).
+    pub perimeter_width: f64,
+    /// Width of the conductive trace, mm (default 0.6).
+    pub conductive_width: f64,
+    /// Δ: clearance added to the conductive width to make the channel, mm (default 0.2). The
+    /// channel is the trace grown by `(conductive_width + channel_extra) / 2`.
+    pub channel_extra: f64,
+    /// Cost multiplier per mm along deflated perimeter trace `i = 1..=perimeters` (outermost
+    /// first), decreasing inward so inner traces are preferred and the outer walls stay intact
+    /// (default `[3.0, 2.0, 1.0]`). Traces past the end of the list use its last value (1.0 if
+    /// empty).
+    pub perimeter_weights: Vec<f64>,
+    /// Cost multiplier per mm of direct connections inside the material and of infill grid edges
+    /// and staircase overlaps (default 1.0).
+    pub base_weight: f64,
+    /// Cost multiplier per mm of direct connections outside the material: across holes and notches
+    /// of one island (default 100, so a route crosses a hole only when going around costs more
+    /// than 100 times the crossing). Gaps between separate islands are never bridged.
+    pub outside_weight: f64,
+    /// Step of the lazily explored infill grid, mm (default 1.0).
+    pub grid_step: f64,
+    /// Minimum xy overlap of the traces of two consecutive layers at a layer change, mm
+    /// (default 2.0).
+    pub interlayer_overlap: f64,
+    /// Fixed cost of one layer change, in mm-equivalents (default 5.0).
+    pub layer_change_penalty: f64,
+    /// Safety cap on A* expansions per wire; a wire that needs more is reported unrouted
+    /// (default 2 000 000).
+    pub max_expansions: usize,
+    /// Vertices of neighbouring layers closer than this (mm) are snapped to one xy, and points
+    /// this close to a region's boundary count as on it (default 0.05 mm: a tenth of a trace
+    /// width, far above the nanometre rounding of intersection points).
+    pub align_tolerance: f64,
+}
+
+impl Default for RouteParams {
+    fn default() -> Self {
+        Self {
+            perimeters: 3,
+            perimeter_width: 0.45,
+            conductive_width: 0.6,
+            channel_extra: 0.2,
+            perimeter_weights: vec![3.0, 2.0, 1.0],
+            base_weight: 1.0,
+            outside_weight: 100.0,
+            grid_step: 1.0,
+            interlayer_overlap: 2.0,
+            layer_change_penalty: 5.0,
+            max_expansions: 2_000_000,
+            align_tolerance: 0.05,
+        }
+    }
+}
+
+impl RouteParams {
+    /// Half the channel width, mm: `(conductive_width + channel_extra) / 2`.
+    pub fn channel_half_width(&self) -> f64 {
+        (self.conductive_width + self.channel_extra) / 2.0
+    }
+
+    /// Weight per mm of deflated perimeter trace `i` (1-based).
+    pub fn perimeter_weight(&self, i: usize) -> f64 {
+        self.perimeter_weights
+            .get(i.saturating_sub(1))
+            .or(self.perimeter_weights.last())
+            .copied()
+            .unwrap_or(1.0)
+    }
+}
+
+/// The route of one wire.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WireRoute {
+    /// Net of the wire.
+    pub net: String,
+    /// Whether a route was found. Unrouted wires have no segments and zero length.
+    pub routed: bool,
+    /// The trace, one polyline per visit of a layer: (layer index, points at the layer's z).
+    /// At a layer change the last `≥ interlayer_overlap` mm of one segment are repeated at the
+    /// start of the next (the staircase overlap).
+    pub segments: Vec<(usize, Vec<Point3>)>,
+    /// Length of the conductor's centreline from pad to pad, mm, in 3D: layer changes add their
+    /// z step, staircase overlaps are counted once.
+    pub length: f64,
+    /// Straight 3D distance between the pads, mm: no route is shorter.
+    pub lower_bound: f64,
+    /// Number of layer changes.
+    pub layer_changes: usize,
+    /// Crossings of the route with the layers' original island boundaries (outer perimeters and
+    /// hole walls): each outside section of a route adds two.
+    pub perimeter_crossings: usize,
+}
+
+/// Routes of all wires and the channels to carve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteResult {
+    /// One route per wire, in input order.
+    pub wires: Vec<WireRoute>,
+    /// Per layer (same indices as the input layers), the union of the channels of all routed
+    /// wires: regions to carve from the plastic before the conductive material fills them.
+    pub channels: Vec<Vec<ExPolygon>>,
+}
+
+/// Heights closer than this (mm) count as equal when a pad is matched to a layer: float noise in
+/// layer tops computed as sums of heights, far below any layer height.
+const Z_TOLERANCE_MM: f64 = 1e-6;
+
+/// Index of the layer for a pad at height `z`: the layer whose range `z - height ..= z` holds it,
+/// else the nearest one; a pad on the boundary of two layers (within 1e-6 mm) belongs to the
+/// lower one, whose top it sits on. `None` when there are no layers.
+pub fn layer_of(layers: &[RouteLayer], z: f64) -> Option<usize> {
+    layers
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let outside = if z > l.z {
+                z - l.z
+            } else {
+                (l.z - l.height - z).max(0.0)
+            };
+            ((outside - Z_TOLERANCE_MM).max(0.0), (z - l.z).abs(), i)
+        })
+        .min_by(|a, b| {
+            a.0.total_cmp(&b.0)
+                .then(a.1.total_cmp(&b.1))
+                .then(a.2.cmp(&b.2))
+        })
+        .map(|(_, _, i)| i)
+}
+
+/// A routed wire's channel and keep-out on one layer.
+struct Placed {
+    net: String,
+    channel: Vec<ExPolygon>,
+    keep_out: Vec<ExPolygon>,
+}
+
+/// Routes every wire through the layers, in the order of [`wire_order`], each wire avoiding the
+/// channels of the wires of other nets routed before it. Wires that cannot be routed are
+/// reported with `routed = false`; routing goes on with the others.
+pub fn route(layers: &[RouteLayer], wires: &[Wire], params: &RouteParams) -> RouteResult {
+    let half = params.channel_half_width();
+    let keep_out_radius = channels::keep_out_radius(params);
+    let mut placed: Vec<Vec<Placed>> = (0..layers.len()).map(|_| Vec::new()).collect();
+    // Pads of every wire: other nets' pads are holes for a wire, so no trace runs over them.
+    let pads: Vec<(usize, &str, Point2)> = wires
+        .iter()
+        .flat_map(|w| [(w, w.from), (w, w.to)])
+        .filter_map(|(w, p)| {
+            layer_of(layers, p.z).map(|l| (l, w.net.as_str(), Point2::from_mm(p.x, p.y)))
+        })
+        .collect();
+    let mut routes: Vec<Option<WireRoute>> = vec![None; wires.len()];
+    for i in wire_order(wires, params) {
+        let wire = &wires[i];
+        let Some(range) = astar::layer_range(layers, wire) else {
+            routes[i] = Some(trace::unrouted(wire));
+            continue;
+        };
+        let inputs: Vec<LayerInput> = range
+            .map(|l| {
+                let mut holes: Vec<ExPolygon> = Vec::new();
+                let mut blocked: Vec<ExPolygon> = Vec::new();
+                for p in placed[l].iter().filter(|p| p.net != wire.net) {
+                    holes.extend(p.channel.iter().cloned());
+                    blocked.extend(p.keep_out.iter().cloned());
+                }
+                for &(_, _, at) in pads
+                    .iter()
+                    .filter(|(pl, net, _)| *pl == l && *net != wire.net)
+                {
+                    holes.extend(channels::disc(at, half));
+                    blocked.extend(channels::disc(at, keep_out_radius));
+                }
+                let original = layers[l].islands.clone();
+                let islands = if holes.is_empty() {
+                    original.clone()
+                } else {
+                    difference(&original, &union(&holes))
+                };
+                LayerInput {
+                    index: l,
+                    z: layers[l].z,
+                    islands,
+                    original,
+                    blocked: if blocked.is_empty() {
+                        blocked
+                    } else {
+                        union(&blocked)
+                    },
+                }
+            })
+            .collect();
+        let mut search = Search::with_layers(inputs, layers, wire, params);
+        while search.step() == SearchState::Running {}
+        let result = search.result();
+        for (l, points) in &result.segments {
+            let xy: Vec<Point2> = points.iter().map(|p| Point2::from_mm(p.x, p.y)).collect();
+            placed[*l].push(Placed {
+                net: wire.net.clone(),
+                channel: channels::polyline_channel(&xy, half),
+                keep_out: channels::polyline_channel(&xy, keep_out_radius),
+            });
+        }
+        routes[i] = Some(result);
+    }
+    let channels = placed
+        .iter()
+        .map(|ps| {
+            let all: Vec<ExPolygon> = ps.iter().flat_map(|p| p.channel.iter().cloned()).collect();
+            if all.is_empty() { all } else { union(&all) }
+        })
+        .collect();
+    RouteResult {
+        wires: routes
+            .into_iter()
+            .zip(wires)
+            .map(|(r, w)| r.unwrap_or_else(|| trace::unrouted(w)))
+            .collect(),
+        channels,
+    }
+}

@@ -1,16 +1,22 @@
-//! The planar pipeline as one walk: Scene → placed on the bed → slice → regions → Program → G-code.
+//! The planar pipeline as one walk: Scene → placed on the bed → slice → (electronics: cavities,
+//! routing, channels) → regions → Program → G-code.
 //!
 //! [`Stage`] names the steps in order (for progress reporting); [`slice_scene`] runs them and
-//! returns the G-code bytes with a [`SliceSummary`] for the report.
+//! returns the G-code bytes with a [`SliceSummary`] for the report; [`slice_scene_with`] adds a
+//! circuit ([`electronics`]).
+
+pub mod electronics;
+
+pub use electronics::{Electronics, ElectronicsReport};
 
 use crate::config::Config;
 use crate::emit::gcode::{GcodeStats, write_gcode};
-use crate::geom::{BoundingBox, Transform};
+use crate::geom::{BoundingBox, ExPolygon, Transform};
 use crate::mesh::Mesh;
-use crate::program::{ObjectLayers, Program, ProgramParams, build_program};
+use crate::program::{LayerExtras, ObjectLayers, Program, ProgramParams, build_program_with};
 use crate::region::{RegionError, make_regions_with_heights};
 use crate::scene::{Scene, placed_meshes};
-use crate::slice::{SliceParams, SliceReport, slice_mesh};
+use crate::slice::{LayerZ, SliceParams, SliceReport, slice_mesh};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -22,6 +28,8 @@ pub enum Stage {
     Place,
     /// Meshes cut into layers of regions with holes.
     Slice,
+    /// Parts placed, cavities carved, wires routed (only with a circuit).
+    Route,
     /// Perimeters, skins, infill and skirt per layer.
     Regions,
     /// Toolpaths and events ordered into a Program.
@@ -32,9 +40,10 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage in order.
-    pub const ALL: [Stage; 5] = [
+    pub const ALL: [Stage; 6] = [
         Stage::Place,
         Stage::Slice,
+        Stage::Route,
         Stage::Regions,
         Stage::Program,
         Stage::Emit,
@@ -45,6 +54,7 @@ impl Stage {
         match self {
             Stage::Place => "placing",
             Stage::Slice => "slicing",
+            Stage::Route => "routing",
             Stage::Regions => "regions",
             Stage::Program => "toolpaths",
             Stage::Emit => "writing G-code",
@@ -91,6 +101,9 @@ pub enum PipelineError {
     /// Writing G-code failed.
     #[error("{0}")]
     Emit(#[from] crate::emit::gcode::EmitError),
+    /// The circuit's placement does not fit.
+    #[error("{0}")]
+    Electronics(#[from] electronics::ElectronicsError),
 }
 
 /// What slicing one object found.
@@ -117,6 +130,12 @@ pub struct SliceSummary {
     pub gcode: GcodeStats,
     /// Wall time per stage in seconds, in stage order.
     pub stage_seconds: Vec<(Stage, f64)>,
+    /// Parts, wires and routing totals, when a circuit was given.
+    pub electronics: Option<ElectronicsReport>,
+    /// The placed parts (bed coordinates), when a circuit was given: what the pick-and-place
+    /// files list.
+    #[serde(skip)]
+    pub parts: Vec<crate::circuit::PlacedPart>,
 }
 
 /// Places every object of the scene on the bed: the scene's combined footprint is centred on the
@@ -157,6 +176,17 @@ pub fn place_on_bed_with_offsets(scene: &Scene, cfg: &Config) -> (Vec<Mesh>, Vec
 pub fn slice_scene(
     scene: &Scene,
     cfg: &Config,
+    progress: impl FnMut(Stage),
+) -> Result<(Vec<u8>, Program, SliceSummary), PipelineError> {
+    slice_scene_with(scene, cfg, None, progress)
+}
+
+/// [`slice_scene`] with an optional circuit: its parts get cavities and placement events, its
+/// nets are routed as conductive traces in carved channels on `route.conductive_tool`.
+pub fn slice_scene_with(
+    scene: &Scene,
+    cfg: &Config,
+    circuit: Option<&Electronics>,
     mut progress: impl FnMut(Stage),
 ) -> Result<(Vec<u8>, Program, SliceSummary), PipelineError> {
     if scene.triangle_count() == 0 {
@@ -170,7 +200,16 @@ pub fn slice_scene(
     };
 
     progress(Stage::Place);
-    let meshes = place_on_bed(scene, cfg);
+    let model_boxes: Vec<BoundingBox> = placed_meshes(scene)
+        .iter()
+        .map(|m| {
+            m.bounding_box().unwrap_or(BoundingBox {
+                min: [0.0; 3],
+                max: [0.0; 3],
+            })
+        })
+        .collect();
+    let (meshes, offsets) = place_on_bed_with_offsets(scene, cfg);
     check_fits(&meshes, cfg)?;
     lap(Stage::Place, &mut times);
 
@@ -183,6 +222,31 @@ pub fn slice_scene(
         .map(|m| (m.name.clone(), m.bounding_box()))
         .collect();
     lap(Stage::Slice, &mut times);
+
+    // Electronics: parts on the bed, then per object cavities, routes and channels.
+    let mut extras = LayerExtras::default();
+    let mut parts = Vec::new();
+    let mut report = None;
+    let mut sliced = sliced;
+    if let Some(e) = circuit {
+        progress(Stage::Route);
+        let placed = electronics::place_circuit(e, &model_boxes, &offsets, cfg)?;
+        let mut r = ElectronicsReport::default();
+        for (i, (layers, _)) in sliced.iter_mut().enumerate() {
+            let zs: Vec<LayerZ> = layers.iter().map(|l| l.z).collect();
+            let mut islands: Vec<Vec<ExPolygon>> = layers
+                .iter_mut()
+                .map(|l| std::mem::take(&mut l.islands))
+                .collect();
+            electronics::object_stage(i, &mut islands, &zs, &placed, cfg, &mut extras, &mut r);
+            for (l, isl) in layers.iter_mut().zip(islands) {
+                l.islands = isl;
+            }
+        }
+        report = Some(r);
+        parts = placed.parts;
+        lap(Stage::Route, &mut times);
+    }
 
     progress(Stage::Regions);
     let mut objects = Vec::with_capacity(sliced.len());
@@ -214,7 +278,7 @@ pub fn slice_scene(
     lap(Stage::Regions, &mut times);
 
     progress(Stage::Program);
-    let program = build_program(&objects, &ProgramParams::from_config(cfg));
+    let program = build_program_with(&objects, &extras, &ProgramParams::from_config(cfg));
     drop(objects);
     lap(Stage::Program, &mut times);
 
@@ -228,6 +292,8 @@ pub fn slice_scene(
         layers: program.layers.len(),
         gcode: stats,
         stage_seconds: times,
+        electronics: report,
+        parts,
     };
     Ok((gcode, program, summary))
 }

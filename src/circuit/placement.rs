@@ -1,0 +1,753 @@
+//! Placement: where each part sits in the printed object, how it gets there, and optional wire
+//! waypoints. An input of the route stage, read from a TOML file, from Electronic Slic3r's
+//! `.3de` XML, or projected from an EAGLE board.
+//!
+//! The TOML form:
+//!
+//! ```toml
+//! origin = "model"        # or "bbox_center", see [`Origin`]
+//! source = "led_coin.sch" # optional: the circuit this placement belongs to
+//!
+//! [[part]]
+//! name = "R1"
+//! x = 10.0
+//! y = 5.0
+//! z = 3.0                 # seating plane: the bottom of the part
+//! rotation = 90.0         # degrees about +z, counter-clockwise seen from above
+//! tilt = [0.0, 0.0]       # optional, degrees about x and y
+//! method = "auto"         # auto | manual | none
+//! body_height = 1.6       # mm above the seating plane
+//! object = 0              # scene object index
+//!
+//! [[net]]
+//! name = "VCC"
+//! waypoints = [{ name = "w1", x = 0.0, y = 0.0, z = 2.0 }]
+//! wires = [["R1.1", "w1"], ["w1", "LED1.A"]]
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::{Circuit, PinRef};
+
+/// What part and waypoint coordinates are relative to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Origin {
+    /// Model coordinates of the part's object (the frame of its mesh file).
+    #[default]
+    Model,
+    /// `x`, `y` from the centre of the object's bounding box and `z` from its bottom (minimum
+    /// z), in model coordinates. This is Electronic Slic3r's frame: it centres each object on
+    /// the bed and stands it on z = 0, so its `.3de` positions use it.
+    BboxCenter,
+}
+
+/// How a part gets into the object when the print pauses for it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlacingMethod {
+    /// Picked and placed by the machine.
+    #[default]
+    Auto,
+    /// The print pauses and a person inserts the part.
+    Manual,
+    /// Not inserted during the print (the cavity and wires are still made).
+    None,
+}
+
+/// When the conductive ink reaches the part's pads (Electronic Slic3r's `connectionMethod`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Connection {
+    /// No special connection step: the traces end on the pads.
+    #[default]
+    None,
+    /// Drops on the pads in the first layer above the seating plane.
+    Layer,
+    /// Drops on the pads once the print has passed the top of the part.
+    Part,
+}
+
+/// The pose of one part.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartPlacement {
+    /// Part name, as in the circuit.
+    pub name: String,
+    /// Position of the package origin in mm, frame given by [`Placement::origin`].
+    pub x: f64,
+    /// See `x`.
+    pub y: f64,
+    /// Seating plane in mm: the bottom of the part, where its pads sit.
+    pub z: f64,
+    /// Rotation about +z in degrees, counter-clockwise seen from above.
+    #[serde(default)]
+    pub rotation: f64,
+    /// Rotations about x and y in degrees, applied after `rotation`: a point turns by
+    /// `Rx(tilt[0]) · Ry(tilt[1]) · Rz(rotation)`, as Electronic Slic3r turns its part meshes.
+    #[serde(default)]
+    pub tilt: [f64; 2],
+    /// EAGLE's mirror (a bottom-side part): package x is negated before rotating.
+    #[serde(default)]
+    pub mirror: bool,
+    /// How the part is inserted.
+    #[serde(default)]
+    pub method: PlacingMethod,
+    /// When the ink reaches its pads.
+    #[serde(default)]
+    pub connection: Connection,
+    /// Height of the part above the seating plane in mm (0: unknown).
+    #[serde(default)]
+    pub body_height: f64,
+    /// Thickness of the pad layer at the bottom of the part in mm, part of `body_height`
+    /// (Electronic Slic3r's `footprintHeight`).
+    #[serde(default)]
+    pub footprint_height: f64,
+    /// Width (package x) and length (package y) of the body in mm, centred on the package
+    /// origin, when known.
+    #[serde(default)]
+    pub body_size: Option<[f64; 2]>,
+    /// Index of the scene object the part sits in.
+    #[serde(default)]
+    pub object: usize,
+}
+
+/// A named point a wire passes through.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Waypoint {
+    /// Name, unique within the net; may not contain `.`.
+    pub name: String,
+    /// Position in mm, frame given by [`Placement::origin`].
+    pub x: f64,
+    /// See `x`.
+    pub y: f64,
+    /// See `x`.
+    pub z: f64,
+    /// Index of the scene object whose frame `x`, `y`, `z` are in.
+    #[serde(default)]
+    pub object: usize,
+}
+
+/// One end of a wire: `"PART.PAD"` (split at the first `.`) or a waypoint name (no `.`).
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(from = "String")]
+pub enum Endpoint {
+    /// A pad of a part. The pad may also be named by its schematic pin (see
+    /// [`super::Part::pad`]).
+    Pin(PinRef),
+    /// A waypoint of the same net.
+    Waypoint(String),
+}
+
+impl From<String> for Endpoint {
+    fn from(s: String) -> Self {
+        match s.split_once('.') {
+            Some((part, pad)) => Endpoint::Pin(PinRef::new(part, pad)),
+            None => Endpoint::Waypoint(s),
+        }
+    }
+}
+
+impl std::fmt::Display for Endpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Endpoint::Pin(p) => p.fmt(f),
+            Endpoint::Waypoint(w) => f.write_str(w),
+        }
+    }
+}
+
+/// Routing hints for one net. A net with wires is connected exactly by them; a net without is
+/// connected by a minimum spanning tree (see [`super::rubberbands`]).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NetRouting {
+    /// Net name, as in the circuit.
+    pub name: String,
+    /// Points the wires pass through.
+    #[serde(default)]
+    pub waypoints: Vec<Waypoint>,
+    /// Wires as pairs of endpoints.
+    #[serde(default)]
+    pub wires: Vec<[Endpoint; 2]>,
+}
+
+/// Where the parts of a circuit sit and how the nets run.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Placement {
+    /// The frame of all coordinates.
+    #[serde(default)]
+    pub origin: Origin,
+    /// The circuit file this placement was made for, relative to the placement file.
+    #[serde(default)]
+    pub source: Option<String>,
+    /// Part poses, `[[part]]` in TOML. Circuit parts not listed are not placed.
+    #[serde(default, rename = "part")]
+    pub parts: Vec<PartPlacement>,
+    /// Net routing hints, `[[net]]` in TOML.
+    #[serde(default, rename = "net")]
+    pub nets: Vec<NetRouting>,
+}
+
+/// One thing wrong in a placement, found by [`Placement::validate`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Problem {
+    /// A placed part the circuit does not have.
+    UnknownPart {
+        /// Part name.
+        part: String,
+    },
+    /// A part placed more than once.
+    DuplicatePart {
+        /// Part name.
+        part: String,
+    },
+    /// A net the circuit does not have.
+    UnknownNet {
+        /// Net name.
+        net: String,
+    },
+    /// A net listed more than once.
+    DuplicateNet {
+        /// Net name.
+        net: String,
+    },
+    /// A wire end naming a part or pad that does not exist.
+    UnknownPin {
+        /// Net name.
+        net: String,
+        /// The endpoint as written.
+        pin: String,
+    },
+    /// A wire end on a pad of another net.
+    PinNotOnNet {
+        /// Net name.
+        net: String,
+        /// The endpoint as written.
+        pin: String,
+    },
+    /// A wire end naming a waypoint the net does not define.
+    UnknownWaypoint {
+        /// Net name.
+        net: String,
+        /// Waypoint name.
+        name: String,
+    },
+    /// A waypoint name used twice in a net, or containing `.`.
+    BadWaypointName {
+        /// Net name.
+        net: String,
+        /// Waypoint name.
+        name: String,
+    },
+    /// A coordinate or size that is not a finite number, or a negative size.
+    BadNumber {
+        /// What it belongs to, e.g. `part "R1"`.
+        item: String,
+        /// The key.
+        key: &'static str,
+    },
+}
+
+impl std::fmt::Display for Problem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Problem::UnknownPart { part } => {
+                write!(f, "placement: part \"{part}\" is not in the circuit")
+            }
+            Problem::DuplicatePart { part } => {
+                write!(f, "placement: part \"{part}\" is placed more than once")
+            }
+            Problem::UnknownNet { net } => {
+                write!(f, "placement: net \"{net}\" is not in the circuit")
+            }
+            Problem::DuplicateNet { net } => {
+                write!(f, "placement: net \"{net}\" is listed more than once")
+            }
+            Problem::UnknownPin { net, pin } => write!(f, "net {net}: pin {pin} does not exist"),
+            Problem::PinNotOnNet { net, pin } => {
+                write!(f, "net {net}: pin {pin} is not on this net")
+            }
+            Problem::UnknownWaypoint { net, name } => {
+                write!(f, "net {net}: waypoint \"{name}\" is not defined")
+            }
+            Problem::BadWaypointName { net, name } => write!(
+                f,
+                "net {net}: waypoint name \"{name}\" is used twice or contains '.'"
+            ),
+            Problem::BadNumber { item, key } => write!(
+                f,
+                "placement: {item}: {key} must be a finite number (and not negative for sizes)"
+            ),
+        }
+    }
+}
+
+/// Why a placement could not be read or used.
+///
+/// # How to fix
+/// File errors name the file and line; [`PlacementError::Invalid`] lists every part, net, pin
+/// and waypoint that does not match the circuit: fix the names in the placement file (part
+/// names as in the schematic, pins as `PART.PAD`).
+#[derive(Debug, thiserror::Error)]
+pub enum PlacementError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file name ends in neither `.toml` nor `.3de`.
+    #[error("{path}: unknown placement format; expected a .toml or .3de file")]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Invalid TOML, or a key that is unknown, missing or of the wrong type.
+    #[error("line {line}: {message}")]
+    Toml {
+        /// 1-based line (0 when the parser gives no position).
+        line: usize,
+        /// The parser's message, naming the key.
+        message: String,
+    },
+    /// An invalid `.3de` document.
+    #[error("line {line}: {message}")]
+    ThreeDe {
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// An error in the file `path`.
+    #[error("{path}: {source}")]
+    WithPath {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        #[source]
+        source: Box<PlacementError>,
+    },
+    /// The placement does not match the circuit.
+    #[error("{}", .0.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "))]
+    Invalid(Vec<Problem>),
+    /// A part or waypoint in an object the scene does not have.
+    #[error("{item}: object {object} does not exist (the scene has {count})")]
+    NoSuchObject {
+        /// What sits in it, e.g. `part "R1"`.
+        item: String,
+        /// The object index.
+        object: usize,
+        /// The number of objects.
+        count: usize,
+    },
+    /// Waypoints relative to bounding boxes where model coordinates are needed.
+    #[error(
+        "net {net}: waypoints are relative to the object bounding box; resolve the placement with Placement::to_model first"
+    )]
+    NotResolved {
+        /// Net name.
+        net: String,
+    },
+}
+
+impl Placement {
+    /// Reads a placement by file extension: `.toml` or `.3de`.
+    ///
+    /// # Errors
+    /// [`PlacementError::WithPath`] around the parse error, or [`PlacementError::Io`] /
+    /// [`PlacementError::UnknownFormat`].
+    pub fn load(path: &Path) -> Result<Self, PlacementError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let parse: fn(&str) -> Result<Self, PlacementError> = match ext.as_deref() {
+            Some("toml") => Self::from_toml,
+            Some("3de") => Self::from_3de,
+            _ => {
+                return Err(PlacementError::UnknownFormat {
+                    path: path.to_path_buf(),
+                });
+            }
+        };
+        let text = std::fs::read_to_string(path).map_err(|source| PlacementError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        parse(&text).map_err(|e| PlacementError::WithPath {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        })
+    }
+
+    /// Parses the TOML form (see the module documentation). Unknown keys are errors.
+    pub fn from_toml(text: &str) -> Result<Self, PlacementError> {
+        toml::from_str(text).map_err(|e: toml::de::Error| {
+            let before = |at: usize| &text.as_bytes()[..at.min(text.len())];
+            PlacementError::Toml {
+                line: e.span().map_or(0, |s| {
+                    before(s.start).iter().filter(|&&c| c == b'\n').count() + 1
+                }),
+                message: e.message().trim().to_owned(),
+            }
+        })
+    }
+
+    /// The elements of an EAGLE board as parts lying on the plane `z`, shifted by `offset`
+    /// (mm, added to the board x, y) in model coordinates. Rotation and mirror (bottom-side
+    /// elements) come from the element; heights are unknown (0) and the nets get no hints.
+    pub fn from_board(board: &conduit_eagle::Board, z: f64, offset: [f64; 2]) -> Self {
+        let parts = board
+            .elements
+            .iter()
+            .map(|e| PartPlacement {
+                name: e.name.clone(),
+                x: e.x + offset[0],
+                y: e.y + offset[1],
+                z,
+                rotation: e.rotation.degrees,
+                tilt: [0.0; 2],
+                mirror: e.rotation.mirror,
+                method: PlacingMethod::Auto,
+                connection: Connection::None,
+                body_height: 0.0,
+                footprint_height: 0.0,
+                body_size: None,
+                object: 0,
+            })
+            .collect();
+        Placement {
+            parts,
+            ..Placement::default()
+        }
+    }
+
+    /// The pose of part `name`.
+    pub fn part(&self, name: &str) -> Option<&PartPlacement> {
+        self.parts.iter().find(|p| p.name == name)
+    }
+
+    /// The routing hints of net `name`.
+    pub fn net(&self, name: &str) -> Option<&NetRouting> {
+        self.nets.iter().find(|n| n.name == name)
+    }
+
+    /// Checks the placement against `circuit` and returns every problem: unknown or repeated
+    /// parts and nets, wire ends on pins that do not exist or belong to another net, unknown or
+    /// badly named waypoints, and numbers that are not finite (or negative sizes).
+    pub fn validate(&self, circuit: &Circuit) -> Result<(), PlacementError> {
+        let mut problems = Vec::new();
+        let mut bad = |item: String, key: &'static str, ok: bool| {
+            if !ok {
+                problems.push(Problem::BadNumber { item, key });
+            }
+        };
+        for p in &self.parts {
+            let item = || format!("part \"{}\"", p.name);
+            for (key, v) in [("x", p.x), ("y", p.y), ("z", p.z), ("rotation", p.rotation)] {
+                bad(item(), key, v.is_finite());
+            }
+            bad(item(), "tilt", p.tilt.iter().all(|v| v.is_finite()));
+            for (key, v) in [
+                ("body_height", p.body_height),
+                ("footprint_height", p.footprint_height),
+            ] {
+                bad(item(), key, v.is_finite() && v >= 0.0);
+            }
+            let size_ok = p
+                .body_size
+                .is_none_or(|s| s.iter().all(|v| v.is_finite() && *v >= 0.0));
+            bad(item(), "body_size", size_ok);
+        }
+        for n in &self.nets {
+            for w in &n.waypoints {
+                let item = || format!("net {} waypoint \"{}\"", n.name, w.name);
+                for (key, v) in [("x", w.x), ("y", w.y), ("z", w.z)] {
+                    bad(item(), key, v.is_finite());
+                }
+            }
+        }
+        for (i, p) in self.parts.iter().enumerate() {
+            if circuit.part(&p.name).is_none() {
+                problems.push(Problem::UnknownPart {
+                    part: p.name.clone(),
+                });
+            } else if self.parts[..i].iter().any(|q| q.name == p.name) {
+                problems.push(Problem::DuplicatePart {
+                    part: p.name.clone(),
+                });
+            }
+        }
+        for (i, n) in self.nets.iter().enumerate() {
+            let Some(net) = circuit.net(&n.name) else {
+                problems.push(Problem::UnknownNet {
+                    net: n.name.clone(),
+                });
+                continue;
+            };
+            if self.nets[..i].iter().any(|m| m.name == n.name) {
+                problems.push(Problem::DuplicateNet {
+                    net: n.name.clone(),
+                });
+            }
+            for (j, w) in n.waypoints.iter().enumerate() {
+                if w.name.contains('.') || n.waypoints[..j].iter().any(|v| v.name == w.name) {
+                    problems.push(Problem::BadWaypointName {
+                        net: n.name.clone(),
+                        name: w.name.clone(),
+                    });
+                }
+            }
+            for end in n.wires.iter().flatten() {
+                match end {
+                    Endpoint::Waypoint(name) => {
+                        if !n.waypoints.iter().any(|w| &w.name == name) {
+                            problems.push(Problem::UnknownWaypoint {
+                                net: n.name.clone(),
+                                name: name.clone(),
+                            });
+                        }
+                    }
+                    Endpoint::Pin(pin) => {
+                        match circuit.part(&pin.part).and_then(|p| p.pad(&pin.pad)) {
+                            None => problems.push(Problem::UnknownPin {
+                                net: n.name.clone(),
+                                pin: pin.to_string(),
+                            }),
+                            Some(pad) => {
+                                let resolved = PinRef::new(&pin.part, &pad.name);
+                                if !net.pins.contains(&resolved) {
+                                    problems.push(Problem::PinNotOnNet {
+                                        net: n.name.clone(),
+                                        pin: pin.to_string(),
+                                    });
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(PlacementError::Invalid(problems))
+        }
+    }
+
+    /// The same placement in model coordinates ([`Origin::Model`]): with
+    /// [`Origin::BboxCenter`], each part and waypoint is shifted by its object's bounding-box
+    /// centre in x, y and its minimum z. `object_bboxes[i]` is the model-space bounding box of
+    /// scene object `i`; with [`Origin::Model`] it is not used.
+    ///
+    /// # Errors
+    /// [`PlacementError::NoSuchObject`] for an object index without a bounding box.
+    pub fn to_model(
+        &self,
+        object_bboxes: &[crate::geom::BoundingBox],
+    ) -> Result<Placement, PlacementError> {
+        let mut out = self.clone();
+        if self.origin == Origin::Model {
+            return Ok(out);
+        }
+        let shift = |object: usize, item: String| -> Result<[f64; 3], PlacementError> {
+            let b = object_bboxes
+                .get(object)
+                .ok_or(PlacementError::NoSuchObject {
+                    item,
+                    object,
+                    count: object_bboxes.len(),
+                })?;
+            Ok([
+                (b.min[0] + b.max[0]) / 2.0,
+                (b.min[1] + b.max[1]) / 2.0,
+                b.min[2],
+            ])
+        };
+        for p in &mut out.parts {
+            let [dx, dy, dz] = shift(p.object, format!("part \"{}\"", p.name))?;
+            (p.x, p.y, p.z) = (p.x + dx, p.y + dy, p.z + dz);
+        }
+        for n in &mut out.nets {
+            for w in &mut n.waypoints {
+                let [dx, dy, dz] =
+                    shift(w.object, format!("net {} waypoint \"{}\"", n.name, w.name))?;
+                (w.x, w.y, w.z) = (w.x + dx, w.y + dy, w.z + dz);
+            }
+        }
+        out.origin = Origin::Model;
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::circuit::tests::{sample, sample_dir};
+
+    pub(crate) fn sample_placement() -> Placement {
+        match Placement::load(&sample_dir().join("placement.toml")) {
+            Ok(p) => p,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    pub(crate) fn err_text<T: std::fmt::Debug>(r: Result<T, PlacementError>) -> String {
+        match r {
+            Ok(v) => panic!("expected an error, got {v:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn sample_placement_loads_and_matches_the_circuit() {
+        let p = sample_placement();
+        assert_eq!(p.origin, Origin::Model);
+        assert_eq!(p.source.as_deref(), Some("led_coin.sch"));
+        let names: Vec<&str> = p.parts.iter().map(|q| q.name.as_str()).collect();
+        assert_eq!(names, ["BAT1", "R1", "LED1"]);
+        let bat = p.part("BAT1").cloned();
+        assert_eq!(
+            bat,
+            Some(PartPlacement {
+                name: "BAT1".into(),
+                x: 15.0,
+                y: 15.0,
+                z: 4.0,
+                rotation: 0.0,
+                tilt: [0.0, 0.0],
+                mirror: false,
+                method: PlacingMethod::Manual,
+                connection: Connection::None,
+                body_height: 3.2,
+                footprint_height: 0.0,
+                body_size: Some([24.0, 21.0]),
+                object: 0,
+            })
+        );
+        assert_eq!(
+            p.part("LED1").map(|q| (q.rotation, q.body_height)),
+            Some((90.0, 1.0))
+        );
+        assert_eq!(p.part("R1").map(|q| q.body_height), Some(0.6));
+        let vcc = p.net("VCC");
+        assert_eq!(
+            vcc.map(|n| n.wires.clone()),
+            Some(vec![
+                [
+                    Endpoint::Pin(PinRef::new("BAT1", "+")),
+                    Endpoint::Waypoint("w1".into())
+                ],
+                [
+                    Endpoint::Waypoint("w1".into()),
+                    Endpoint::Pin(PinRef::new("R1", "1"))
+                ],
+            ])
+        );
+        assert!(p.validate(&sample()).is_ok());
+    }
+
+    #[test]
+    fn unknown_parts_pins_and_waypoints_are_named() {
+        let p = Placement::from_toml(
+            r#"
+            [[part]]
+            name = "R9"
+            x = 1.0
+            y = 2.0
+            z = 3.0
+            [[part]]
+            name = "R1"
+            x = 1.0
+            y = 2.0
+            z = inf
+            [[net]]
+            name = "VCC"
+            wires = [["LED1.X", "w9"], ["R1.2", "BAT1.+"]]
+            [[net]]
+            name = "NOPE"
+            "#,
+        );
+        let Ok(p) = p else { panic!("{p:?}") };
+        let msg = err_text(p.validate(&sample()));
+        for want in [
+            "placement: part \"R9\" is not in the circuit",
+            "placement: part \"R1\": z must be a finite number",
+            "net VCC: pin LED1.X does not exist",
+            "net VCC: waypoint \"w9\" is not defined",
+            "net VCC: pin R1.2 is not on this net",
+            "placement: net \"NOPE\" is not in the circuit",
+        ] {
+            assert!(msg.contains(want), "{want:?} not in {msg:?}");
+        }
+        let Err(PlacementError::Invalid(problems)) = p.validate(&sample()) else {
+            panic!()
+        };
+        assert_eq!(problems.len(), 6);
+    }
+
+    #[test]
+    fn toml_errors_name_the_file_line_and_key() {
+        let dir = tempfile::tempdir().ok();
+        let Some(dir) = dir else { return };
+        let path = dir.path().join("bad.toml");
+        std::fs::write(
+            &path,
+            "origin = \"model\"\n[[part]]\nname = \"R1\"\ncolour = 3\n",
+        )
+        .ok();
+        let msg = err_text(Placement::load(&path));
+        assert!(
+            msg.contains("bad.toml") && msg.contains("line 4") && msg.contains("colour"),
+            "{msg}"
+        );
+        let msg = err_text(Placement::from_toml("origin = \"centre\""));
+        assert!(msg.contains("line 1") && msg.contains("centre"), "{msg}");
+        let path = dir.path().join("p.json");
+        assert!(err_text(Placement::load(&path)).contains("p.json"));
+    }
+
+    pub(crate) const BOARD: &str = r#"<?xml version="1.0"?>
+<eagle version="9.6.2"><drawing><board>
+ <libraries><library name="L"><packages><package name="P">
+  <smd name="1" x="-1" y="0" dx="1" dy="1" layer="1"/>
+  <smd name="2" x="1" y="0" dx="1" dy="1" layer="1"/>
+ </package></packages></library></libraries>
+ <elements>
+  <element name="R1" library="L" package="P" value="1k" x="10" y="20" rot="R90"/>
+  <element name="R2" library="L" package="P" value="2k" x="30" y="20" rot="MR0"/>
+ </elements>
+ <signals>
+  <signal name="A"><contactref element="R1" pad="2"/><contactref element="R2" pad="1"/></signal>
+  <signal name="B"><contactref element="R1" pad="1"/></signal>
+ </signals>
+</board></drawing></eagle>"#;
+
+    #[test]
+    fn board_projection_applies_z_offset_rotation_and_mirror() {
+        let b = match conduit_eagle::read_board(BOARD.as_bytes()) {
+            Ok(b) => b,
+            Err(e) => panic!("{e}"),
+        };
+        let p = Placement::from_board(&b, 2.5, [-5.0, 3.0]);
+        assert_eq!(p.origin, Origin::Model);
+        let pose = |n: &str| p.part(n).map(|q| (q.x, q.y, q.z, q.rotation, q.mirror));
+        assert_eq!(pose("R1"), Some((5.0, 23.0, 2.5, 90.0, false)));
+        assert_eq!(pose("R2"), Some((25.0, 23.0, 2.5, 0.0, true)));
+        let c = Circuit::from_board(&b);
+        assert_eq!(c.nets.len(), 1); // B has one pad
+        assert_eq!(
+            c.nets[0].pins,
+            [PinRef::new("R1", "2"), PinRef::new("R2", "1")]
+        );
+        assert!(p.validate(&c).is_ok());
+    }
+}

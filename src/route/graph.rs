@@ -1,0 +1,726 @@
+//! The routing graph: deflated perimeter traces, direct connections and wire endpoints per layer.
+//!
+//! Place in the pipeline: built per wire, before its A* search (`astar.rs`), over the layers
+//! between the wire's endpoint layers ± 1. The search grows it lazily (infill grid, inter-layer
+//! edges); this file builds the static part:
+//!
+//! - **Deflated perimeter traces**: the layer islands (with other nets' channels as holes) shrunk
+//!   by `i·perimeter_width + (conductive_width + channel_extra)/2` for `i = 1..=perimeters`; every
+//!   ring of each result is a closed chain of vertices whose edges cost `length ×
+//!   perimeter_weights[i-1]`.
+//! - **Direct connections**: the wire's rubberband projected into the layer, split where it meets
+//!   the rings, the island boundaries and the keep-outs of other nets' traces. Sections inside
+//!   the material cost `base_weight` per mm, sections across holes and notches of one island
+//!   `outside_weight`; sections inside a keep-out or bridging two separate islands are left out.
+//!   The split points are inserted into the ring edges they lie on, connecting the two.
+//! - **Endpoints**: each pad becomes a vertex on its layer, joined to the nearest point of every
+//!   ring within the perimeter zone (plus a grid step) and to every vertex within a grid step.
+//!
+//! Rings and sections are supersampled so consecutive vertices are at most
+//! `min(interlayer_overlap, grid_step)` apart. Ring samples sit at fixed arc lengths from the
+//! ring's canonical start, so identical rings on neighbouring layers give identical vertices, and
+//! each new vertex is snapped to a vertex of the neighbour layers within `align_tolerance`:
+//! inter-layer edges then join vertices of exactly the same xy.
+
+use super::RouteParams;
+use super::index::{Hit, RegionIndex, dist, lerp, point_segment_distance, project_param};
+use crate::geom::{ExPolygon, Join, Point2, offset, scaled, unscaled};
+use std::collections::{BTreeMap, HashMap};
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A small multiplicative hasher for the integer keys of the vertex maps (the std SipHash is
+/// built against adversarial keys, which these are not). Maps are only looked up, never
+/// iterated, so the hasher does not affect the output.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct IntHasher(u64);
+
+impl Hasher for IntHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
+
+    fn write_i64(&mut self, v: i64) {
+        self.write_u64(v as u64);
+    }
+
+    fn write_usize(&mut self, v: usize) {
+        self.write_u64(v as u64);
+    }
+}
+
+type IntMap<K, V> = HashMap<K, V, BuildHasherDefault<IntHasher>>;
+
+/// Vertex number within one wire's graph.
+pub(crate) type VertexId = u32;
+
+/// Chord deviation of the round corners of deflated traces, mm.
+const ROUND_DEVIATION_MM: f64 = 0.01;
+
+/// Points of one layer closer than this are one vertex (scaled units: 1 µm, far above the
+/// nanometre rounding of intersection points and far below a trace width).
+pub(crate) const MERGE_NM: i64 = 1_000;
+
+/// One layer's input to the router, with the state left by the wires already routed.
+#[derive(Debug, Clone)]
+pub(crate) struct LayerInput {
+    /// Index of the layer in the caller's list.
+    pub index: usize,
+    /// Top of the layer, mm.
+    pub z: f64,
+    /// Material where this wire's channel may go: the islands with other nets' channels removed.
+    pub islands: Vec<ExPolygon>,
+    /// The caller's islands, before any channel was carved (inside/outside and crossings).
+    pub original: Vec<ExPolygon>,
+    /// Where no trace centre of this wire may run (other nets' traces grown by two channel
+    /// half-widths).
+    pub blocked: Vec<ExPolygon>,
+}
+
+/// One deflated perimeter trace.
+#[derive(Debug, Clone)]
+pub(crate) struct Ring {
+    /// The ring's points (closed).
+    pub points: Vec<Point2>,
+    /// Cost per mm along it.
+    pub weight: f64,
+}
+
+/// A layer made ready for routing: its rings and the regions the router queries.
+#[derive(Debug, Clone)]
+pub(crate) struct PreparedLayer {
+    /// Index of the layer in the caller's list.
+    pub index: usize,
+    /// Top of the layer, mm.
+    pub z: f64,
+    /// All deflated perimeter traces, outermost offset first.
+    pub rings: Vec<Ring>,
+    /// Edges of `rings`, grouped by ring number.
+    pub ring_edges: RegionIndex,
+    /// The first deflated area: where a trace centre keeps its channel inside the material and
+    /// clear of other channels.
+    pub clearance: RegionIndex,
+    /// The innermost deflated area, explored on the grid.
+    pub infill: RegionIndex,
+    /// The original islands (inside/outside decisions, perimeter crossings).
+    pub material: RegionIndex,
+    /// Outer contours of the original islands, grouped by island.
+    pub contours: RegionIndex,
+    /// Keep-outs of other nets' traces.
+    pub blocked: RegionIndex,
+}
+
+impl PreparedLayer {
+    /// Deflates the islands of `input` into rings and indexes the regions.
+    pub(crate) fn new(input: &LayerInput, params: &RouteParams) -> Self {
+        let half = params.channel_half_width();
+        let mut rings = Vec::new();
+        let mut areas: Vec<Vec<ExPolygon>> = Vec::new();
+        for i in 1..=params.perimeters {
+            let inset = i as f64 * params.perimeter_width + half;
+            let area = offset(&input.islands, -inset, Join::Round(ROUND_DEVIATION_MM));
+            let weight = params.perimeter_weight(i);
+            for ex in &area {
+                for ring in std::iter::once(&ex.contour).chain(&ex.holes) {
+                    if ring.points.len() >= 3 {
+                        rings.push(Ring {
+                            points: ring.points.clone(),
+                            weight,
+                        });
+                    }
+                }
+            }
+            areas.push(area);
+        }
+        if areas.is_empty() {
+            areas.push(offset(
+                &input.islands,
+                -half,
+                Join::Round(ROUND_DEVIATION_MM),
+            ));
+        }
+        let ring_refs: Vec<(u32, &[Point2])> = rings
+            .iter()
+            .enumerate()
+            .map(|(k, r)| (k as u32, r.points.as_slice()))
+            .collect();
+        let contours: Vec<(u32, &[Point2])> = input
+            .original
+            .iter()
+            .enumerate()
+            .map(|(k, ex)| (k as u32, ex.contour.points.as_slice()))
+            .collect();
+        Self {
+            index: input.index,
+            z: input.z,
+            ring_edges: RegionIndex::new(&ring_refs),
+            clearance: RegionIndex::of_regions(areas.first().map_or(&[], Vec::as_slice)),
+            infill: RegionIndex::of_regions(areas.last().map_or(&[], Vec::as_slice)),
+            material: RegionIndex::of_regions(&input.original),
+            contours: RegionIndex::new(&contours),
+            blocked: RegionIndex::of_regions(&input.blocked),
+            rings,
+        }
+    }
+
+    /// Whether the segment `a`–`b` runs into a keep-out.
+    pub(crate) fn blocked_segment(&self, a: Point2, b: Point2) -> bool {
+        !self.blocked.is_empty()
+            && (self.blocked.crosses(a, b)
+                || self.blocked.contains(a)
+                || self.blocked.contains(b)
+                || self.blocked.contains(lerp(a, b, 0.5)))
+    }
+
+    /// Whether `a` and `b` lie within (or on) the outer contour of one island.
+    pub(crate) fn same_island(&self, a: Point2, b: Point2, tol: i64) -> bool {
+        let (ga, gb) = (
+            self.contours.groups_at(a, tol),
+            self.contours.groups_at(b, tol),
+        );
+        ga.iter().any(|g| gb.binary_search(g).is_ok())
+    }
+
+    /// Cost per mm of a straight link `a`–`b` on this layer, or `None` if it may not be used:
+    /// it enters a keep-out, or it runs outside the material between two separate islands.
+    pub(crate) fn link_weight(
+        &self,
+        a: Point2,
+        b: Point2,
+        params: &RouteParams,
+        tol: i64,
+    ) -> Option<f64> {
+        if self.blocked_segment(a, b) {
+            return None;
+        }
+        if self.material.inside_or_on(lerp(a, b, 0.5), tol) {
+            Some(params.base_weight)
+        } else if self.same_island(a, b, tol) {
+            Some(params.outside_weight)
+        } else {
+            None
+        }
+    }
+}
+
+/// One vertex of the routing graph.
+#[derive(Debug, Clone)]
+pub(crate) struct Vertex {
+    /// Position, scaled units.
+    pub p: Point2,
+    /// Layer index (the caller's numbering).
+    pub layer: usize,
+    /// Whether the infill grid has been explored around it.
+    pub explored: bool,
+    /// Whether it lies in the infill region, once asked.
+    pub infill: Option<bool>,
+}
+
+/// One directed edge.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Edge {
+    /// Head of the edge.
+    pub to: VertexId,
+    /// Cost, mm-equivalents.
+    pub cost: f64,
+}
+
+/// Vertices keyed by their scaled (x, y, layer), with planar edges and a spatial hash.
+#[derive(Debug, Clone)]
+pub(crate) struct Graph {
+    /// Vertices by id.
+    pub verts: Vec<Vertex>,
+    /// Outgoing planar edges per vertex.
+    pub adj: Vec<Vec<Edge>>,
+    by_pos: IntMap<(usize, i64, i64), VertexId>,
+    cells: IntMap<(usize, i64, i64), Vec<VertexId>>,
+    cell: i64,
+    align: i64,
+}
+
+impl Graph {
+    /// An empty graph with spatial-hash cells of `cell` scaled units and neighbour-layer snapping
+    /// within `align` scaled units.
+    pub(crate) fn new(cell: i64, align: i64) -> Self {
+        Self {
+            verts: Vec::new(),
+            adj: Vec::new(),
+            by_pos: IntMap::default(),
+            cells: IntMap::default(),
+            cell: cell.max(1),
+            align,
+        }
+    }
+
+    /// Vertices of `layer` within `radius` of `p`, by increasing id.
+    pub(crate) fn within(&self, layer: usize, p: Point2, radius: i64) -> Vec<VertexId> {
+        let (x0, x1) = (
+            (p.x - radius).div_euclid(self.cell),
+            (p.x + radius).div_euclid(self.cell),
+        );
+        let (y0, y1) = (
+            (p.y - radius).div_euclid(self.cell),
+            (p.y + radius).div_euclid(self.cell),
+        );
+        let r2 = (radius as i128) * (radius as i128);
+        let mut out = Vec::new();
+        for cx in x0..=x1 {
+            for cy in y0..=y1 {
+                if let Some(ids) = self.cells.get(&(layer, cx, cy)) {
+                    out.extend(
+                        ids.iter()
+                            .copied()
+                            .filter(|&v| self.verts[v as usize].p.distance_squared(p) <= r2),
+                    );
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
+    /// The vertex of `layer` nearest to `p` within `radius` (ties to the lower id).
+    pub(crate) fn nearest(&self, layer: usize, p: Point2, radius: i64) -> Option<VertexId> {
+        if let Some(&v) = self.by_pos.get(&(layer, p.x, p.y)) {
+            return Some(v);
+        }
+        self.within(layer, p, radius)
+            .into_iter()
+            .min_by_key(|&v| (self.verts[v as usize].p.distance_squared(p), v))
+    }
+
+    /// The vertex at `p` on `layer`: an existing one within [`MERGE_NM`], else a new one, snapped
+    /// to the xy of the nearest vertex of a neighbour layer within the alignment tolerance.
+    /// Returns the vertex and whether it was created.
+    pub(crate) fn add_vertex(&mut self, layer: usize, p: Point2) -> (VertexId, bool) {
+        if let Some(v) = self.nearest(layer, p, MERGE_NM) {
+            return (v, false);
+        }
+        let mut q = p;
+        for other in [layer.checked_sub(1), Some(layer + 1)]
+            .into_iter()
+            .flatten()
+        {
+            if let Some(v) = self.nearest(other, p, self.align) {
+                q = self.verts[v as usize].p;
+                break;
+            }
+        }
+        if let Some(&v) = self.by_pos.get(&(layer, q.x, q.y)) {
+            return (v, false);
+        }
+        let id = self.verts.len() as VertexId;
+        self.verts.push(Vertex {
+            p: q,
+            layer,
+            explored: false,
+            infill: None,
+        });
+        self.adj.push(Vec::new());
+        self.by_pos.insert((layer, q.x, q.y), id);
+        self.cells
+            .entry((layer, q.x.div_euclid(self.cell), q.y.div_euclid(self.cell)))
+            .or_default()
+            .push(id);
+        (id, true)
+    }
+
+    /// Joins `a` and `b` both ways at `weight` per mm of their distance (once).
+    pub(crate) fn link(&mut self, a: VertexId, b: VertexId, weight: f64) {
+        if a == b || self.adj[a as usize].iter().any(|e| e.to == b) {
+            return;
+        }
+        let cost = unscaled(1) * dist(self.verts[a as usize].p, self.verts[b as usize].p) * weight;
+        self.adj[a as usize].push(Edge { to: b, cost });
+        self.adj[b as usize].push(Edge { to: a, cost });
+    }
+
+    /// Position of vertex `v`.
+    pub(crate) fn pos(&self, v: VertexId) -> Point2 {
+        self.verts[v as usize].p
+    }
+
+    /// Layer of vertex `v`.
+    pub(crate) fn layer(&self, v: VertexId) -> usize {
+        self.verts[v as usize].layer
+    }
+}
+
+/// A wire's pads, snapped to their layers.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Ends {
+    /// Start pad xy.
+    pub from: Point2,
+    /// Start layer.
+    pub from_layer: usize,
+    /// End pad xy.
+    pub to: Point2,
+    /// End layer.
+    pub to_layer: usize,
+}
+
+impl Ends {
+    /// The piece of the rubberband projected into `layer`, if any.
+    ///
+    /// Between pads on different layers the rubberband is shared out by layer index: each of the
+    /// `k + 1` layers from the start layer to the end layer gets `1/(k + 1)` of it, in order, so
+    /// the endpoint layers get a piece too (pads usually sit at a layer's top, where the raw z
+    /// range would give them none). The pieces of consecutive layers meet at the same point, the
+    /// rubberband's crossing of the layer boundary. A wire within one layer gets the whole
+    /// segment there and on the layers just above and below, so it can change layer to pass a
+    /// channel.
+    pub(crate) fn piece(&self, layer: usize) -> Option<(Point2, Point2)> {
+        let (la, lb) = (self.from_layer, self.to_layer);
+        if la == lb {
+            return (layer.abs_diff(la) <= 1).then_some((self.from, self.to));
+        }
+        if layer < la.min(lb) || layer > la.max(lb) {
+            return None;
+        }
+        let shares = (la.abs_diff(lb) + 1) as f64;
+        let k = layer.abs_diff(la) as f64;
+        Some((
+            lerp(self.from, self.to, k / shares),
+            lerp(self.from, self.to, (k + 1.0) / shares),
+        ))
+    }
+}
+
+/// A point to insert into edge `edge` of a ring, at parameter `u` along the edge.
+#[derive(Debug, Clone, Copy)]
+struct Insert {
+    edge: usize,
+    u: f64,
+    point: Point2,
+}
+
+/// Ring points: corners, inserted points and samples every `spacing` of arc length from the
+/// ring's start, in order along the ring, without repeats.
+fn sample_ring(ring: &[Point2], inserts: &[Insert], spacing: f64) -> Vec<Point2> {
+    let mut out: Vec<Point2> = Vec::new();
+    let mut arc = 0.0;
+    for k in 0..ring.len() {
+        let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
+        let len = dist(a, b);
+        let mut at: Vec<(f64, Point2)> = vec![(0.0, a)];
+        at.extend(
+            inserts
+                .iter()
+                .filter(|i| i.edge == k)
+                .map(|i| (i.u, i.point)),
+        );
+        if len > 0.0 {
+            let mut j = (arc / spacing).floor() + 1.0;
+            while j * spacing < arc + len {
+                let u = (j * spacing - arc) / len;
+                at.push((u, lerp(a, b, u)));
+                j += 1.0;
+            }
+        }
+        at.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        for (_, p) in at {
+            if out
+                .last()
+                .is_none_or(|&q| q.distance_squared(p) > (MERGE_NM as i128).pow(2))
+            {
+                out.push(p);
+            }
+        }
+        arc += len;
+    }
+    while out.len() > 1 && out[0].distance_squared(out[out.len() - 1]) <= (MERGE_NM as i128).pow(2)
+    {
+        out.pop();
+    }
+    out
+}
+
+/// Points of the straight section `a`–`b` so no two consecutive are more than `spacing` apart.
+pub(crate) fn supersample(a: Point2, b: Point2, spacing: f64) -> Vec<Point2> {
+    let n = (dist(a, b) / spacing).ceil().max(1.0) as usize;
+    (0..=n).map(|i| lerp(a, b, i as f64 / n as f64)).collect()
+}
+
+/// The static graph of one wire over `layers` (consecutive, ascending), and the vertices of its
+/// two pads.
+pub(crate) fn build(
+    layers: &[PreparedLayer],
+    ends: &Ends,
+    params: &RouteParams,
+) -> (Graph, VertexId, VertexId) {
+    let spacing = scaled(sample_spacing(params)) as f64;
+    let tol = scaled(params.align_tolerance).max(1);
+    let step = scaled(params.grid_step).max(1);
+    let mut graph = Graph::new(step, tol);
+    let reach = scaled(
+        params.perimeters as f64 * params.perimeter_width
+            + params.channel_half_width()
+            + params.grid_step,
+    );
+    let mut pads: BTreeMap<usize, Vec<Point2>> = BTreeMap::new();
+    pads.entry(ends.from_layer).or_default().push(ends.from);
+    pads.entry(ends.to_layer).or_default().push(ends.to);
+    let mut source = None;
+    let mut target = None;
+    for layer in layers {
+        let l = layer.index;
+        let piece = ends.piece(l);
+        let layer_pads = pads.get(&l).cloned().unwrap_or_default();
+        // Where the direct connection and the pads' links meet the rings.
+        let mut inserts: Vec<Vec<Insert>> = vec![Vec::new(); layer.rings.len()];
+        let ring_hits: Vec<Hit> = piece.map_or(Vec::new(), |(a, b)| layer.ring_edges.hits(a, b));
+        for h in &ring_hits {
+            inserts[h.group as usize].push(Insert {
+                edge: h.edge as usize,
+                u: h.u,
+                point: h.point,
+            });
+        }
+        let mut pad_links: Vec<(Point2, Point2)> = Vec::new();
+        for &pad in &layer_pads {
+            for (r, ring) in layer.rings.iter().enumerate() {
+                if let Some(ins) = nearest_on_ring(&ring.points, pad, reach) {
+                    inserts[r].push(ins);
+                    pad_links.push((pad, ins.point));
+                }
+            }
+        }
+        for (ring, ins) in layer.rings.iter().zip(&inserts) {
+            let pts = sample_ring(&ring.points, ins, spacing);
+            let ids: Vec<VertexId> = pts.iter().map(|&p| graph.add_vertex(l, p).0).collect();
+            for k in 0..ids.len() {
+                graph.link(ids[k], ids[(k + 1) % ids.len()], ring.weight);
+            }
+        }
+        if let Some((a, b)) = piece {
+            add_direct(&mut graph, layer, a, b, &ring_hits, params, spacing, tol);
+        }
+        for &pad in &layer_pads {
+            let (v, _) = graph.add_vertex(l, pad);
+            if l == ends.from_layer && pad == ends.from && source.is_none() {
+                source = Some(v);
+            }
+            if l == ends.to_layer && pad == ends.to {
+                target = Some(v);
+            }
+            for &(_, q) in pad_links.iter().filter(|(p, _)| *p == pad) {
+                if let Some(w) = layer.link_weight(pad, q, params, tol) {
+                    let (u, _) = graph.add_vertex(l, q);
+                    graph.link(v, u, w);
+                }
+            }
+            for u in graph.within(l, graph.pos(v), step) {
+                if let Some(w) = layer.link_weight(graph.pos(v), graph.pos(u), params, tol) {
+                    graph.link(v, u, w);
+                }
+            }
+        }
+    }
+    // The pads' layers are always in `layers`; should they not be, the pads still get vertices
+    // (unconnected) so the search fails cleanly.
+    let source = source.unwrap_or_else(|| graph.add_vertex(ends.from_layer, ends.from).0);
+    let target = target.unwrap_or_else(|| graph.add_vertex(ends.to_layer, ends.to).0);
+    (graph, source, target)
+}
+
+/// Largest distance between consecutive vertices along rings and sections, mm.
+pub(crate) fn sample_spacing(params: &RouteParams) -> f64 {
+    params
+        .interlayer_overlap
+        .min(params.grid_step)
+        .max(params.align_tolerance * 4.0)
+}
+
+/// The point of `ring` nearest to `p`, if within `reach` scaled units.
+fn nearest_on_ring(ring: &[Point2], p: Point2, reach: i64) -> Option<Insert> {
+    let mut best: Option<(f64, Insert)> = None;
+    for k in 0..ring.len() {
+        let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
+        let d = point_segment_distance(p, a, b);
+        if d <= reach as f64 && best.as_ref().is_none_or(|(bd, _)| d < *bd) {
+            let u = project_param(p, a, b);
+            best = Some((
+                d,
+                Insert {
+                    edge: k,
+                    u,
+                    point: lerp(a, b, u),
+                },
+            ));
+        }
+    }
+    best.map(|(_, i)| i)
+}
+
+/// Adds the direct connection `a`–`b` on `layer`: split at the rings (at the very points
+/// inserted into them), the island boundaries and the keep-outs; each section weighted by where
+/// it runs, or left out.
+#[allow(clippy::too_many_arguments)]
+fn add_direct(
+    graph: &mut Graph,
+    layer: &PreparedLayer,
+    a: Point2,
+    b: Point2,
+    ring_hits: &[Hit],
+    params: &RouteParams,
+    spacing: f64,
+    tol: i64,
+) {
+    let mut cuts: Vec<(f64, Point2)> = vec![(0.0, a), (1.0, b)];
+    cuts.extend(ring_hits.iter().map(|h| (h.t, h.point)));
+    cuts.extend(layer.material.hits(a, b).iter().map(|h| (h.t, h.point)));
+    cuts.extend(layer.blocked.hits(a, b).iter().map(|h| (h.t, h.point)));
+    // A stable sort: among equal parameters the section's ends and the ring points come first,
+    // so a split point is the very point inserted into the ring.
+    cuts.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut points: Vec<Point2> = Vec::new();
+    for (_, p) in cuts {
+        if points
+            .last()
+            .is_none_or(|&q| q.distance_squared(p) > (MERGE_NM as i128).pow(2))
+        {
+            points.push(p);
+        }
+    }
+    for w in points.windows(2) {
+        let (p, q) = (w[0], w[1]);
+        // The section is split at every boundary, so its midpoint tells where all of it runs.
+        let mid = lerp(p, q, 0.5);
+        if layer.blocked.contains(mid) {
+            continue;
+        }
+        let weight = if layer.material.inside_or_on(mid, tol) {
+            params.base_weight
+        } else if layer.same_island(p, q, tol) {
+            params.outside_weight
+        } else {
+            continue;
+        };
+        let pts = supersample(p, q, spacing);
+        let mut prev = None;
+        for s in pts {
+            let (v, _) = graph.add_vertex(layer.index, s);
+            if let Some(u) = prev {
+                graph.link(u, v, weight);
+            }
+            prev = Some(v);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Polygon;
+
+    fn square(x0: f64, s: f64) -> Polygon {
+        Polygon::new(vec![
+            Point2::from_mm(x0, x0),
+            Point2::from_mm(x0 + s, x0),
+            Point2::from_mm(x0 + s, x0 + s),
+            Point2::from_mm(x0, x0 + s),
+        ])
+    }
+
+    fn annulus_input(index: usize) -> LayerInput {
+        let mut hole = square(15.0, 30.0);
+        hole.points.reverse();
+        let islands = vec![ExPolygon {
+            contour: square(0.0, 60.0),
+            holes: vec![hole],
+        }];
+        LayerInput {
+            index,
+            z: 0.2 * (index + 1) as f64,
+            islands: islands.clone(),
+            original: islands,
+            blocked: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn annulus_deflates_into_three_weighted_ring_pairs() {
+        let params = RouteParams::default();
+        let layer = PreparedLayer::new(&annulus_input(0), &params);
+        assert_eq!(layer.rings.len(), 6);
+        let weights: Vec<f64> = layer.rings.iter().map(|r| r.weight).collect();
+        assert_eq!(weights, vec![3.0, 3.0, 2.0, 2.0, 1.0, 1.0]);
+        // The innermost outer ring is 3·0.45 + 0.4 = 1.75 mm inside the outer wall.
+        let x_min = |r: &Ring| r.points.iter().map(|p| p.x).min().unwrap_or(0);
+        assert_eq!(x_min(&layer.rings[4]), scaled(1.75));
+        assert!(layer.infill.contains(Point2::from_mm(5.0, 30.0)));
+        assert!(!layer.infill.contains(Point2::from_mm(14.0, 30.0)));
+        assert!(layer.clearance.contains(Point2::from_mm(14.0, 30.0)));
+    }
+
+    #[test]
+    fn identical_layers_get_vertices_at_identical_xy() {
+        let params = RouteParams::default();
+        let layers: Vec<PreparedLayer> = (0..3)
+            .map(|i| PreparedLayer::new(&annulus_input(i), &params))
+            .collect();
+        let ends = Ends {
+            from: Point2::from_mm(5.0, 30.0),
+            from_layer: 0,
+            to: Point2::from_mm(55.0, 30.0),
+            to_layer: 2,
+        };
+        let (graph, s, t) = build(&layers, &ends, &params);
+        assert_eq!((graph.layer(s), graph.layer(t)), (0, 2));
+        // Every vertex of layer 1 on a ring has a twin on layer 0 or 2 at exactly its xy.
+        let mut twins = 0;
+        for v in graph.verts.iter().filter(|v| v.layer == 1) {
+            if graph.by_pos.contains_key(&(0, v.p.x, v.p.y))
+                || graph.by_pos.contains_key(&(2, v.p.x, v.p.y))
+            {
+                twins += 1;
+            }
+        }
+        let on_1 = graph.verts.iter().filter(|v| v.layer == 1).count();
+        assert!(twins as f64 > 0.95 * on_1 as f64, "{twins} of {on_1}");
+        // Apart from the pads' links, edges are at most min(overlap, grid step) long, plus what
+        // snapping to a neighbour layer may add at both ends.
+        let longest = scaled(sample_spacing(&params) + 2.0 * params.align_tolerance) as f64;
+        for (v, edges) in graph.adj.iter().enumerate() {
+            for e in edges.iter().filter(|e| ![s, t].contains(&e.to)) {
+                if ![s, t].contains(&(v as VertexId)) {
+                    assert!(dist(graph.pos(v as VertexId), graph.pos(e.to)) <= longest);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rubberband_is_shared_out_by_layer() {
+        let ends = Ends {
+            from: Point2::from_mm(0.0, 0.0),
+            from_layer: 2,
+            to: Point2::from_mm(30.0, 0.0),
+            to_layer: 4,
+        };
+        assert_eq!(ends.piece(1), None);
+        assert_eq!(
+            ends.piece(2),
+            Some((Point2::from_mm(0.0, 0.0), Point2::from_mm(10.0, 0.0)))
+        );
+        assert_eq!(
+            ends.piece(4),
+            Some((Point2::from_mm(20.0, 0.0), Point2::from_mm(30.0, 0.0)))
+        );
+        let flat = Ends {
+            to_layer: 2,
+            ..ends
+        };
+        assert_eq!(flat.piece(3), Some((flat.from, flat.to)));
+        assert_eq!(flat.piece(4), None);
+    }
+}

@@ -1,0 +1,357 @@
+//! Point and segment queries against the rings of a region, bucketed into horizontal bands.
+//!
+//! Place in the pipeline: a helper of the router (`route`), which asks many "is this point in the
+//! material?", "where does this rubberband cross the perimeter traces?" and "does this link cross
+//! a channel?" questions per layer. Edges are sorted into 1 mm bands of y, so a query only looks
+//! at the edges whose y range overlaps the query's.
+//!
+//! Orientation tests are exact (`i128` cross products of nanometre coordinates); only the
+//! parameters of intersection points are `f64`.
+
+use crate::geom::{ExPolygon, Point2};
+
+/// Height of one band of edges, in scaled units (1 mm).
+const BAND: i64 = 1_000_000;
+
+/// One edge of a ring, with the group it belongs to and its index within its ring.
+#[derive(Debug, Clone, Copy)]
+struct Edge {
+    a: Point2,
+    b: Point2,
+    group: u32,
+    index: u32,
+}
+
+/// Where a query segment meets an edge of the index.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Hit {
+    /// Parameter along the query segment, 0 at its start, 1 at its end.
+    pub t: f64,
+    /// Group of the edge hit (ring or island number, as given to [`RegionIndex::new`]).
+    pub group: u32,
+    /// Index of the edge within its ring (edge `k` runs from point `k` to point `k + 1`).
+    pub edge: u32,
+    /// Parameter along the edge.
+    pub u: f64,
+    /// The meeting point, rounded to the nanometre.
+    pub point: Point2,
+}
+
+/// Edges of a set of closed rings, bucketed by y for point-in-region and crossing queries.
+///
+/// Containment uses the even-odd rule over all rings, which is the region's interior when the
+/// rings are those of non-overlapping [`ExPolygon`]s (contours and holes).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct RegionIndex {
+    edges: Vec<Edge>,
+    /// Band of the lowest point of each edge.
+    first_band: Vec<u32>,
+    y0: i64,
+    bands: Vec<Vec<u32>>,
+}
+
+fn orient(a: Point2, b: Point2, p: Point2) -> i128 {
+    a.cross(b, p)
+}
+
+fn sign(v: i128) -> i8 {
+    v.signum() as i8
+}
+
+/// Whether `a`–`b` and the edge cross at one point interior to both.
+fn proper_crossing(a: Point2, b: Point2, e: Edge) -> bool {
+    if a.x.max(b.x) < e.a.x.min(e.b.x) || a.x.min(b.x) > e.a.x.max(e.b.x) {
+        return false;
+    }
+    let (d1, d2) = (orient(e.a, e.b, a), orient(e.a, e.b, b));
+    let (d3, d4) = (orient(a, b, e.a), orient(a, b, e.b));
+    sign(d1) * sign(d2) < 0 && sign(d3) * sign(d4) < 0
+}
+
+/// Distance (scaled units, as `f64`) from `p` to the segment `a`–`b`.
+pub(crate) fn point_segment_distance(p: Point2, a: Point2, b: Point2) -> f64 {
+    let (dx, dy) = ((b.x - a.x) as f64, (b.y - a.y) as f64);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        (((p.x - a.x) as f64 * dx + (p.y - a.y) as f64 * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (qx, qy) = (a.x as f64 + t * dx, a.y as f64 + t * dy);
+    ((qx - p.x as f64).powi(2) + (qy - p.y as f64).powi(2)).sqrt()
+}
+
+/// Parameter (0..=1) of the point of `a`–`b` nearest to `p`.
+pub(crate) fn project_param(p: Point2, a: Point2, b: Point2) -> f64 {
+    let (dx, dy) = ((b.x - a.x) as f64, (b.y - a.y) as f64);
+    let len2 = dx * dx + dy * dy;
+    if len2 > 0.0 {
+        (((p.x - a.x) as f64 * dx + (p.y - a.y) as f64 * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// The point at parameter `t` of `a`–`b`, rounded to the nanometre.
+pub(crate) fn lerp(a: Point2, b: Point2, t: f64) -> Point2 {
+    Point2::new(
+        (a.x as f64 + t * (b.x - a.x) as f64).round() as i64,
+        (a.y as f64 + t * (b.y - a.y) as f64).round() as i64,
+    )
+}
+
+/// Euclidean distance between two points, scaled units as `f64`.
+pub(crate) fn dist(a: Point2, b: Point2) -> f64 {
+    (a.distance_squared(b) as f64).sqrt()
+}
+
+/// Every ring of `regions` (contours and holes), grouped by the index of its ExPolygon.
+pub(crate) fn expolygon_rings(regions: &[ExPolygon]) -> Vec<(u32, &[Point2])> {
+    regions
+        .iter()
+        .enumerate()
+        .flat_map(|(i, ex)| {
+            std::iter::once(&ex.contour)
+                .chain(ex.holes.iter())
+                .map(move |r| (i as u32, r.points.as_slice()))
+        })
+        .collect()
+}
+
+impl RegionIndex {
+    /// An index over closed `rings`, each tagged with a group number.
+    pub(crate) fn new(rings: &[(u32, &[Point2])]) -> Self {
+        let mut edges = Vec::new();
+        for &(group, ring) in rings {
+            if ring.len() < 2 {
+                continue;
+            }
+            for k in 0..ring.len() {
+                let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
+                if a != b {
+                    edges.push(Edge {
+                        a,
+                        b,
+                        group,
+                        index: k as u32,
+                    });
+                }
+            }
+        }
+        let Some(y0) = edges.iter().map(|e| e.a.y.min(e.b.y)).min() else {
+            return Self::default();
+        };
+        let y1 = edges.iter().map(|e| e.a.y.max(e.b.y)).max().unwrap_or(y0);
+        let count = ((y1 - y0) / BAND + 1) as usize;
+        let mut bands = vec![Vec::new(); count];
+        let mut first_band = Vec::with_capacity(edges.len());
+        for (i, e) in edges.iter().enumerate() {
+            let lo = ((e.a.y.min(e.b.y) - y0) / BAND) as usize;
+            let hi = ((e.a.y.max(e.b.y) - y0) / BAND) as usize;
+            for band in &mut bands[lo..=hi.min(count - 1)] {
+                band.push(i as u32);
+            }
+            first_band.push(lo as u32);
+        }
+        Self {
+            edges,
+            first_band,
+            y0,
+            bands,
+        }
+    }
+
+    /// An index over the rings of `regions`, grouped by ExPolygon.
+    pub(crate) fn of_regions(regions: &[ExPolygon]) -> Self {
+        Self::new(&expolygon_rings(regions))
+    }
+
+    /// Whether the index holds no edges (an empty region).
+    pub(crate) fn is_empty(&self) -> bool {
+        self.edges.is_empty()
+    }
+
+    /// Edges of the bands overlapping `y_lo..=y_hi`, each once (in the first of those bands it
+    /// lies in).
+    fn edges_between(&self, y_lo: i64, y_hi: i64) -> impl Iterator<Item = Edge> + '_ {
+        let last = self.bands.len() as i64 - 1;
+        let band = |y: i64| (y - self.y0).div_euclid(BAND);
+        let range = (!self.bands.is_empty() && band(y_hi) >= 0 && band(y_lo) <= last)
+            .then(|| (band(y_lo).max(0) as usize, band(y_hi).min(last) as usize));
+        range.into_iter().flat_map(move |(lo, hi)| {
+            (lo..=hi).flat_map(move |k| {
+                self.bands[k]
+                    .iter()
+                    .filter(move |&&i| (self.first_band[i as usize] as usize).max(lo) == k)
+                    .map(move |&i| self.edges[i as usize])
+            })
+        })
+    }
+
+    /// Edges of the band holding `y` (each edge whose y range contains `y` is there).
+    fn band_at(&self, y: i64) -> &[u32] {
+        if self.bands.is_empty() || y < self.y0 {
+            return &[];
+        }
+        let k = ((y - self.y0) / BAND) as usize;
+        self.bands.get(k).map_or(&[], Vec::as_slice)
+    }
+
+    /// Whether `p` is strictly inside (even-odd over all rings). Points exactly on an edge may go
+    /// either way; use [`Self::inside_or_on`] where the boundary matters.
+    pub(crate) fn contains(&self, p: Point2) -> bool {
+        let mut inside = false;
+        for &i in self.band_at(p.y) {
+            let e = self.edges[i as usize];
+            if (e.a.y > p.y) != (e.b.y > p.y) && e.a.x.max(e.b.x) >= p.x {
+                let (lo, hi) = if e.a.y < e.b.y {
+                    (e.a, e.b)
+                } else {
+                    (e.b, e.a)
+                };
+                if orient(lo, hi, p) > 0 {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+
+    /// Whether `p` lies within `tol` (scaled units) of an edge.
+    pub(crate) fn near_boundary(&self, p: Point2, tol: i64) -> bool {
+        self.edges_between(p.y - tol, p.y + tol).any(|e| {
+            e.a.x.min(e.b.x) - tol <= p.x
+                && e.a.x.max(e.b.x) + tol >= p.x
+                && point_segment_distance(p, e.a, e.b) <= tol as f64
+        })
+    }
+
+    /// Whether `p` is inside or within `tol` of the boundary.
+    pub(crate) fn inside_or_on(&self, p: Point2, tol: i64) -> bool {
+        self.contains(p) || self.near_boundary(p, tol)
+    }
+
+    /// Groups whose rings contain `p` (even-odd per group) or pass within `tol` of it, sorted.
+    pub(crate) fn groups_at(&self, p: Point2, tol: i64) -> Vec<u32> {
+        let mut parity: Vec<(u32, bool)> = Vec::new();
+        for &i in self.band_at(p.y) {
+            let e = self.edges[i as usize];
+            if (e.a.y > p.y) != (e.b.y > p.y) {
+                let (lo, hi) = if e.a.y < e.b.y {
+                    (e.a, e.b)
+                } else {
+                    (e.b, e.a)
+                };
+                if orient(lo, hi, p) > 0 {
+                    match parity.iter_mut().find(|(g, _)| *g == e.group) {
+                        Some(entry) => entry.1 = !entry.1,
+                        None => parity.push((e.group, true)),
+                    }
+                }
+            }
+        }
+        let mut groups: Vec<u32> = parity.into_iter().filter(|g| g.1).map(|g| g.0).collect();
+        for e in self.edges_between(p.y - tol, p.y + tol) {
+            if point_segment_distance(p, e.a, e.b) <= tol as f64 {
+                groups.push(e.group);
+            }
+        }
+        groups.sort_unstable();
+        groups.dedup();
+        groups
+    }
+
+    /// Every point where the segment `a`–`b` meets an edge (crossing or touching; collinear
+    /// overlaps are skipped), sorted by the parameter along `a`–`b`, then by group and edge.
+    pub(crate) fn hits(&self, a: Point2, b: Point2) -> Vec<Hit> {
+        let mut out = Vec::new();
+        for e in self.edges_between(a.y.min(b.y), a.y.max(b.y)) {
+            if a.x.max(b.x) < e.a.x.min(e.b.x) || a.x.min(b.x) > e.a.x.max(e.b.x) {
+                continue;
+            }
+            let (d1, d2) = (orient(e.a, e.b, a), orient(e.a, e.b, b));
+            let (d3, d4) = (orient(a, b, e.a), orient(a, b, e.b));
+            if d1 == d2 || d3 == d4 {
+                // Parallel (or collinear): no single meeting point.
+                continue;
+            }
+            if sign(d1) * sign(d2) > 0 || sign(d3) * sign(d4) > 0 {
+                continue;
+            }
+            let t = d1 as f64 / (d1 - d2) as f64;
+            let u = d3 as f64 / (d3 - d4) as f64;
+            out.push(Hit {
+                t,
+                group: e.group,
+                edge: e.index,
+                u,
+                point: lerp(a, b, t),
+            });
+        }
+        out.sort_by(|x, y| {
+            x.t.total_cmp(&y.t)
+                .then(x.group.cmp(&y.group))
+                .then(x.edge.cmp(&y.edge))
+        });
+        out
+    }
+
+    /// Whether the segment `a`–`b` properly crosses an edge (touching does not count).
+    pub(crate) fn crosses(&self, a: Point2, b: Point2) -> bool {
+        self.edges_between(a.y.min(b.y), a.y.max(b.y))
+            .any(|e| proper_crossing(a, b, e))
+    }
+
+    /// How many times the segment `a`–`b` properly crosses the boundary.
+    pub(crate) fn count_crossings(&self, a: Point2, b: Point2) -> usize {
+        self.edges_between(a.y.min(b.y), a.y.max(b.y))
+            .filter(|e| proper_crossing(a, b, *e))
+            .count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Polygon;
+
+    fn square(x0: f64, y0: f64, s: f64) -> Polygon {
+        Polygon::new(vec![
+            Point2::from_mm(x0, y0),
+            Point2::from_mm(x0 + s, y0),
+            Point2::from_mm(x0 + s, y0 + s),
+            Point2::from_mm(x0, y0 + s),
+        ])
+    }
+
+    fn annulus() -> ExPolygon {
+        let mut hole = square(15.0, 15.0, 30.0);
+        hole.points.reverse();
+        ExPolygon {
+            contour: square(0.0, 0.0, 60.0),
+            holes: vec![hole],
+        }
+    }
+
+    #[test]
+    fn containment_respects_holes() {
+        let idx = RegionIndex::of_regions(&[annulus()]);
+        assert!(idx.contains(Point2::from_mm(5.0, 30.0)));
+        assert!(!idx.contains(Point2::from_mm(30.0, 30.0)));
+        assert!(!idx.contains(Point2::from_mm(70.0, 30.0)));
+        assert!(idx.inside_or_on(Point2::from_mm(15.0, 30.0), 10));
+        assert_eq!(idx.groups_at(Point2::from_mm(5.0, 5.0), 10), vec![0]);
+    }
+
+    #[test]
+    fn a_line_across_the_annulus_meets_four_edges_in_order() {
+        let idx = RegionIndex::of_regions(&[annulus()]);
+        let (a, b) = (Point2::from_mm(-5.0, 30.0), Point2::from_mm(65.0, 30.0));
+        let hits = idx.hits(a, b);
+        let xs: Vec<f64> = hits.iter().map(|h| h.point.to_mm().0).collect();
+        assert_eq!(xs, vec![0.0, 15.0, 45.0, 60.0]);
+        assert_eq!(idx.count_crossings(a, b), 4);
+        assert!(idx.crosses(a, b));
+        assert!(!idx.crosses(Point2::from_mm(1.0, 1.0), Point2::from_mm(10.0, 2.0)));
+    }
+}

@@ -1,0 +1,91 @@
+//! Inter-layer connections: where a route may step to the layer above or below, and the
+//! staircase overlap that makes the step conduct.
+//!
+//! Place in the pipeline: called by the A* search (`astar.rs`) each time it expands a vertex `u`.
+//! Conductive traces of two layers connect only where they overlap in xy, so a layer change is
+//! allowed only where the route's last stretch on this layer can be printed on the neighbour
+//! layer too:
+//!
+//! 1. walk `u`'s best path back, along this layer (including a staircase overlap this layer
+//!    started with), until the walked length exceeds `interlayer_overlap + grid_step`;
+//! 2. every point of that piece must have a match on the neighbour layer: a vertex at the same
+//!    xy (within `align_tolerance`), or a point inside the neighbour's first deflated area (where
+//!    a channel fits) and out of its keep-outs; no piece edge may cross a keep-out;
+//! 3. then `u` is joined to its match on the neighbour layer, at the cost of the piece (length ×
+//!    `base_weight`) plus `layer_change_penalty`, and the piece is kept: the route prints it on
+//!    both layers, at the end of this layer's segment and the start of the next.
+//!
+//! The rubberband's own crossing of a layer boundary (where the direct connections of two
+//! consecutive layers meet) is a vertex of both layers at the same xy, so it is one such
+//! candidate; a plain edge there would join two traces with no overlap, which does not conduct.
+
+use super::graph::{Graph, PreparedLayer, VertexId};
+use super::index::dist;
+use crate::geom::Point2;
+
+/// The best-path predecessor of a vertex: the previous vertex and, for a layer change, the
+/// staircase overlap piece (an index into the search's list of pieces).
+pub(crate) type Parent = Option<(VertexId, Option<u32>)>;
+
+/// The last stretch of the best path to `u` on `u`'s layer, from its far end to `u`, once it is
+/// longer than `need` (scaled units); `None` if the path on this layer is shorter.
+pub(crate) fn walk_back(
+    graph: &Graph,
+    parents: &[Parent],
+    overlaps: &[Vec<Point2>],
+    u: VertexId,
+    need: f64,
+) -> Option<Vec<Point2>> {
+    let layer = graph.layer(u);
+    let mut points = vec![graph.pos(u)];
+    let mut length = 0.0;
+    let mut v = u;
+    loop {
+        let (p, piece) = parents[v as usize]?;
+        match piece {
+            None => {
+                if graph.layer(p) != layer {
+                    return None;
+                }
+                let q = graph.pos(p);
+                length += points.last().map_or(0.0, |&l| dist(l, q));
+                points.push(q);
+                v = p;
+            }
+            Some(k) => {
+                // `v` was reached by a layer change whose piece is printed on this layer too:
+                // walk it backwards; the path before it lies on another layer.
+                for &q in overlaps[k as usize].iter().rev().skip(1) {
+                    length += points.last().map_or(0.0, |&l| dist(l, q));
+                    points.push(q);
+                    if length > need {
+                        break;
+                    }
+                }
+                if length <= need {
+                    return None;
+                }
+            }
+        }
+        if length > need {
+            points.reverse();
+            return Some(points);
+        }
+    }
+}
+
+/// Whether every point of `piece` can be printed on `layer` (see the module docs).
+pub(crate) fn piece_fits(piece: &[Point2], graph: &Graph, layer: &PreparedLayer, tol: i64) -> bool {
+    let fits = |p: Point2| {
+        graph.nearest(layer.index, p, tol).is_some()
+            || (layer.clearance.inside_or_on(p, tol) && !layer.blocked.contains(p))
+    };
+    piece.iter().all(|&p| fits(p))
+        && (layer.blocked.is_empty()
+            || piece.windows(2).all(|w| !layer.blocked.crosses(w[0], w[1])))
+}
+
+/// Length of a polyline, scaled units.
+pub(crate) fn polyline_length(points: &[Point2]) -> f64 {
+    points.windows(2).map(|w| dist(w[0], w[1])).sum()
+}

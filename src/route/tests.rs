@@ -1,0 +1,326 @@
+//! Routing scenarios on hand-built layers: an annulus plate, a solid plate, two separate blocks.
+
+use super::*;
+use crate::geom::{Polygon, intersection};
+
+const LAYER_HEIGHT: f64 = 0.2;
+
+fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Polygon {
+    Polygon::new(vec![
+        Point2::from_mm(x0, y0),
+        Point2::from_mm(x1, y0),
+        Point2::from_mm(x1, y1),
+        Point2::from_mm(x0, y1),
+    ])
+}
+
+fn solid(p: Polygon) -> ExPolygon {
+    ExPolygon {
+        contour: p,
+        holes: Vec::new(),
+    }
+}
+
+/// `count` layers of 0.2 mm, all with the same islands.
+fn stack(islands: Vec<ExPolygon>, count: usize) -> Vec<RouteLayer> {
+    (0..count)
+        .map(|i| RouteLayer {
+            z: LAYER_HEIGHT * (i + 1) as f64,
+            height: LAYER_HEIGHT,
+            islands: islands.clone(),
+        })
+        .collect()
+}
+
+/// A 60 mm square plate with a 30 mm square hole in the middle, 5 layers.
+fn annulus_plate() -> Vec<RouteLayer> {
+    let mut hole = rect(15.0, 15.0, 45.0, 45.0);
+    hole.points.reverse();
+    stack(
+        vec![ExPolygon {
+            contour: rect(0.0, 0.0, 60.0, 60.0),
+            holes: vec![hole],
+        }],
+        5,
+    )
+}
+
+fn wire(net: &str, from: (f64, f64, f64), to: (f64, f64, f64)) -> Wire {
+    Wire {
+        net: net.into(),
+        from: Point3::new(from.0, from.1, from.2),
+        to: Point3::new(to.0, to.1, to.2),
+    }
+}
+
+fn top(layers: &[RouteLayer]) -> f64 {
+    layers.last().map_or(0.0, |l| l.z)
+}
+
+fn xy_length(points: &[Point3]) -> f64 {
+    points
+        .windows(2)
+        .map(|w| ((w[1].x - w[0].x).powi(2) + (w[1].y - w[0].y).powi(2)).sqrt())
+        .sum()
+}
+
+/// Distance in xy from `p` to the polyline `line`.
+fn distance_to_polyline(p: &Point3, line: &[Point3]) -> f64 {
+    line.windows(2)
+        .map(|w| {
+            let (ax, ay, bx, by) = (w[0].x, w[0].y, w[1].x, w[1].y);
+            let (dx, dy) = (bx - ax, by - ay);
+            let len2 = dx * dx + dy * dy;
+            let t = if len2 > 0.0 {
+                (((p.x - ax) * dx + (p.y - ay) * dy) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            ((ax + t * dx - p.x).powi(2) + (ay + t * dy - p.y).powi(2)).sqrt()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Length of the start of `next` that runs along `prev` (in xy): how far two consecutive layers'
+/// traces overlap at a layer change.
+fn overlap_length(prev: &[Point3], next: &[Point3]) -> f64 {
+    let on = |p: &Point3| distance_to_polyline(p, prev) < 1e-4;
+    let mut length = 0.0;
+    for w in next.windows(2) {
+        if !(on(&w[0]) && on(&w[1])) {
+            break;
+        }
+        length += xy_length(w);
+    }
+    length
+}
+
+/// The union of the channels of one wire's segments on `layer`.
+fn wire_channel(route: &WireRoute, layer: usize, params: &RouteParams) -> Vec<ExPolygon> {
+    let parts: Vec<ExPolygon> = route
+        .segments
+        .iter()
+        .filter(|(l, _)| *l == layer)
+        .flat_map(|(_, pts)| trace_channel(pts, params.channel_half_width()))
+        .collect();
+    union(&parts)
+}
+
+fn area(a: &[ExPolygon]) -> f64 {
+    a.iter().map(ExPolygon::area_mm2).sum()
+}
+
+/// Whether the xy of `p` is strictly inside the axis-aligned box.
+fn strictly_inside(p: (f64, f64), x0: f64, y0: f64, x1: f64, y1: f64) -> bool {
+    p.0 > x0 && p.0 < x1 && p.1 > y0 && p.1 < y1
+}
+
+#[test]
+fn annulus_route_follows_the_perimeters_around_the_hole() {
+    let layers = annulus_plate();
+    let z = top(&layers);
+    let params = RouteParams::default();
+    let w = wire("sig", (5.0, 30.0, z), (55.0, 30.0, z));
+    let result = route(&layers, std::slice::from_ref(&w), &params);
+    let r = &result.wires[0];
+    assert!(r.routed, "{r:?}");
+    assert_eq!(r.lower_bound, 50.0);
+    // Never inside the hole: every point, and every edge sampled every 0.05 mm.
+    for (_, pts) in &r.segments {
+        for s in pts.windows(2) {
+            let n = (xy_length(s) / 0.05).ceil().max(1.0) as usize;
+            for i in 0..=n {
+                let t = i as f64 / n as f64;
+                let p = (
+                    s[0].x + t * (s[1].x - s[0].x),
+                    s[0].y + t * (s[1].y - s[0].y),
+                );
+                assert!(
+                    !strictly_inside(p, 15.0, 15.0, 45.0, 45.0),
+                    "{p:?} in the hole"
+                );
+            }
+        }
+    }
+    assert_eq!(r.perimeter_crossings, 0);
+    // Shortest path around the hole: to a corner of the hole, along one side, to the other pad.
+    let around = 2.0 * (10.0f64.powi(2) + 15.0f64.powi(2)).sqrt() + 30.0;
+    assert!(r.length > r.lower_bound, "{}", r.length);
+    assert!(r.length < 1.6 * around, "{} vs {around}", r.length);
+    // The route stays on the pads' layer: a detour through other layers costs more.
+    assert_eq!(r.layer_changes, 0);
+    assert!(r.segments.iter().all(|(l, _)| *l == 4));
+    // The channel is returned on the trace's layer only.
+    assert!(area(&result.channels[4]) > 0.8 * r.length * 0.9);
+    assert!(result.channels[..4].iter().all(Vec::is_empty));
+}
+
+#[test]
+fn crossing_rubberbands_get_disjoint_channels() {
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 4);
+    let z = top(&layers);
+    let params = RouteParams::default();
+    let wires = [
+        wire("a", (5.0, 5.0, z), (35.0, 35.0, z)),
+        wire("b", (5.0, 35.0, z), (35.0, 5.0, z)),
+    ];
+    let result = route(&layers, &wires, &params);
+    for r in &result.wires {
+        assert!(r.routed, "{r:?}");
+        assert!(r.length >= r.lower_bound - 1e-6);
+    }
+    for l in 0..layers.len() {
+        let a = wire_channel(&result.wires[0], l, &params);
+        let b = wire_channel(&result.wires[1], l, &params);
+        let common = area(&intersection(&a, &b));
+        assert!(common < 1e-6, "layer {l}: channels share {common} mm²");
+    }
+    // One of them had to change layer (or go around the other's end): it is longer.
+    let longest = result.wires.iter().map(|r| r.length / r.lower_bound);
+    assert!(longest.fold(0.0, f64::max) > 1.0);
+}
+
+#[test]
+fn wire_between_layers_climbs_with_staircase_overlaps() {
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 5);
+    let params = RouteParams::default();
+    let w = wire("up", (5.0, 20.0, layers[0].z), (35.0, 20.0, layers[4].z));
+    let r = route_wire(&layers, &w, &params);
+    assert!(r.routed, "{r:?}");
+    assert!(r.layer_changes >= 4, "{r:?}");
+    assert_eq!(r.layer_changes + 1, r.segments.len());
+    assert_eq!(r.segments.first().map(|s| s.0), Some(0));
+    assert_eq!(r.segments.last().map(|s| s.0), Some(4));
+    for pair in r.segments.windows(2) {
+        let ((la, a), (lb, b)) = (&pair[0], &pair[1]);
+        assert_eq!(la.abs_diff(*lb), 1);
+        // Points sit at their layer's top.
+        assert!(a.iter().all(|p| (p.z - layers[*la].z).abs() < 1e-12));
+        let overlap = overlap_length(a, b);
+        assert!(
+            overlap >= params.interlayer_overlap,
+            "layers {la}→{lb}: overlap {overlap}"
+        );
+    }
+    assert!(
+        r.length > r.lower_bound && r.length < 2.0 * r.lower_bound,
+        "{r:?}"
+    );
+}
+
+#[test]
+fn single_stepping_reaches_the_same_route() {
+    let layers = annulus_plate();
+    let z = top(&layers);
+    let params = RouteParams::default();
+    let w = wire("sig", (5.0, 30.0, z), (55.0, 30.0, z));
+    let mut search = Search::new(&layers, &w, &params);
+    assert_eq!(search.state(), SearchState::Running);
+    let mut steps = 0;
+    let state = loop {
+        let s = search.step();
+        steps += 1;
+        if s != SearchState::Running {
+            break s;
+        }
+    };
+    assert_eq!(state, SearchState::Found);
+    assert!(steps > 10 && search.expansions() < steps);
+    // Stepping a finished search changes nothing.
+    assert_eq!(search.step(), SearchState::Found);
+    assert_eq!(search.result(), route_wire(&layers, &w, &params));
+    assert!(search.result().routed);
+}
+
+#[test]
+fn pad_on_a_separate_island_is_unrouted_and_the_rest_goes_on() {
+    let layers = stack(
+        vec![
+            solid(rect(0.0, 0.0, 20.0, 20.0)),
+            solid(rect(30.0, 0.0, 50.0, 20.0)),
+        ],
+        3,
+    );
+    let z = top(&layers);
+    let wires = [
+        wire("gap", (5.0, 10.0, z), (40.0, 10.0, z)),
+        wire("ok", (3.0, 3.0, z), (17.0, 17.0, z)),
+    ];
+    let result = route(&layers, &wires, &RouteParams::default());
+    let gap = &result.wires[0];
+    assert!(!gap.routed);
+    assert!(gap.segments.is_empty());
+    assert_eq!(gap.length, 0.0);
+    assert_eq!(gap.lower_bound, 35.0);
+    assert!(result.wires[1].routed);
+    assert_eq!(result.wires[1].net, "ok");
+}
+
+#[test]
+fn routing_is_deterministic() {
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 6);
+    let (z0, z5) = (layers[0].z, layers[5].z);
+    let wires = [
+        wire("a", (5.0, 5.0, z5), (35.0, 35.0, z5)),
+        wire("b", (5.0, 35.0, z5), (35.0, 5.0, z5)),
+        wire("c", (20.0, 3.0, z0), (20.0, 37.0, z5)),
+        wire("a", (35.0, 35.0, z5), (35.0, 20.0, z5)),
+    ];
+    let params = RouteParams::default();
+    let first = route(&layers, &wires, &params);
+    let second = route(&layers, &wires, &params);
+    assert_eq!(first, second);
+    assert!(first.wires.iter().filter(|w| w.routed).count() >= 3);
+}
+
+#[test]
+fn layer_of_picks_the_containing_or_nearest_layer() {
+    let layers = stack(vec![solid(rect(0.0, 0.0, 10.0, 10.0))], 3);
+    assert_eq!(layer_of(&layers, 0.2), Some(0));
+    // Float noise on a boundary still picks the layer whose top the pad sits on.
+    assert_eq!(layer_of(&layers, 0.2 + 1e-12), Some(0));
+    assert_eq!(layer_of(&layers, 0.4 - 1e-12), Some(1));
+    assert_eq!(layer_of(&layers, 0.3), Some(1));
+    assert_eq!(layer_of(&layers, 0.6), Some(2));
+    assert_eq!(layer_of(&layers, 5.0), Some(2));
+    assert_eq!(layer_of(&layers, -1.0), Some(0));
+    assert_eq!(layer_of(&[], 1.0), None);
+}
+
+#[test]
+fn cheap_outside_weight_lets_the_route_cross_the_hole() {
+    let layers = annulus_plate();
+    let z = top(&layers);
+    let params = RouteParams {
+        outside_weight: 1.0,
+        ..RouteParams::default()
+    };
+    let r = route_wire(
+        &layers,
+        &wire("sig", (5.0, 30.0, z), (55.0, 30.0, z)),
+        &params,
+    );
+    assert!(r.routed);
+    // Straight across: into the hole and out again.
+    assert!((r.length - 50.0).abs() < 1e-6, "{}", r.length);
+    assert_eq!(r.perimeter_crossings, 2);
+}
+
+#[test]
+fn wires_of_one_net_may_share_a_pad() {
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 3);
+    let z = top(&layers);
+    let wires = [
+        wire("gnd", (2.0, 20.0, z), (20.0, 20.0, z)),
+        wire("gnd", (20.0, 20.0, z), (38.0, 20.0, z)),
+        wire("sig", (20.0, 5.0, z), (20.0, 35.0, z)),
+    ];
+    let result = route(&layers, &wires, &RouteParams::default());
+    assert!(result.wires.iter().all(|w| w.routed), "{result:?}");
+    // The two gnd wires run straight into their shared pad.
+    assert!((result.wires[0].length - 18.0).abs() < 1e-6);
+    assert!((result.wires[1].length - 18.0).abs() < 1e-6);
+    // The gnd line leaves no room for a trace at its ends: the signal crosses it on another
+    // layer and comes back.
+    assert!(result.wires[2].layer_changes >= 2, "{:?}", result.wires[2]);
+}

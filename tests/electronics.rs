@@ -1,0 +1,239 @@
+//! `conduit slice --circuit --placement`: the bundled LED + coin-cell demo built into a block.
+
+use crate::support::{conduit, sample, stderr, temp_dir};
+use serde_json::Value;
+
+/// One extruding move of the replayed G-code.
+struct Extrusion {
+    tool: usize,
+    role: String,
+    z: f64,
+    from: [f64; 2],
+    to: [f64; 2],
+}
+
+impl Extrusion {
+    /// Points along the move: both ends and three between.
+    fn samples(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
+        (0..=4).map(|k| {
+            let t = f64::from(k) / 4.0;
+            [
+                self.from[0] + t * (self.to[0] - self.from[0]),
+                self.from[1] + t * (self.to[1] - self.from[1]),
+            ]
+        })
+    }
+}
+
+/// What the demo's G-code holds: extrusions, and (part, z of the layer it was placed in).
+struct Replayed {
+    extrusions: Vec<Extrusion>,
+    events: Vec<(String, f64)>,
+}
+
+fn replay(text: &str) -> Replayed {
+    let mut out = Replayed {
+        extrusions: Vec::new(),
+        events: Vec::new(),
+    };
+    let (mut tool, mut role, mut layer_z) = (0usize, String::new(), 0.0f64);
+    let (mut pos, mut e, mut relative_e) = ([0.0f64; 3], 0.0f64, false);
+    for line in text.lines() {
+        if let Some(r) = line.strip_prefix(";TYPE:") {
+            role = r.to_owned();
+        } else if let Some(z) = line.strip_prefix(";Z:") {
+            layer_z = z.parse().expect(";Z: number");
+        } else if let Some(rest) = line.strip_prefix(";PICK_AND_PLACE PART=") {
+            let part = rest.split(' ').next().unwrap_or_default().to_owned();
+            out.events.push((part, layer_z));
+        } else if let Some(rest) = line.strip_prefix(";MANUAL_INSERT PART=") {
+            out.events.push((rest.to_owned(), layer_z));
+        }
+        let code = line.split(';').next().unwrap_or_default().trim();
+        let mut words = code.split_whitespace();
+        match words.next() {
+            Some(t) if t.starts_with('T') && t.len() > 1 => {
+                tool = t[1..].parse().expect("tool number");
+            }
+            Some("M83") => relative_e = true,
+            Some("M82") => relative_e = false,
+            Some("G92") => {
+                for w in words {
+                    if let Some(v) = w.strip_prefix('E') {
+                        e = v.parse().expect("E");
+                    }
+                }
+            }
+            Some("G0" | "G1") => {
+                let mut to = pos;
+                let mut de = 0.0;
+                for w in words {
+                    let (k, v) = w.split_at(1);
+                    let v: f64 = v.parse().expect("a number");
+                    match k {
+                        "X" => to[0] = v,
+                        "Y" => to[1] = v,
+                        "Z" => to[2] = v,
+                        "E" if relative_e => de = v,
+                        "E" => {
+                            de = v - e;
+                            e = v;
+                        }
+                        _ => {}
+                    }
+                }
+                let moves_xy = to[0] != pos[0] || to[1] != pos[1];
+                // Paste tools carry no E: their moves with the valve open are the traces.
+                if moves_xy && (de > 0.0 || (tool == 1 && role == "Conductive trace")) {
+                    out.extrusions.push(Extrusion {
+                        tool,
+                        role: role.clone(),
+                        z: to[2],
+                        from: [pos[0], pos[1]],
+                        to: [to[0], to[1]],
+                    });
+                }
+                pos = to;
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+#[test]
+fn demo_circuit_slices_with_cavities_traces_events_and_placement_files() {
+    let dir = temp_dir();
+    let out = dir.path().join("demo.gcode");
+    let report = dir.path().join("demo.json");
+    let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
+    let o = conduit([
+        "slice".as_ref(),
+        demo("block.stl").as_os_str(),
+        "--circuit".as_ref(),
+        demo("led_coin.sch").as_os_str(),
+        "--placement".as_ref(),
+        demo("placement.toml").as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--report".as_ref(),
+        report.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let check = conduit(["check".as_ref(), out.as_os_str()]);
+    assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let e = &report["electronics"];
+    assert_eq!(e["routed"], 4, "{e}");
+    assert_eq!(e["unrouted"], 0);
+    let total = e["total_length"].as_f64().expect("length");
+    let bound = e["total_lower_bound"].as_f64().expect("bound");
+    assert!(
+        total >= bound - 1e-6 && total < 2.0 * bound,
+        "{total} vs {bound}"
+    );
+    let parts = e["parts"].as_array().expect("parts");
+    assert_eq!(parts.len(), 3);
+
+    let text = std::fs::read_to_string(&out).expect("G-code");
+    let r = replay(&text);
+    // Traces: on tool 1, on the seating plane's layer (all parts sit at z = 4).
+    let traces: Vec<&Extrusion> = r.extrusions.iter().filter(|x| x.tool == 1).collect();
+    assert!(traces.len() > 10, "{} trace moves", traces.len());
+    assert!(traces.iter().all(|t| t.role == "Conductive trace"));
+    assert!(traces.iter().all(|t| (t.z - 4.0).abs() < 1e-9));
+    // Plastic stays on tool 0.
+    assert!(
+        r.extrusions
+            .iter()
+            .filter(|x| x.tool == 0)
+            .all(|x| x.role != "Conductive trace")
+    );
+
+    // Each part is placed once, at the start of the first layer above its cavity.
+    let heights = [("BAT1", 3.2), ("R1", 0.6), ("LED1", 1.0)];
+    assert_eq!(r.events.len(), 3);
+    for (name, h) in heights {
+        let (_, layer_top) = r
+            .events
+            .iter()
+            .find(|(p, _)| p == name)
+            .unwrap_or_else(|| panic!("no event for {name}"));
+        let layer_bottom = layer_top - 0.2;
+        assert!(
+            layer_bottom >= 4.0 + h - 1e-6 && layer_bottom < 4.0 + h + 0.2,
+            "{name} placed in the layer up to {layer_top}"
+        );
+    }
+    // The coin cell's cavity (24 × 21 mm body + 0.3 mm) is empty of plastic from the seating
+    // plane to its top: no plastic extrusion passes inside it (0.5 mm in from its edge).
+    let bat = parts
+        .iter()
+        .find(|p| p["name"] == "BAT1")
+        .expect("BAT1 in the report");
+    let (cx, cy) = (
+        bat["position"][0].as_f64().expect("x"),
+        bat["position"][1].as_f64().expect("y"),
+    );
+    let inside = |p: [f64; 2]| (p[0] - cx).abs() < 12.3 - 0.5 && (p[1] - cy).abs() < 10.8 - 0.5;
+    let in_cavity = r
+        .extrusions
+        .iter()
+        .filter(|x| x.tool == 0 && x.z > 4.0 + 1e-6 && x.z <= 7.2 + 1e-6)
+        .filter(|x| x.samples().any(inside))
+        .count();
+    assert_eq!(in_cavity, 0);
+    // Under it (the floor) and over it (the lid) there is plastic.
+    for z in [4.0, 7.4] {
+        assert!(
+            r.extrusions
+                .iter()
+                .any(|x| x.tool == 0 && (x.z - z).abs() < 1e-9 && x.samples().any(inside)),
+            "no plastic at z {z}"
+        );
+    }
+
+    // The pick-and-place files list the three parts where the report puts them.
+    let pos = std::fs::read_to_string(dir.path().join("demo.pos")).expect(".pos written");
+    let records = conduit_pnp::read_kicad_pos(&pos).expect(".pos parses");
+    assert_eq!(records.len(), 3);
+    for (rec, part) in records.iter().zip(parts) {
+        assert_eq!(rec.reference, part["name"].as_str().expect("name"));
+        for (k, v) in [rec.x, rec.y, rec.z].into_iter().enumerate() {
+            let want = part["position"][k].as_f64().expect("coordinate");
+            assert!((v - want).abs() < 1e-4, "{}: {v} vs {want}", rec.reference);
+        }
+    }
+    let xml =
+        std::fs::read_to_string(dir.path().join("demo.openpnp.xml")).expect("OpenPnP written");
+    let board = conduit_pnp::read_openpnp_board(&xml).expect("OpenPnP parses");
+    assert_eq!(board.len(), 3);
+    assert_eq!(board[2].rotation_deg, 90.0);
+}
+
+#[test]
+fn unknown_part_in_the_placement_is_an_error_naming_it() {
+    let dir = temp_dir();
+    let placement = dir.path().join("bad.toml");
+    std::fs::write(
+        &placement,
+        "origin = \"model\"\n[[part]]\nname = \"R9\"\nx = 1.0\ny = 1.0\nz = 1.0\n",
+    )
+    .expect("written");
+    let out = dir.path().join("bad.gcode");
+    let o = conduit([
+        "slice".as_ref(),
+        sample("circuit_demo/block.stl").as_os_str(),
+        "--circuit".as_ref(),
+        sample("circuit_demo/led_coin.sch").as_os_str(),
+        "--placement".as_ref(),
+        placement.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(stderr(&o).contains("R9"), "{}", stderr(&o));
+    assert!(!out.exists(), "no G-code on failure");
+}
