@@ -237,3 +237,50 @@ fn unknown_part_in_the_placement_is_an_error_naming_it() {
     assert!(stderr(&o).contains("R9"), "{}", stderr(&o));
     assert!(!out.exists(), "no G-code on failure");
 }
+
+#[test]
+fn route_command_draws_every_layer_with_traces_cavities_and_a_report() {
+    let dir = temp_dir();
+    let svgs = dir.path().join("layers");
+    let report = dir.path().join("route.json");
+    let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
+    let o = conduit([
+        "route".as_ref(),
+        demo("block.stl").as_os_str(),
+        "--circuit".as_ref(),
+        demo("led_coin.sch").as_os_str(),
+        "--placement".as_ref(),
+        demo("placement.toml").as_os_str(),
+        "--out-dir".as_ref(),
+        svgs.as_os_str(),
+        "--report".as_ref(),
+        report.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // 8 mm in 0.2 mm layers: 40 SVGs.
+    let read = |i: usize| {
+        std::fs::read_to_string(svgs.join(format!("layer_{i:04}.svg"))).expect("SVG written")
+    };
+    assert!(!svgs.join("layer_0041.svg").exists());
+    for i in 1..=40 {
+        let svg = read(i);
+        let z = 0.2 * i as f64;
+        assert!(
+            svg.contains(&format!("<title>z = {z:.3} mm</title>")),
+            "layer {i}"
+        );
+        // Traces only on the seating plane's layer (z = 4), cavities from there to the coin
+        // cell's top (7.2 mm).
+        assert_eq!(svg.contains("<polyline"), i == 20, "layer {i}");
+        assert_eq!(
+            svg.contains("stroke-dasharray"),
+            (21..=36).contains(&i),
+            "layer {i}"
+        );
+    }
+    assert_eq!(read(20).matches("<polyline").count(), 4);
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    assert_eq!(report["routed"], 4);
+    assert_eq!(report["wires"].as_array().map(Vec::len), Some(4));
+}

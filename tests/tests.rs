@@ -6,6 +6,7 @@
 mod cli;
 mod conformance;
 mod electronics;
+mod electronics_corpus;
 mod preview;
 mod roundtrip;
 mod slice;

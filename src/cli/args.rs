@@ -28,6 +28,9 @@ pub enum Command {
     Config(ConfigArgs),
     /// Draw a G-code file (conduit's or another slicer's): one SVG per layer and a PNG contact sheet.
     Preview(PreviewArgs),
+    /// Place a circuit in models and route its nets, without G-code: a report and one SVG per
+    /// layer (material, cavities, channels, traces).
+    Route(RouteArgs),
 }
 
 /// Where settings come from: a config file plus `--set` overrides.
@@ -65,6 +68,30 @@ pub struct SliceArgs {
     /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.
     #[arg(long, value_name = "P.toml|P.3de", requires = "circuit")]
     pub placement: Option<PathBuf>,
+}
+
+/// Arguments of `conduit route`.
+#[derive(Debug, Args)]
+pub struct RouteArgs {
+    /// Models the circuit is built into (STL, 3MF, OBJ, OFF, PLY).
+    #[arg(required = true, value_name = "MODEL")]
+    pub models: Vec<PathBuf>,
+    /// Settings.
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// The circuit: an EAGLE schematic or board (.sch, .brd).
+    #[arg(long, value_name = "X.sch|X.brd")]
+    pub circuit: PathBuf,
+    /// Where the parts go: a placement TOML or an Electronic Slic3r .3de file.
+    #[arg(long, value_name = "P.toml|P.3de")]
+    pub placement: PathBuf,
+    /// Folder for `layer_0001.svg`... (created if missing).
+    #[arg(short, long = "out-dir", value_name = "DIR")]
+    pub out_dir: PathBuf,
+    /// Also write the JSON report (parts; per wire routed, length, lower bound, layer changes,
+    /// perimeter crossings; totals).
+    #[arg(long, value_name = "REPORT.json")]
+    pub report: Option<PathBuf>,
 }
 
 /// Arguments of `conduit check`.

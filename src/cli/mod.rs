@@ -8,6 +8,7 @@ mod convert;
 mod info;
 mod preview;
 mod progress;
+mod route;
 mod slice;
 
 use clap::Parser;
@@ -52,6 +53,7 @@ pub fn run() -> ExitCode {
         args::Command::Check(a) => check::run(a),
         args::Command::Config(a) => config::run(a),
         args::Command::Preview(a) => preview::run(a),
+        args::Command::Route(a) => route::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -10,3 +10,4 @@
 
 pub mod gcode;
 pub mod preview;
+pub mod route_svg;

@@ -204,8 +204,18 @@ pub fn route_params(cfg: &Config) -> RouteParams {
     }
 }
 
+/// What the electronics stage cut from one object's layers.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ObjectCuts {
+    /// The part cavities.
+    pub cavities: Vec<Cavity>,
+    /// Per layer, the wire channels.
+    pub channels: Vec<Vec<ExPolygon>>,
+}
+
 /// Everything the electronics stage adds to one object: its islands are carved in place; the
-/// returned extras carry the traces, drops and part events, and the report entries.
+/// extras get the traces, drops and part events, the report its entries; the cuts are
+/// returned for drawing.
 pub fn object_stage(
     object: usize,
     islands: &mut [Vec<ExPolygon>],
@@ -214,7 +224,7 @@ pub fn object_stage(
     cfg: &Config,
     extras: &mut LayerExtras,
     report: &mut ElectronicsReport,
-) {
+) -> ObjectCuts {
     let parts = &circuit.parts;
     let spans: Vec<(f64, f64)> = zs.iter().map(|z| (z.bottom, z.top)).collect();
     let mine: Vec<(usize, &PlacedPart)> = parts
@@ -368,6 +378,10 @@ pub fn object_stage(
         .filter(|w| w.routed)
         .map(|w| w.lower_bound)
         .sum();
+    ObjectCuts {
+        cavities,
+        channels: result.channels,
+    }
 }
 
 /// The layer whose top is the seating plane `z` (within half a layer), where pad drops go.

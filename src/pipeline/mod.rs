@@ -11,13 +11,14 @@ pub use electronics::{Electronics, ElectronicsReport};
 
 use crate::config::Config;
 use crate::emit::gcode::{GcodeStats, write_gcode};
-use crate::geom::{BoundingBox, ExPolygon, Transform};
+use crate::geom::{BoundingBox, ExPolygon, Point3, Transform, scaled};
 use crate::mesh::Mesh;
 use crate::program::{LayerExtras, ObjectLayers, Program, ProgramParams, build_program_with};
 use crate::region::{RegionError, make_regions_with_heights};
 use crate::scene::{Scene, placed_meshes};
 use crate::slice::{LayerZ, SliceParams, SliceReport, slice_mesh};
 use serde::Serialize;
+use std::collections::BTreeMap;
 use std::time::Instant;
 
 /// The pipeline's steps, in order.
@@ -181,24 +182,50 @@ pub fn slice_scene(
     slice_scene_with(scene, cfg, None, progress)
 }
 
-/// [`slice_scene`] with an optional circuit: its parts get cavities and placement events, its
-/// nets are routed as conductive traces in carved channels on `route.conductive_tool`.
-pub fn slice_scene_with(
+/// Stage timings: each lap records the time since the previous one.
+struct Laps {
+    times: Vec<(Stage, f64)>,
+    clock: Instant,
+}
+
+impl Laps {
+    fn new() -> Self {
+        Self {
+            times: Vec::new(),
+            clock: Instant::now(),
+        }
+    }
+
+    fn lap(&mut self, stage: Stage) {
+        self.times.push((stage, self.clock.elapsed().as_secs_f64()));
+        self.clock = Instant::now();
+    }
+}
+
+/// The pipeline up to the regions stage: objects on the bed, sliced, and with a circuit the
+/// electronics stage run on their islands.
+struct Front {
+    /// Per object: its layers and slicing report.
+    sliced: Vec<(Vec<crate::slice::SlicedLayer>, SliceReport)>,
+    /// Per object: name and bed bounding box.
+    placed: Vec<(String, Option<BoundingBox>)>,
+    extras: LayerExtras,
+    report: Option<ElectronicsReport>,
+    parts: Vec<crate::circuit::PlacedPart>,
+    /// Per object: what the electronics stage cut (empty without a circuit).
+    cuts: Vec<electronics::ObjectCuts>,
+}
+
+fn front(
     scene: &Scene,
     cfg: &Config,
     circuit: Option<&Electronics>,
-    mut progress: impl FnMut(Stage),
-) -> Result<(Vec<u8>, Program, SliceSummary), PipelineError> {
+    progress: &mut impl FnMut(Stage),
+    laps: &mut Laps,
+) -> Result<Front, PipelineError> {
     if scene.triangle_count() == 0 {
         return Err(PipelineError::EmptyScene);
     }
-    let mut times = Vec::new();
-    let mut clock = Instant::now();
-    let mut lap = |stage: Stage, times: &mut Vec<(Stage, f64)>| {
-        times.push((stage, clock.elapsed().as_secs_f64()));
-        clock = Instant::now();
-    };
-
     progress(Stage::Place);
     let model_boxes: Vec<BoundingBox> = placed_meshes(scene)
         .iter()
@@ -211,26 +238,30 @@ pub fn slice_scene_with(
         .collect();
     let (meshes, offsets) = place_on_bed_with_offsets(scene, cfg);
     check_fits(&meshes, cfg)?;
-    lap(Stage::Place, &mut times);
+    laps.lap(Stage::Place);
 
     progress(Stage::Slice);
     let params = SliceParams::new(cfg.slice.region.layer_height, cfg.slice.first_layer_height)?;
-    let sliced: Vec<_> = meshes.iter().map(|m| slice_mesh(m, &params)).collect();
+    let mut sliced: Vec<_> = meshes.iter().map(|m| slice_mesh(m, &params)).collect();
     // The meshes are not needed past slicing: keep only what the report says about them.
     let placed: Vec<(String, Option<BoundingBox>)> = meshes
         .into_iter()
         .map(|m| (m.name.clone(), m.bounding_box()))
         .collect();
-    lap(Stage::Slice, &mut times);
+    laps.lap(Stage::Slice);
 
     // Electronics: parts on the bed, then per object cavities, routes and channels.
-    let mut extras = LayerExtras::default();
-    let mut parts = Vec::new();
-    let mut report = None;
-    let mut sliced = sliced;
+    let mut out = Front {
+        sliced: Vec::new(),
+        placed,
+        extras: LayerExtras::default(),
+        report: None,
+        parts: Vec::new(),
+        cuts: Vec::new(),
+    };
     if let Some(e) = circuit {
         progress(Stage::Route);
-        let placed = electronics::place_circuit(e, &model_boxes, &offsets, cfg)?;
+        let circuit = electronics::place_circuit(e, &model_boxes, &offsets, cfg)?;
         let mut r = ElectronicsReport::default();
         for (i, (layers, _)) in sliced.iter_mut().enumerate() {
             let zs: Vec<LayerZ> = layers.iter().map(|l| l.z).collect();
@@ -238,15 +269,123 @@ pub fn slice_scene_with(
                 .iter_mut()
                 .map(|l| std::mem::take(&mut l.islands))
                 .collect();
-            electronics::object_stage(i, &mut islands, &zs, &placed, cfg, &mut extras, &mut r);
+            let cuts = electronics::object_stage(
+                i,
+                &mut islands,
+                &zs,
+                &circuit,
+                cfg,
+                &mut out.extras,
+                &mut r,
+            );
+            out.cuts.push(cuts);
             for (l, isl) in layers.iter_mut().zip(islands) {
                 l.islands = isl;
             }
         }
-        report = Some(r);
-        parts = placed.parts;
-        lap(Stage::Route, &mut times);
+        out.report = Some(r);
+        out.parts = circuit.parts;
+        laps.lap(Stage::Route);
     }
+    out.sliced = sliced;
+    Ok(out)
+}
+
+/// One layer of [`RouteView`], bed coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteViewLayer {
+    /// Top of the layer, mm.
+    pub z: f64,
+    /// The material left after cavities and channels, all objects.
+    pub islands: Vec<ExPolygon>,
+    /// Part cavities cut from this layer.
+    pub cavities: Vec<ExPolygon>,
+    /// Wire channels cut from this layer.
+    pub channels: Vec<ExPolygon>,
+    /// Conductive paths printed on this layer (traces and drops).
+    pub traces: Vec<Vec<Point3>>,
+}
+
+/// What `conduit route` shows: the layers with what the electronics stage made of them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteView {
+    /// Layers bottom to top (objects merged by height).
+    pub layers: Vec<RouteViewLayer>,
+    /// Parts and wires.
+    pub report: ElectronicsReport,
+    /// Placed parts, bed coordinates.
+    pub parts: Vec<crate::circuit::PlacedPart>,
+}
+
+/// The pipeline up to routing, without regions or G-code: for `conduit route`.
+pub fn route_scene(
+    scene: &Scene,
+    cfg: &Config,
+    circuit: &Electronics,
+    mut progress: impl FnMut(Stage),
+) -> Result<RouteView, PipelineError> {
+    let mut laps = Laps::new();
+    let f = front(scene, cfg, Some(circuit), &mut progress, &mut laps)?;
+    let mut by_z: BTreeMap<i64, RouteViewLayer> = BTreeMap::new();
+    for ((layers, _), cuts) in f.sliced.into_iter().zip(&f.cuts) {
+        for (i, l) in layers.into_iter().enumerate() {
+            let key = scaled(l.z.top);
+            let entry = by_z.entry(key).or_insert_with(|| RouteViewLayer {
+                z: l.z.top,
+                islands: Vec::new(),
+                cavities: Vec::new(),
+                channels: Vec::new(),
+                traces: Vec::new(),
+            });
+            entry.islands.extend(l.islands);
+            entry.cavities.extend(
+                cuts.cavities
+                    .iter()
+                    .filter(|c| c.overlaps(l.z.bottom, l.z.top))
+                    .flat_map(|c| c.outline.iter().cloned()),
+            );
+            if let Some(ch) = cuts.channels.get(i) {
+                entry.channels.extend(ch.iter().cloned());
+            }
+        }
+    }
+    for (key, paths) in &f.extras.paths_after {
+        if let Some(layer) = by_z.get_mut(key) {
+            layer.traces.extend(paths.iter().map(|p| {
+                let mut pts = p.points.clone();
+                if p.closed
+                    && let Some(first) = pts.first().copied()
+                {
+                    pts.push(first);
+                }
+                pts
+            }));
+        }
+    }
+    Ok(RouteView {
+        layers: by_z.into_values().collect(),
+        report: f.report.unwrap_or_default(),
+        parts: f.parts,
+    })
+}
+
+/// [`slice_scene`] with an optional circuit: its parts get cavities and placement events, its
+/// nets are routed as conductive traces in carved channels on `route.conductive_tool`.
+pub fn slice_scene_with(
+    scene: &Scene,
+    cfg: &Config,
+    circuit: Option<&Electronics>,
+    mut progress: impl FnMut(Stage),
+) -> Result<(Vec<u8>, Program, SliceSummary), PipelineError> {
+    let mut laps = Laps::new();
+    let Front {
+        sliced,
+        placed,
+        extras,
+        report,
+        parts,
+        cuts: _,
+    } = front(scene, cfg, circuit, &mut progress, &mut laps)?;
 
     progress(Stage::Regions);
     let mut objects = Vec::with_capacity(sliced.len());
@@ -275,23 +414,23 @@ pub fn slice_scene_with(
             slice: report,
         });
     }
-    lap(Stage::Regions, &mut times);
+    laps.lap(Stage::Regions);
 
     progress(Stage::Program);
     let program = build_program_with(&objects, &extras, &ProgramParams::from_config(cfg));
     drop(objects);
-    lap(Stage::Program, &mut times);
+    laps.lap(Stage::Program);
 
     progress(Stage::Emit);
     let mut gcode = Vec::new();
     let stats = write_gcode(&program, cfg, &mut gcode)?;
-    lap(Stage::Emit, &mut times);
+    laps.lap(Stage::Emit);
 
     let summary = SliceSummary {
         objects: summaries,
         layers: program.layers.len(),
         gcode: stats,
-        stage_seconds: times,
+        stage_seconds: laps.times,
         electronics: report,
         parts,
     };

@@ -1,0 +1,59 @@
+//! `conduit route`: a circuit placed in models and routed, shown as one SVG per layer, without
+//! G-code.
+
+use super::{Failure, args::RouteArgs, config::resolve};
+use anyhow::Context;
+use conduit::circuit::{Circuit, Placement};
+use conduit::emit::route_svg::{layer_svg, view_box};
+use conduit::pipeline::{Electronics, route_scene};
+use conduit::scene::{LoadOptions, Scene, load_scene, write_atomically};
+use std::io::Write;
+
+pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
+    let cfg = resolve(&args.config)?;
+    let mut scene = Scene::default();
+    for path in &args.models {
+        let (s, warnings) =
+            load_scene(path, &LoadOptions::default()).map_err(anyhow::Error::from)?;
+        for w in warnings {
+            eprintln!("warning: {}: {w}", path.display());
+        }
+        scene.objects.extend(s.objects);
+    }
+    let electronics = Electronics {
+        circuit: Circuit::load(&args.circuit).map_err(anyhow::Error::from)?,
+        placement: Placement::load(&args.placement).map_err(anyhow::Error::from)?,
+    };
+    let view = route_scene(&scene, &cfg, &electronics, |_| {})
+        .with_context(|| format!("routing {}", args.circuit.display()))?;
+    std::fs::create_dir_all(&args.out_dir)
+        .with_context(|| format!("{}: cannot create the folder", args.out_dir.display()))?;
+    if let Some(bounds) = view_box(&view.layers) {
+        for (i, layer) in view.layers.iter().enumerate() {
+            let path = args.out_dir.join(format!("layer_{:04}.svg", i + 1));
+            let svg = layer_svg(layer, bounds, cfg.route.conductive_width);
+            write_atomically(&path, |f| f.write_all(svg.as_bytes()))
+                .with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+    }
+    if let Some(report) = &args.report {
+        let json = serde_json::to_vec_pretty(&view.report).context("serialising the report")?;
+        write_atomically(report, |f| f.write_all(&json))
+            .with_context(|| format!("{}: cannot write report", report.display()))?;
+    }
+    let r = &view.report;
+    eprintln!(
+        "{}: {} layers drawn; {} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
+        args.out_dir.display(),
+        view.layers.len(),
+        r.parts.len(),
+        r.routed,
+        r.routed + r.unrouted,
+        r.total_length,
+        r.total_lower_bound
+    );
+    for w in r.wires.iter().filter(|w| !w.routed) {
+        eprintln!("warning: net {} could not be routed", w.net);
+    }
+    Ok(())
+}

@@ -1,0 +1,397 @@
+//! Corpus EAGLE boards placed on a grid in a generated block and routed.
+//!
+//! Each board's schematic is loaded and every part with pads is put in a cell of a grid (the
+//! cell is the part's pad extent plus [`CELL_MARGIN_MM`] on each side, at least
+//! [`MIN_CELL_MM`]), all at rotation 0 on one seating plane, in a cuboid block sized to the
+//! grid. The block is sliced with the circuit (through the library, or the CLI for one board),
+//! and the report must account for every wire of the nets' spanning trees; the small boards
+//! must route completely.
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use conduit::circuit::{Circuit, PadShape, Part, Placement};
+use conduit::config::Config;
+use conduit::geom::{Point3, Transform};
+use conduit::mesh::Mesh;
+use conduit::pipeline::{Electronics, slice_scene_with};
+use conduit::scene::{MeshFormat, Scene, SceneObject, save};
+use serde_json::Value;
+
+use crate::support::{conduit, corpus, stderr, temp_dir};
+
+/// Smallest side of a grid cell, mm.
+const MIN_CELL_MM: f64 = 6.0;
+/// Space on each side of a part's pad extent within its cell, mm.
+const CELL_MARGIN_MM: f64 = 2.0;
+/// Material around the grid, mm.
+const BLOCK_MARGIN_MM: f64 = 5.0;
+/// Height of the block, mm.
+const BLOCK_HEIGHT_MM: f64 = 4.0;
+/// Seating plane of every part, mm: the top of the fifth 0.2 mm layer.
+const SEATING_Z_MM: f64 = 1.0;
+/// Body height of every part, mm.
+const BODY_HEIGHT_MM: f64 = 1.0;
+
+/// The schematic of corpus board `name` (`eagle/<name>/*/*.sch`).
+fn schematic(corpus: &Path, name: &str) -> PathBuf {
+    let dir = corpus.join("eagle").join(name);
+    let mut found = Vec::new();
+    let mut stack = vec![dir.clone()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).expect("corpus board folder readable") {
+            let path = entry.expect("directory entry").path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "sch") {
+                found.push(path);
+            }
+        }
+    }
+    assert_eq!(found.len(), 1, "one .sch under {}", dir.display());
+    found.remove(0)
+}
+
+/// The extent of a part's pads in its package frame, `[min x, min y, max x, max y]` mm, or
+/// `None` for a package without pads.
+fn pad_extent(part: &Part) -> Option<[f64; 4]> {
+    part.pads
+        .iter()
+        .map(|pad| {
+            let (w, h) = match pad.shape {
+                PadShape::Round { diameter } => (diameter, diameter),
+                PadShape::Rect { width, height } | PadShape::Oblong { width, height } => {
+                    (width, height)
+                }
+            };
+            let (s, c) = pad.rotation_deg.to_radians().sin_cos();
+            let hx = (c.abs() * w + s.abs() * h) / 2.0;
+            let hy = (s.abs() * w + c.abs() * h) / 2.0;
+            [pad.x - hx, pad.y - hy, pad.x + hx, pad.y + hy]
+        })
+        .reduce(|a, b| {
+            [
+                a[0].min(b[0]),
+                a[1].min(b[1]),
+                a[2].max(b[2]),
+                a[3].max(b[3]),
+            ]
+        })
+}
+
+/// Parts on a grid: the placement and the block it fits in.
+struct Grid {
+    /// The placement, TOML, model coordinates.
+    toml: String,
+    /// Names of the placed parts.
+    placed: BTreeSet<String>,
+    /// Size of the block in x and y, mm; the block stands on z = 0 from the origin.
+    size: [f64; 2],
+}
+
+/// A TOML basic string.
+fn toml_string(s: &str) -> String {
+    format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
+}
+
+/// Every part with pads on a grid as square as possible, in circuit order, row by row. A
+/// column is as wide as its widest cell and a row as deep as its deepest; each part's pads
+/// are centred in its cell.
+fn grid_placement(circuit: &Circuit) -> Grid {
+    let parts: Vec<(&Part, [f64; 4])> = circuit
+        .parts
+        .iter()
+        .filter_map(|p| pad_extent(p).map(|e| (p, e)))
+        .collect();
+    let cols = (parts.len() as f64).sqrt().ceil().max(1.0) as usize;
+    let rows = parts.len().div_ceil(cols);
+    let cell = |e: &[f64; 4]| {
+        [
+            (e[2] - e[0] + 2.0 * CELL_MARGIN_MM).max(MIN_CELL_MM),
+            (e[3] - e[1] + 2.0 * CELL_MARGIN_MM).max(MIN_CELL_MM),
+        ]
+    };
+    let mut widths = vec![0.0f64; cols];
+    let mut depths = vec![0.0f64; rows];
+    for (k, (_, e)) in parts.iter().enumerate() {
+        let [w, d] = cell(e);
+        widths[k % cols] = widths[k % cols].max(w);
+        depths[k / cols] = depths[k / cols].max(d);
+    }
+    let starts = |sizes: &[f64]| -> Vec<f64> {
+        sizes
+            .iter()
+            .scan(BLOCK_MARGIN_MM, |at, s| {
+                let start = *at;
+                *at += s;
+                Some(start)
+            })
+            .collect()
+    };
+    let (xs, ys) = (starts(&widths), starts(&depths));
+    let mut toml = String::from("origin = \"model\"\n");
+    for (k, (part, e)) in parts.iter().enumerate() {
+        let (col, row) = (k % cols, k / cols);
+        let x = xs[col] + widths[col] / 2.0 - (e[0] + e[2]) / 2.0;
+        let y = ys[row] + depths[row] / 2.0 - (e[1] + e[3]) / 2.0;
+        write!(
+            toml,
+            "\n[[part]]\nname = {}\nx = {x:?}\ny = {y:?}\nz = {SEATING_Z_MM:?}\n\
+             rotation = 0.0\nmethod = \"auto\"\nbody_height = {BODY_HEIGHT_MM:?}\n",
+            toml_string(&part.name)
+        )
+        .expect("writing to a String");
+    }
+    let size = [
+        widths.iter().sum::<f64>() + 2.0 * BLOCK_MARGIN_MM,
+        depths.iter().sum::<f64>() + 2.0 * BLOCK_MARGIN_MM,
+    ];
+    Grid {
+        toml,
+        placed: parts.iter().map(|(p, _)| p.name.clone()).collect(),
+        size,
+    }
+}
+
+/// The block for a grid, as a one-object scene.
+fn block(grid: &Grid) -> Scene {
+    let mesh = Mesh::cuboid(
+        "block",
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(grid.size[0], grid.size[1], BLOCK_HEIGHT_MM),
+    );
+    Scene {
+        objects: vec![SceneObject {
+            name: "block".into(),
+            mesh,
+            transform: Transform::identity(),
+            tool: None,
+        }],
+    }
+}
+
+/// Wires the router must be given: per net, one fewer than its pins on placed parts (the
+/// spanning tree's edges). Counted from the circuit, not from the report.
+fn expected_wires(circuit: &Circuit, placed: &BTreeSet<String>) -> usize {
+    circuit
+        .nets
+        .iter()
+        .map(|n| {
+            let pins: BTreeSet<(&str, &str)> = n
+                .pins
+                .iter()
+                .filter(|p| placed.contains(&p.part))
+                .filter_map(|p| {
+                    let pad = circuit.part(&p.part)?.pad(&p.pad)?;
+                    Some((p.part.as_str(), pad.name.as_str()))
+                })
+                .collect();
+            pins.len().saturating_sub(1)
+        })
+        .sum()
+}
+
+/// A corpus board placed on its grid.
+struct Board {
+    name: &'static str,
+    circuit: Circuit,
+    grid: Grid,
+    expected: usize,
+}
+
+impl Board {
+    /// Corpus board `name`, or `None` (after the skip line) without the corpus.
+    fn load(name: &'static str) -> Option<Board> {
+        let corpus = corpus()?;
+        let sch = schematic(&corpus, name);
+        let circuit = Circuit::load(&sch).unwrap_or_else(|e| panic!("{e}"));
+        let grid = grid_placement(&circuit);
+        let expected = expected_wires(&circuit, &grid.placed);
+        Some(Board {
+            name,
+            circuit,
+            grid,
+            expected,
+        })
+    }
+
+    /// Slices the block with the circuit through the library; the `electronics` report as
+    /// JSON.
+    fn slice(&self) -> Value {
+        let placement = Placement::from_toml(&self.grid.toml).unwrap_or_else(|e| panic!("{e}"));
+        let e = Electronics {
+            circuit: self.circuit.clone(),
+            placement,
+        };
+        let started = Instant::now();
+        let (_, _, summary) =
+            slice_scene_with(&block(&self.grid), &Config::default(), Some(&e), |_| {})
+                .unwrap_or_else(|e| panic!("{}: {e}", self.name));
+        let report = summary.electronics.expect("a report with a circuit");
+        let value = serde_json::to_value(&report).expect("the report serialises");
+        self.log(&value, started);
+        value
+    }
+
+    /// Slices through the CLI into `dir`: the `electronics` report, stderr, and the G-code.
+    fn slice_cli(&self, dir: &Path) -> (Value, String, PathBuf) {
+        let (stl, toml) = (dir.join("block.stl"), dir.join("placement.toml"));
+        let (out, report) = (dir.join("board.gcode"), dir.join("report.json"));
+        save(&block(&self.grid), &stl, MeshFormat::Stl).expect("block written");
+        std::fs::write(&toml, &self.grid.toml).expect("placement written");
+        let sch = schematic(&corpus().expect("corpus"), self.name);
+        let started = Instant::now();
+        let o = conduit([
+            "slice".as_ref(),
+            stl.as_os_str(),
+            "--circuit".as_ref(),
+            sch.as_os_str(),
+            "--placement".as_ref(),
+            toml.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+            "--report".as_ref(),
+            report.as_os_str(),
+        ]);
+        assert!(o.status.success(), "{}: {}", self.name, stderr(&o));
+        let text = std::fs::read_to_string(&report).expect("report written");
+        let mut value: Value = serde_json::from_str(&text).expect("report is JSON");
+        let e = value["electronics"].take();
+        self.log(&e, started);
+        (e, stderr(&o), out)
+    }
+
+    fn log(&self, e: &Value, started: Instant) {
+        println!(
+            "{}: {} parts on a {:.0} × {:.0} mm grid, {} nets, {} wires expected, {} routed, \
+             {} unrouted, {:.1} mm of trace for {:.1} mm straight, {:.1} s",
+            self.name,
+            self.grid.placed.len(),
+            self.grid.size[0],
+            self.grid.size[1],
+            self.circuit.nets.len(),
+            self.expected,
+            e["routed"],
+            e["unrouted"],
+            e["total_length"].as_f64().unwrap_or(f64::NAN),
+            e["total_lower_bound"].as_f64().unwrap_or(f64::NAN),
+            started.elapsed().as_secs_f64()
+        );
+    }
+
+    /// The report accounts for every wire: one entry each, counts and totals that add up, no
+    /// unplaced pins, every part placed, and routed wires that stay inside the material and are
+    /// no shorter than the straight line. Returns the unrouted wires' nets.
+    fn check_accounted(&self, e: &Value) -> BTreeSet<String> {
+        let name = self.name;
+        let wires = e["wires"].as_array().expect("wires");
+        assert_eq!(wires.len(), self.expected, "{name}: wires in the report");
+        let routed = e["routed"].as_u64().expect("routed") as usize;
+        let unrouted = e["unrouted"].as_u64().expect("unrouted") as usize;
+        assert_eq!(
+            routed + unrouted,
+            self.expected,
+            "{name}: routed + unrouted"
+        );
+        let number = |w: &Value, k: &str| w[k].as_f64().unwrap_or_else(|| panic!("{name}: {k}"));
+        let (mut length, mut bound, mut count) = (0.0, 0.0, 0);
+        let mut failed = BTreeSet::new();
+        for w in wires {
+            let net = w["net"].as_str().expect("net name");
+            assert!(self.circuit.net(net).is_some(), "{name}: unknown net {net}");
+            if w["routed"] != Value::Bool(true) {
+                failed.insert(net.to_owned());
+                continue;
+            }
+            count += 1;
+            let (l, b) = (number(w, "length"), number(w, "lower_bound"));
+            assert!(
+                l >= b - 1e-6,
+                "{name}: net {net} is {l} mm, straight {b} mm"
+            );
+            assert_eq!(
+                w["perimeter_crossings"], 0,
+                "{name}: net {net} leaves the block"
+            );
+            length += l;
+            bound += b;
+        }
+        assert_eq!(count, routed, "{name}: routed wires vs the routed count");
+        let total = number(e, "total_length");
+        let total_bound = number(e, "total_lower_bound");
+        assert!(
+            (total - length).abs() < 1e-6 * (1.0 + length),
+            "{name}: {total} vs {length}"
+        );
+        assert!(
+            (total_bound - bound).abs() < 1e-6 * (1.0 + bound),
+            "{name}: {total_bound}"
+        );
+        assert!(
+            total >= total_bound - 1e-6,
+            "{name}: {total} < {total_bound}"
+        );
+        assert_eq!(e["unplaced_pins"], Value::Array(Vec::new()), "{name}");
+        let parts = e["parts"].as_array().expect("parts");
+        let names: BTreeSet<String> = parts
+            .iter()
+            .map(|p| p["name"].as_str().expect("part name").to_owned())
+            .collect();
+        assert_eq!(names, self.grid.placed, "{name}: parts in the report");
+        failed
+    }
+
+    /// Every wire routed.
+    fn check_complete(&self, e: &Value) {
+        let failed = self.check_accounted(e);
+        assert!(failed.is_empty(), "{}: unrouted nets {failed:?}", self.name);
+        assert_eq!(e["unrouted"], 0);
+        assert_eq!(e["routed"], self.expected);
+    }
+}
+
+#[test]
+fn lilypad_vibe_board_routes_completely() {
+    let Some(board) = Board::load("LilyPad_Vibe_Board") else {
+        return;
+    };
+    board.check_complete(&board.slice());
+}
+
+#[test]
+fn lilypad_tri_color_led_routes_completely_through_the_cli() {
+    let Some(board) = Board::load("LilyPad_Tri-Color_LED") else {
+        return;
+    };
+    let dir = temp_dir();
+    let (e, err, gcode) = board.slice_cli(dir.path());
+    board.check_complete(&e);
+    assert!(!err.contains("could not be routed"), "{err}");
+    let check = conduit(["check".as_ref(), gcode.as_os_str()]);
+    assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+}
+
+#[test]
+fn openlog_routes_completely() {
+    let Some(board) = Board::load("OpenLog") else {
+        return;
+    };
+    board.check_complete(&board.slice());
+}
+
+#[test]
+fn redbot_reports_every_wire_and_names_the_unrouted_nets() {
+    let Some(board) = Board::load("RedBot") else {
+        return;
+    };
+    let dir = temp_dir();
+    let (e, err, _) = board.slice_cli(dir.path());
+    let failed = board.check_accounted(&e);
+    for net in &failed {
+        let line = format!("net {net} could not be routed");
+        assert!(err.contains(&line), "RedBot: no '{line}' in {err}");
+    }
+    println!("RedBot: unrouted nets {failed:?}");
+}
