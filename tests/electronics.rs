@@ -84,7 +84,7 @@ fn replay(text: &str) -> Replayed {
                 }
                 let moves_xy = to[0] != pos[0] || to[1] != pos[1];
                 // Paste tools carry no E: their moves with the valve open are the traces.
-                if moves_xy && (de > 0.0 || (tool == 1 && role == "Conductive trace")) {
+                if moves_xy && (de > 0.0 || (tool == 1 && role.starts_with("Conductive"))) {
                     out.extrusions.push(Extrusion {
                         tool,
                         role: role.clone(),
@@ -283,4 +283,42 @@ fn route_command_draws_every_layer_with_traces_cavities_and_a_report() {
         serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
     assert_eq!(report["routed"], 4);
     assert_eq!(report["wires"].as_array().map(Vec::len), Some(4));
+}
+
+#[test]
+fn pad_drops_put_one_drop_on_every_pad() {
+    let dir = temp_dir();
+    let out = dir.path().join("drops.gcode");
+    let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
+    let o = conduit([
+        "slice".as_ref(),
+        demo("block.stl").as_os_str(),
+        "--circuit".as_ref(),
+        demo("led_coin.sch").as_os_str(),
+        "--placement".as_ref(),
+        demo("placement.toml").as_os_str(),
+        "--set".as_ref(),
+        "route.pad_drops=true".as_ref(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).expect("G-code");
+    // Six pads (BAT1 +/−, R1 1/2, LED1 A/C): six drops, each a closed ring of 12 moves on
+    // tool 1 at the seating plane.
+    let r = replay(&text);
+    // (The paste valve is not replayed: the travels between drops are the long moves.)
+    let chord = 2.0 * 0.3 * (15f64).to_radians().sin();
+    let drops: Vec<&Extrusion> = r
+        .extrusions
+        .iter()
+        .filter(|x| x.role == "Conductive drop")
+        .filter(|x| ((x.to[0] - x.from[0]).hypot(x.to[1] - x.from[1]) - chord).abs() < 2e-3)
+        .collect();
+    assert!(
+        drops
+            .iter()
+            .all(|d| d.tool == 1 && (d.z - 4.0).abs() < 1e-9)
+    );
+    assert_eq!(drops.len(), 6 * 12, "{} drop moves", drops.len());
 }
