@@ -6,20 +6,12 @@ use anyhow::Context;
 use conduit::circuit::{Circuit, Placement};
 use conduit::emit::route_svg::{layer_svg, view_box};
 use conduit::pipeline::{Electronics, route_scene};
-use conduit::scene::{LoadOptions, Scene, load_scene, write_atomically};
+use conduit::scene::write_atomically;
 use std::io::Write;
 
 pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
     let cfg = resolve(&args.config)?;
-    let mut scene = Scene::default();
-    for path in &args.models {
-        let (s, warnings) =
-            load_scene(path, &LoadOptions::default()).map_err(anyhow::Error::from)?;
-        for w in warnings {
-            eprintln!("warning: {}: {w}", path.display());
-        }
-        scene.objects.extend(s.objects);
-    }
+    let scene = super::slice::load_models(&args.models)?;
     let electronics = Electronics {
         circuit: Circuit::load(&args.circuit).map_err(anyhow::Error::from)?,
         placement: Placement::load(&args.placement).map_err(anyhow::Error::from)?,

@@ -11,15 +11,7 @@ use std::io::{IsTerminal, Write};
 
 pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     let cfg = resolve(&args.config)?;
-    let mut scene = Scene::default();
-    for path in &args.models {
-        let (s, warnings) =
-            load_scene(path, &LoadOptions::default()).map_err(anyhow::Error::from)?;
-        for w in warnings {
-            eprintln!("warning: {}: {w}", path.display());
-        }
-        scene.objects.extend(s.objects);
-    }
+    let scene = load_models(&args.models)?;
     let electronics = match (&args.circuit, &args.placement) {
         (Some(c), Some(p)) => Some(Electronics {
             circuit: Circuit::load(c).map_err(anyhow::Error::from)?,
@@ -79,6 +71,20 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// One scene of every object of `models`, in order; reader warnings go to stderr.
+pub(crate) fn load_models(models: &[std::path::PathBuf]) -> Result<Scene, Failure> {
+    let mut scene = Scene::default();
+    for path in models {
+        let (s, warnings) =
+            load_scene(path, &LoadOptions::default()).map_err(anyhow::Error::from)?;
+        for w in warnings {
+            eprintln!("warning: {}: {w}", path.display());
+        }
+        scene.objects.extend(s.objects);
+    }
+    Ok(scene)
 }
 
 /// A bar over the pipeline's stages, hidden when stderr is not a terminal.
