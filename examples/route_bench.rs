@@ -12,7 +12,7 @@
 use std::time::{Duration, Instant};
 
 use conduit::geom::{ExPolygon, Point2, Point3, Polygon};
-use conduit::route::{RouteLayer, RouteParams, RouteResult, Wire, route};
+use conduit::route::{PadCopper, RouteLayer, RouteParams, RouteResult, Wire, route};
 
 /// Side of the square block, mm.
 const SIDE_MM: f64 = 40.0;
@@ -129,11 +129,16 @@ fn main() {
     let layers = layers();
     let wires = wires();
     let params = RouteParams::default();
+    // A round pad of twice the trace width on each end of every wire.
+    let pads: Vec<PadCopper> = wires
+        .iter()
+        .flat_map(|w| [w.from, w.to].map(|p| PadCopper::round(Some(&w.net), p, 1.2)))
+        .collect();
     let mut times: Vec<Duration> = Vec::with_capacity(RUNS);
     let mut first: Option<RouteResult> = None;
     for run in 0..RUNS {
         let started = Instant::now();
-        let result = route(&layers, &wires, &params);
+        let result = route(&layers, &wires, &pads, &params);
         times.push(started.elapsed());
         match &first {
             None => first = Some(result),

@@ -7,7 +7,7 @@
 //! and the report must account for every wire of the nets' spanning trees; the small boards
 //! must route completely.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -96,51 +96,79 @@ fn toml_string(s: &str) -> String {
     format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
 }
 
-/// Every part with pads in a cell, cells in rows: deepest cells first, each row filled left to
-/// right up to the width that makes the block about square (`sqrt` of the cells' total area),
-/// each row as deep as its deepest cell. A part's pads are centred in its cell.
-fn grid_placement(circuit: &Circuit, margin: f64) -> Grid {
+/// Board positions of the elements of the `.brd` beside `sch`, by part name.
+fn board_positions(sch: &Path) -> BTreeMap<String, [f64; 2]> {
+    let brd = sch.with_extension("brd");
+    let bytes = std::fs::read(&brd).unwrap_or_else(|e| panic!("{}: {e}", brd.display()));
+    let board = conduit_eagle::read_board(&bytes).unwrap_or_else(|e| panic!("{e}"));
+    board
+        .elements
+        .iter()
+        .map(|e| (e.name.clone(), [e.x, e.y]))
+        .collect()
+}
+
+/// Every part with pads in a cell of a square grid (`ceil(sqrt(n))` columns), at rotation 0 on
+/// one seating plane. The grid keeps the board's topology: parts are taken by their board y
+/// (rows, bottom first) and, within a row, by board x, so parts the designer put side by side
+/// are neighbours here too. Each column is as wide as its widest cell, each row as deep as its
+/// deepest; a part's pads are centred in its cell.
+fn grid_placement(circuit: &Circuit, positions: &BTreeMap<String, [f64; 2]>, margin: f64) -> Grid {
     let cell = |e: &[f64; 4]| {
         [
             (e[2] - e[0] + 2.0 * margin).max(MIN_CELL_MM),
             (e[3] - e[1] + 2.0 * margin).max(MIN_CELL_MM),
         ]
     };
-    let mut parts: Vec<(&Part, [f64; 4], [f64; 2])> = circuit
+    let at = |p: &Part| positions.get(&p.name).copied().unwrap_or([f64::MAX; 2]);
+    let mut parts: Vec<(&Part, [f64; 4])> = circuit
         .parts
         .iter()
-        .filter_map(|p| pad_extent(p).map(|e| (p, e, cell(&e))))
+        .filter_map(|p| pad_extent(p).map(|e| (p, e)))
         .collect();
-    // Deepest first; the sort is stable, so equal cells keep the circuit's order.
-    parts.sort_by(|a, b| b.2[1].total_cmp(&a.2[1]));
-    let area: f64 = parts.iter().map(|(_, _, c)| c[0] * c[1]).sum();
-    let widest = parts.iter().map(|(_, _, c)| c[0]).fold(0.0, f64::max);
-    let row_width = area.sqrt().max(widest);
+    parts.sort_by(|a, b| at(a.0)[1].total_cmp(&at(b.0)[1]));
+    let cols = (parts.len() as f64).sqrt().ceil().max(1.0) as usize;
+    for row in parts.chunks_mut(cols) {
+        row.sort_by(|a, b| at(a.0)[0].total_cmp(&at(b.0)[0]));
+    }
+    let rows = parts.len().div_ceil(cols);
+    let mut widths = vec![0.0f64; cols];
+    let mut depths = vec![0.0f64; rows];
+    for (k, (_, e)) in parts.iter().enumerate() {
+        let [w, d] = cell(e);
+        widths[k % cols] = widths[k % cols].max(w);
+        depths[k / cols] = depths[k / cols].max(d);
+    }
+    let starts = |sizes: &[f64]| -> Vec<f64> {
+        sizes
+            .iter()
+            .scan(BLOCK_MARGIN_MM, |next, s| {
+                let start = *next;
+                *next += s;
+                Some(start)
+            })
+            .collect()
+    };
+    let (xs, ys) = (starts(&widths), starts(&depths));
     let mut toml = String::from("origin = \"model\"\n");
-    let (mut x, mut y, mut row_depth, mut width) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    for (part, e, [w, d]) in &parts {
-        if x > 0.0 && x + w > row_width + 1e-9 {
-            (x, y, row_depth) = (0.0, y + row_depth, 0.0);
-        }
-        let cx = BLOCK_MARGIN_MM + x + w / 2.0 - (e[0] + e[2]) / 2.0;
-        let cy = BLOCK_MARGIN_MM + y + d / 2.0 - (e[1] + e[3]) / 2.0;
+    for (k, (part, e)) in parts.iter().enumerate() {
+        let (col, row) = (k % cols, k / cols);
+        let x = xs[col] + widths[col] / 2.0 - (e[0] + e[2]) / 2.0;
+        let y = ys[row] + depths[row] / 2.0 - (e[1] + e[3]) / 2.0;
         write!(
             toml,
-            "\n[[part]]\nname = {}\nx = {cx:?}\ny = {cy:?}\nz = {SEATING_Z_MM:?}\n\
+            "\n[[part]]\nname = {}\nx = {x:?}\ny = {y:?}\nz = {SEATING_Z_MM:?}\n\
              rotation = 0.0\nmethod = \"auto\"\nbody_height = {BODY_HEIGHT_MM:?}\n",
             toml_string(&part.name)
         )
         .expect("writing to a String");
-        x += w;
-        width = width.max(x);
-        row_depth = row_depth.max(*d);
     }
     Grid {
         toml,
-        placed: parts.iter().map(|(p, _, _)| p.name.clone()).collect(),
+        placed: parts.iter().map(|(p, _)| p.name.clone()).collect(),
         size: [
-            width + 2.0 * BLOCK_MARGIN_MM,
-            y + row_depth + 2.0 * BLOCK_MARGIN_MM,
+            widths.iter().sum::<f64>() + 2.0 * BLOCK_MARGIN_MM,
+            depths.iter().sum::<f64>() + 2.0 * BLOCK_MARGIN_MM,
         ],
     }
 }
@@ -197,15 +225,7 @@ impl Board {
         let corpus = corpus()?;
         let sch = schematic(&corpus, name);
         let circuit = Circuit::load(&sch).unwrap_or_else(|e| panic!("{e}"));
-        let margin = std::env::var("MARGIN")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(CELL_MARGIN_MM);
-        let grid = if std::env::var("PACK").is_ok_and(|p| p == "grid") {
-            square_grid(&circuit, margin)
-        } else {
-            grid_placement(&circuit, margin)
-        };
+        let grid = grid_placement(&circuit, &board_positions(&sch), CELL_MARGIN_MM);
         let expected = expected_wires(&circuit, &grid.placed);
         Some(Board {
             name,
@@ -217,16 +237,15 @@ impl Board {
 
     /// Slices the block with the circuit through the library; the `electronics` report as
     /// JSON.
-    fn slice(&self) -> Value {
+    fn slice(&self, cfg: &Config) -> Value {
         let placement = Placement::from_toml(&self.grid.toml).unwrap_or_else(|e| panic!("{e}"));
         let e = Electronics {
             circuit: self.circuit.clone(),
             placement,
         };
         let started = Instant::now();
-        let (_, _, summary) =
-            slice_scene_with(&block(&self.grid), &Config::default(), Some(&e), |_| {})
-                .unwrap_or_else(|e| panic!("{}: {e}", self.name));
+        let (_, _, summary) = slice_scene_with(&block(&self.grid), cfg, Some(&e), |_| {})
+            .unwrap_or_else(|e| panic!("{}: {e}", self.name));
         let report = summary.electronics.expect("a report with a circuit");
         let value = serde_json::to_value(&report).expect("the report serialises");
         self.log(&value, started);
@@ -355,7 +374,7 @@ fn lilypad_vibe_board_routes_completely() {
     let Some(board) = Board::load("LilyPad_Vibe_Board") else {
         return;
     };
-    board.check_complete(&board.slice());
+    board.check_complete(&board.slice(&Config::default()));
 }
 
 #[test]
@@ -371,13 +390,41 @@ fn lilypad_tri_color_led_routes_completely_through_the_cli() {
     assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
 }
 
+/// OpenLog's config: its ATmega328 is a TQFP-32 at 0.8 mm pitch, where two 0.6 mm traces with
+/// 0.2 mm of clearance do not fit between neighbouring pads (the report warns and names them);
+/// 0.4 mm traces do.
+fn openlog_config() -> Config {
+    let mut cfg = Config::default();
+    cfg.route.conductive_width = 0.4;
+    cfg
+}
+
 #[test]
-#[ignore = "bug: 11 of OpenLog's nets (3.3V, CS, GND, MISO, MOSI, N$1, N$2, RST, RXI, SCK, TXO) are not routed on the grid placement; the router or the placement helper must be fixed"]
+fn openlog_accounts_for_every_wire_and_routes_most() {
+    let Some(board) = Board::load("OpenLog") else {
+        return;
+    };
+    let e = board.slice(&openlog_config());
+    let failed = board.check_accounted(&e);
+    println!("OpenLog: unrouted nets {failed:?}");
+    // A regression guard until every net routes (the ignored test below): at least 70 %.
+    let routed = e["routed"].as_u64().expect("routed") as usize;
+    assert!(
+        10 * routed >= 7 * board.expected,
+        "{routed} of {}",
+        board.expected
+    );
+    // No pitch warning at this width.
+    assert_eq!(e["warnings"], Value::Array(Vec::new()));
+}
+
+#[test]
+#[ignore = "bug: 12 of OpenLog's 46 wires (nets CS, GND, MISO, MOSI, N$1, N$2, RXI, SCK, TXO, all at the TQFP U1 or the microSD socket U3) are not routed: sequential routing with rip-up and reroute walls in pads around U1; a negotiated-congestion router is the next step"]
 fn openlog_routes_completely() {
     let Some(board) = Board::load("OpenLog") else {
         return;
     };
-    board.check_complete(&board.slice());
+    board.check_complete(&board.slice(&openlog_config()));
 }
 
 #[test]
@@ -394,61 +441,4 @@ fn redbot_reports_every_wire_and_names_the_unrouted_nets() {
         assert!(err.contains(&line), "RedBot: no '{line}' in {err}");
     }
     println!("RedBot: unrouted nets {failed:?}");
-}
-
-/// Old square grid (exploration).
-fn square_grid(circuit: &Circuit, margin: f64) -> Grid {
-    let parts: Vec<(&Part, [f64; 4])> = circuit
-        .parts
-        .iter()
-        .filter_map(|p| pad_extent(p).map(|e| (p, e)))
-        .collect();
-    let cols = (parts.len() as f64).sqrt().ceil().max(1.0) as usize;
-    let rows = parts.len().div_ceil(cols);
-    let cell = |e: &[f64; 4]| {
-        [
-            (e[2] - e[0] + 2.0 * margin).max(MIN_CELL_MM),
-            (e[3] - e[1] + 2.0 * margin).max(MIN_CELL_MM),
-        ]
-    };
-    let mut widths = vec![0.0f64; cols];
-    let mut depths = vec![0.0f64; rows];
-    for (k, (_, e)) in parts.iter().enumerate() {
-        let [w, d] = cell(e);
-        widths[k % cols] = widths[k % cols].max(w);
-        depths[k / cols] = depths[k / cols].max(d);
-    }
-    let starts = |sizes: &[f64]| -> Vec<f64> {
-        sizes
-            .iter()
-            .scan(BLOCK_MARGIN_MM, |at, s| {
-                let start = *at;
-                *at += s;
-                Some(start)
-            })
-            .collect()
-    };
-    let (xs, ys) = (starts(&widths), starts(&depths));
-    let mut toml = String::from("origin = \"model\"\n");
-    for (k, (part, e)) in parts.iter().enumerate() {
-        let (col, row) = (k % cols, k / cols);
-        let x = xs[col] + widths[col] / 2.0 - (e[0] + e[2]) / 2.0;
-        let y = ys[row] + depths[row] / 2.0 - (e[1] + e[3]) / 2.0;
-        write!(
-            toml,
-            "\n[[part]]\nname = {}\nx = {x:?}\ny = {y:?}\nz = {SEATING_Z_MM:?}\n\
-             rotation = 0.0\nmethod = \"auto\"\nbody_height = {BODY_HEIGHT_MM:?}\n",
-            toml_string(&part.name)
-        )
-        .expect("writing to a String");
-    }
-    let size = [
-        widths.iter().sum::<f64>() + 2.0 * BLOCK_MARGIN_MM,
-        depths.iter().sum::<f64>() + 2.0 * BLOCK_MARGIN_MM,
-    ];
-    Grid {
-        toml,
-        placed: parts.iter().map(|(p, _)| p.name.clone()).collect(),
-        size,
-    }
 }

@@ -7,6 +7,8 @@
 //! mirrored (EAGLE bottom-side) parts *before* rotating, as EAGLE's `MR` rotations do. Pads keep
 //! their own rotation within the package, applied first.
 
+use std::collections::BTreeMap;
+
 use super::placement::{PartPlacement, PlacementError, PlacingMethod};
 use super::{Circuit, PadShape};
 use crate::geom::{BoundingBox, Point2, Point3, Polygon, Vector3};
@@ -24,6 +26,8 @@ pub struct PlacedPad {
     pub centre: Point3,
     /// The copper outline projected on the xy plane, counter-clockwise, scaled integers.
     pub outline: Polygon,
+    /// The net the pad belongs to; `None` for a pin no net uses.
+    pub net: Option<String>,
 }
 
 /// A part where it sits in the object.
@@ -72,6 +76,15 @@ pub fn place(
 ) -> Result<Vec<PlacedPart>, PlacementError> {
     placement.validate(circuit)?;
     let model = placement.to_model(object_bboxes)?;
+    let nets: BTreeMap<(&str, &str), &str> = circuit
+        .nets
+        .iter()
+        .flat_map(|n| {
+            n.pins
+                .iter()
+                .map(move |p| ((p.part.as_str(), p.pad.as_str()), n.name.as_str()))
+        })
+        .collect();
     let mut out = Vec::with_capacity(model.parts.len());
     for p in &model.parts {
         if !object_bboxes.is_empty() && p.object >= object_bboxes.len() {
@@ -100,6 +113,9 @@ pub fn place(
                     name: pad.name.clone(),
                     centre: pose.map(pad.x, pad.y),
                     outline: ccw(Polygon::new(pts)),
+                    net: nets
+                        .get(&(part.name.as_str(), pad.name.as_str()))
+                        .map(|n| (*n).to_owned()),
                 }
             })
             .collect();

@@ -44,8 +44,14 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
         r.total_length,
         r.total_lower_bound
     );
+    for w in &r.warnings {
+        eprintln!("warning: {w}");
+    }
     for w in r.wires.iter().filter(|w| !w.routed) {
-        eprintln!("warning: net {} could not be routed", w.net);
+        eprintln!(
+            "warning: net {} could not be routed ({} to {})",
+            w.net, w.from, w.to
+        );
     }
     Ok(())
 }

@@ -463,6 +463,26 @@ const KEYS: &[KeyDoc] = &[
     ),
     k(
         "route",
+        "layer_span",
+        "Layers below and above the pads a route may use to pass other traces.",
+    ),
+    k(
+        "route",
+        "rip_up_rounds",
+        "Rounds of rip-up and reroute for wires that could not be routed.",
+    ),
+    k(
+        "route",
+        "max_detour",
+        "Longest route worth printing, times the straight pad-to-pad distance (plus detour_slack).",
+    ),
+    k(
+        "route",
+        "detour_slack",
+        "Allowance added to the detour limit, mm.",
+    ),
+    k(
+        "route",
         "pad_drops",
         "A conductive drop on every pad, also on pins no net uses.",
     ),

@@ -37,6 +37,20 @@ pub struct RouteSettings {
     pub interlayer_overlap: f64,
     /// Extra cost of each layer change, in mm of base-weight path. Default 5.
     pub layer_change_penalty: f64,
+    /// Layers below the lower pad and above the upper pad a route may use to pass other
+    /// traces. Traces of different nets on adjacent layers would touch, so a crossing needs a
+    /// layer in between: at least 2 for routes to cross at all. Default 3.
+    pub layer_span: usize,
+    /// Rounds of rip-up and reroute for wires that could not be routed: the wires in their way
+    /// are routed again after them. 0 routes each wire once. Default 3.
+    pub rip_up_rounds: usize,
+    /// Longest route worth printing, as a multiple of the straight distance between the pads
+    /// (plus `detour_slack`): a trace's resistance grows with its length, so a wire that needs a
+    /// longer route is reported unrouted. Default 4.
+    pub max_detour: f64,
+    /// Allowance added to the detour limit, mm: room for layer changes and a way round a part on
+    /// short wires. Default 40.
+    pub detour_slack: f64,
     /// Put a conductive drop (a small disc of trace) on every pad, also on pins no net uses,
     /// so a part's leads sit in paste. Default false.
     pub pad_drops: bool,
@@ -57,6 +71,10 @@ impl Default for RouteSettings {
             grid_step: 1.0,
             interlayer_overlap: 2.0,
             layer_change_penalty: 5.0,
+            layer_span: 3,
+            rip_up_rounds: 3,
+            max_detour: 4.0,
+            detour_slack: 40.0,
             pad_drops: false,
         }
     }
@@ -71,6 +89,7 @@ impl RouteSettings {
             ("grid_step", self.grid_step),
             ("interlayer_overlap", self.interlayer_overlap),
             ("base_weight", self.base_weight),
+            ("max_detour", self.max_detour),
             ("outside_weight", self.outside_weight),
         ] {
             if !(v.is_finite() && v > 0.0) {
@@ -82,6 +101,7 @@ impl RouteSettings {
             ("channel_extra", self.channel_extra),
             ("cavity_offset", self.cavity_offset),
             ("layer_change_penalty", self.layer_change_penalty),
+            ("detour_slack", self.detour_slack),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 out.push(format!("route.{key} must be ≥ 0, got {v}"));

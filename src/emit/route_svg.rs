@@ -6,7 +6,7 @@
 
 use std::fmt::Write;
 
-use super::preview::svg::num;
+use super::preview::svg::{escape, num};
 use crate::geom::{ExPolygon, Polygon, unscaled};
 use crate::pipeline::RouteViewLayer;
 
@@ -95,6 +95,19 @@ pub fn layer_svg(layer: &RouteViewLayer, view: [f64; 4], trace_width: f64) -> St
         &layer.cavities,
         "fill=\"none\" stroke=\"#e07000\" stroke-width=\"0.15\" stroke-dasharray=\"0.6 0.3\"",
     );
+    for (name, outline) in &layer.pads {
+        let pts: Vec<String> = outline
+            .points
+            .iter()
+            .map(|p| format!("{},{}", num(unscaled(p.x)), num(-unscaled(p.y))))
+            .collect();
+        let _ = writeln!(
+            out,
+            "<polygon fill=\"#c88a2e\" stroke=\"none\" points=\"{}\"><title>{}</title></polygon>",
+            pts.join(" "),
+            escape(name)
+        );
+    }
     for t in &layer.traces {
         let pts: Vec<String> = t
             .iter()
@@ -136,6 +149,7 @@ mod tests {
                 Point3::new(1.0, 2.0, 1.2),
                 Point3::new(18.0, 2.0, 1.2),
             ]],
+            pads: vec![("R1.<1>".into(), square(17.5, 1.5, 1.0).contour)],
         };
         let view = view_box(std::slice::from_ref(&layer)).expect("something to draw");
         assert_eq!(view, [0.0, 0.0, 20.0, 20.0]);
@@ -146,5 +160,8 @@ mod tests {
         assert_eq!(svg.matches("<path").count(), 3);
         assert!(svg.contains("points=\"1.000,-2.000 18.000,-2.000\""));
         assert!(svg.contains("M5.000 -5.000 L9.000 -5.000 L9.000 -9.000 L5.000 -9.000 Z"));
+        assert!(svg.contains(
+            "points=\"17.500,-1.500 18.500,-1.500 18.500,-2.500 17.500,-2.500\"><title>R1.&lt;1&gt;</title>"
+        ));
     }
 }

@@ -14,7 +14,7 @@ use crate::config::Config;
 use crate::geom::{BoundingBox, ExPolygon, Point2, Point3, Polygon, scaled};
 use crate::program::{Event, LayerExtras, Role, Toolpath};
 use crate::region::cavity::{Cavity, carve_cavities, carve_channels};
-use crate::route::{RouteLayer, RouteParams, Wire, route};
+use crate::route::{PadCopper, RouteLayer, RouteParams, Wire, min_trace_spacing, route};
 use crate::slice::LayerZ;
 
 /// A circuit and where its parts go: what `--circuit` and `--placement` give.
@@ -31,6 +31,10 @@ pub struct Electronics {
 pub struct NetRoute {
     /// Net name.
     pub net: String,
+    /// The start pin, `PART.PAD` (or `waypoint`).
+    pub from: String,
+    /// The end pin, `PART.PAD` (or `waypoint`).
+    pub to: String,
     /// Whether a route was found.
     pub routed: bool,
     /// Length of the route, mm (0 when not routed).
@@ -60,6 +64,9 @@ pub struct ElectronicsReport {
     pub total_length: f64,
     /// Sum of the lower bounds of the routed wires, mm.
     pub total_lower_bound: f64,
+    /// Design problems found before routing, one line each (pads of different nets closer
+    /// than two traces can pass).
+    pub warnings: Vec<String>,
 }
 
 /// One placed part in the report.
@@ -102,11 +109,23 @@ pub enum ElectronicsError {
 pub struct PlacedCircuit {
     /// Parts in placement order, bed coordinates.
     pub parts: Vec<PlacedPart>,
-    /// (object, wire): the wires of every net, bed coordinates; a wire belongs to the object of
-    /// its first pin's part (object 0 for waypoint-only wires).
-    pub wires: Vec<(usize, Wire)>,
+    /// The wires of every net, bed coordinates.
+    pub wires: Vec<CircuitWire>,
     /// Net pins on parts the placement does not list (`net`, `part.pad`).
     pub unplaced: Vec<(String, String)>,
+}
+
+/// One wire to route, with the object it runs in and what it joins.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CircuitWire {
+    /// Scene object: the object of its first pin's part (object 0 for waypoint-only wires).
+    pub object: usize,
+    /// The rubberband, bed coordinates.
+    pub wire: Wire,
+    /// The start pin as `PART.PAD`, or `waypoint`.
+    pub from: String,
+    /// The end pin as `PART.PAD`, or `waypoint`.
+    pub to: String,
 }
 
 /// [`place`] and [`rubberbands`] in model coordinates (`bboxes` of the scene's objects), then
@@ -141,14 +160,20 @@ pub fn place_circuit(
                 .unwrap_or(0);
             let d = offset(object);
             let shift = |p: Point3| Point3::new(p.x + d[0], p.y + d[1], p.z + d[2]);
-            (
+            let label = |pin: &Option<crate::circuit::PinRef>| {
+                pin.as_ref()
+                    .map_or_else(|| "waypoint".to_owned(), ToString::to_string)
+            };
+            CircuitWire {
                 object,
-                Wire {
+                wire: Wire {
                     net: b.net.clone(),
                     from: shift(b.from),
                     to: shift(b.to),
                 },
-            )
+                from: label(&b.from_pin),
+                to: label(&b.to_pin),
+            }
         })
         .collect();
     for part in &mut parts {
@@ -200,6 +225,10 @@ pub fn route_params(cfg: &Config) -> RouteParams {
         grid_step: r.grid_step,
         interlayer_overlap: r.interlayer_overlap,
         layer_change_penalty: r.layer_change_penalty,
+        layer_span: r.layer_span,
+        rip_up_rounds: r.rip_up_rounds,
+        max_detour: r.max_detour,
+        detour_slack: r.detour_slack,
         ..RouteParams::default()
     }
 }
@@ -245,12 +274,12 @@ pub fn object_stage(
         .collect();
     carve_cavities(islands, &spans, &cavities);
 
-    let wires: Vec<Wire> = circuit
+    let mine_wires: Vec<&CircuitWire> = circuit
         .wires
         .iter()
-        .filter(|(o, _)| *o == object)
-        .map(|(_, w)| w.clone())
+        .filter(|w| w.object == object)
         .collect();
+    let wires: Vec<Wire> = mine_wires.iter().map(|w| w.wire.clone()).collect();
     if object == 0 {
         report
             .unplaced_pins
@@ -265,7 +294,20 @@ pub fn object_stage(
             islands: isl.clone(),
         })
         .collect();
-    let result = route(&layers, &wires, &route_params(cfg));
+    let pads: Vec<PadCopper> = mine
+        .iter()
+        .flat_map(|(_, p)| &p.pads)
+        .map(|pad| PadCopper {
+            net: pad.net.clone(),
+            z: pad.centre.z,
+            outline: pad.outline.clone(),
+        })
+        .collect();
+    let params = route_params(cfg);
+    report
+        .warnings
+        .extend(mine.iter().filter_map(|(_, p)| pitch_warning(p, &params)));
+    let result = route(&layers, &wires, &pads, &params);
     carve_channels(islands, &result.channels);
 
     // Traces: one path per wire and layer, longest first on each layer.
@@ -273,9 +315,11 @@ pub fn object_stage(
     let speed = cfg.slice.conductive_speed;
     let width = cfg.route.conductive_width;
     let mut per_layer: BTreeMap<usize, Vec<Toolpath>> = BTreeMap::new();
-    for w in &result.wires {
+    for (w, ends) in result.wires.iter().zip(&mine_wires) {
         report.wires.push(NetRoute {
             net: w.net.clone(),
+            from: ends.from.clone(),
+            to: ends.to.clone(),
             routed: w.routed,
             length: if w.routed { w.length } else { 0.0 },
             lower_bound: w.lower_bound,
@@ -347,7 +391,8 @@ pub fn object_stage(
             method: method_name(part.method),
             position: [part.position.x, part.position.y, part.position.z],
             rotation_deg: part.rotation_deg,
-            placed_after_z: after,
+            // Layer heights are sums of floats: report the nanometre the layer starts at.
+            placed_after_z: (after * 1e6).round() / 1e6,
         };
         match zs.iter().position(|z| z.bottom >= top - 1e-6) {
             Some(layer) => {
@@ -382,6 +427,55 @@ pub fn object_stage(
         cavities,
         channels: result.channels,
     }
+}
+
+/// A warning when two connected pads of different nets on `part` are closer than two traces
+/// of different nets may run ([`min_trace_spacing`]): traces cannot reach both. Names the
+/// closest such pair.
+fn pitch_warning(part: &PlacedPart, params: &RouteParams) -> Option<String> {
+    let spacing = min_trace_spacing(params);
+    let mut closest: Option<(f64, &str, &str)> = None;
+    for (i, a) in part.pads.iter().enumerate() {
+        for b in &part.pads[i + 1..] {
+            let (Some(na), Some(nb)) = (&a.net, &b.net) else {
+                continue;
+            };
+            if na == nb {
+                continue;
+            }
+            let d = ((a.centre.x - b.centre.x).powi(2) + (a.centre.y - b.centre.y).powi(2)).sqrt();
+            if d < spacing && closest.is_none_or(|(c, _, _)| d < c) {
+                closest = Some((d, &a.name, &b.name));
+            }
+        }
+    }
+    closest.map(|(d, a, b)| {
+        format!(
+            "pads {p}.{a} and {p}.{b} are {d:.2} mm apart, closer than two traces can run \
+             ({spacing:.2} mm with route.conductive_width {w} and route.channel_extra {x}): \
+             their nets cannot both be routed; a conductive_width of {max:.2} mm fits",
+            p = part.name,
+            w = params.conductive_width,
+            x = params.channel_extra,
+            max = fitting_width(d, params),
+        )
+    })
+}
+
+/// The widest conductive width, in 0.05 mm steps, whose traces may run `d` mm apart.
+fn fitting_width(d: f64, params: &RouteParams) -> f64 {
+    let mut w = (params.conductive_width * 20.0).floor() / 20.0;
+    while w > 0.05 {
+        let p = RouteParams {
+            conductive_width: w,
+            ..params.clone()
+        };
+        if min_trace_spacing(&p) < d {
+            break;
+        }
+        w -= 0.05;
+    }
+    (w * 100.0).round() / 100.0
 }
 
 /// The layer whose top is the seating plane `z` (within half a layer), where pad drops go.
@@ -466,4 +560,71 @@ pub fn pnp_records(circuit: &Circuit, parts: &[PlacedPart]) -> Vec<conduit_pnp::
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::circuit::PlacedPad;
+    use crate::geom::{Point2, Polygon};
+
+    /// A part with one square 0.5 mm pad per `(name, x, net)`, on the x axis.
+    fn row(pads: &[(&str, f64, Option<&str>)]) -> PlacedPart {
+        let square = |x: f64| {
+            Polygon::new(vec![
+                Point2::from_mm(x - 0.25, -0.25),
+                Point2::from_mm(x + 0.25, -0.25),
+                Point2::from_mm(x + 0.25, 0.25),
+                Point2::from_mm(x - 0.25, 0.25),
+            ])
+        };
+        PlacedPart {
+            name: "U1".into(),
+            method: PlacingMethod::Auto,
+            position: Point3::new(0.0, 0.0, 1.0),
+            rotation_deg: 0.0,
+            mirror: false,
+            body_height: 1.0,
+            object: 0,
+            pads: pads
+                .iter()
+                .map(|&(name, x, net)| PlacedPad {
+                    name: name.into(),
+                    centre: Point3::new(x, 0.0, 1.0),
+                    outline: square(x),
+                    net: net.map(str::to_owned),
+                })
+                .collect(),
+            footprint: square(0.0),
+        }
+    }
+
+    #[test]
+    fn pads_of_two_nets_closer_than_two_traces_are_named() {
+        let params = RouteParams::default();
+        // Traces of different nets keep (0.6 + 0.2) mm plus the polygon allowance apart.
+        let spacing = min_trace_spacing(&params);
+        assert!(spacing > 0.8 && spacing < 0.83, "{spacing}");
+        let tight = row(&[
+            ("1", 0.0, Some("A")),
+            ("2", 0.8, Some("B")),
+            ("3", 1.6, Some("A")),
+        ]);
+        let w = pitch_warning(&tight, &params).expect("a warning");
+        assert!(w.starts_with("pads U1.1 and U1.2 are 0.80 mm apart"), "{w}");
+        assert!(w.ends_with("a conductive_width of 0.55 mm fits"), "{w}");
+        // 0.55 mm does fit, 0.6 does not.
+        let at = |w: f64| RouteParams {
+            conductive_width: w,
+            ..params.clone()
+        };
+        assert!(min_trace_spacing(&at(0.55)) < 0.8 && min_trace_spacing(&at(0.6)) > 0.8);
+        // Same net, unconnected pins, or enough room: nothing to say.
+        let same = row(&[("1", 0.0, Some("A")), ("2", 0.8, Some("A"))]);
+        let free = row(&[("1", 0.0, Some("A")), ("2", 0.8, None)]);
+        let wide = row(&[("1", 0.0, Some("A")), ("2", 1.27, Some("B"))]);
+        for part in [same, free, wide] {
+            assert_eq!(pitch_warning(&part, &params), None);
+        }
+    }
 }

@@ -304,6 +304,8 @@ pub struct RouteViewLayer {
     pub channels: Vec<ExPolygon>,
     /// Conductive paths printed on this layer (traces and drops).
     pub traces: Vec<Vec<Point3>>,
+    /// Pads seated on this layer's top: `PART.PAD` and the copper outline.
+    pub pads: Vec<(String, crate::geom::Polygon)>,
 }
 
 /// What `conduit route` shows: the layers with what the electronics stage made of them.
@@ -336,6 +338,7 @@ pub fn route_scene(
                 cavities: Vec::new(),
                 channels: Vec::new(),
                 traces: Vec::new(),
+                pads: Vec::new(),
             });
             entry.islands.extend(l.islands);
             entry.cavities.extend(
@@ -360,6 +363,17 @@ pub fn route_scene(
                 }
                 pts
             }));
+        }
+    }
+    for part in &f.parts {
+        for pad in &part.pads {
+            // The layer whose top the pad sits on, within float noise.
+            let key = scaled(pad.centre.z);
+            if let Some((_, layer)) = by_z.range_mut(key - 1..=key + 1).next() {
+                layer
+                    .pads
+                    .push((format!("{}.{}", part.name, pad.name), pad.outline.clone()));
+            }
         }
     }
     Ok(RouteView {

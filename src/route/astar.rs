@@ -17,7 +17,7 @@
 //!   total float order; vertex ids follow creation order, which depends only on the input; hash
 //!   maps are only looked up, never iterated.
 
-use super::graph::{self, Ends, Graph, LayerInput, PreparedLayer, VertexId};
+use super::graph::{self, Ends, Graph, LayerInput, PENALTY_FACTOR, PreparedLayer, VertexId};
 use super::index::{dist, lerp};
 use super::interlayer::{Parent, piece_fits, polyline_length, walk_back};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, layer_of, trace};
@@ -70,13 +70,31 @@ impl Ord for Open {
     }
 }
 
+/// The eight 45° grid directions, in lattice steps.
+const GRID_DIRECTIONS: [(i64, i64); 8] = [
+    (1, 0),
+    (1, 1),
+    (0, 1),
+    (-1, 1),
+    (-1, 0),
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+];
+
 /// Fraction of a grid step within which a new grid point reuses an existing vertex.
 const GRID_REUSE: f64 = 1.0 / 3.0;
 
-/// The layers a wire may use: from the lower endpoint layer − 1 to the upper one + 1.
-pub(crate) fn layer_range(layers: &[RouteLayer], wire: &Wire) -> Option<RangeInclusive<usize>> {
+/// The layers a wire may use: from the lower endpoint layer − `layer_span` to the upper one +
+/// `layer_span`.
+pub(crate) fn layer_range(
+    layers: &[RouteLayer],
+    wire: &Wire,
+    params: &RouteParams,
+) -> Option<RangeInclusive<usize>> {
     let (a, b) = (layer_of(layers, wire.from.z)?, layer_of(layers, wire.to.z)?);
-    Some(a.min(b).saturating_sub(1)..=(a.max(b) + 1).min(layers.len() - 1))
+    let span = params.layer_span;
+    Some(a.min(b).saturating_sub(span)..=(a.max(b) + span).min(layers.len() - 1))
 }
 
 /// The A* search of one wire's route, one expansion per [`Search::step`].
@@ -98,13 +116,16 @@ pub struct Search {
     min_weight: f64,
     /// Least cost of one layer change.
     change_cost: f64,
+    /// Routes costing more than this are not searched for (see [`RouteParams::max_detour`]).
+    cost_limit: f64,
 }
 
 impl Search {
     /// A search for `wire` on `layers` as given: their islands are the material, nothing is
-    /// blocked. Only the layers from the lower pad's layer − 1 to the upper pad's + 1 are used.
+    /// blocked. Only the layers from the lower pad's layer − `layer_span` to the upper pad's +
+    /// `layer_span` are used.
     pub fn new(layers: &[RouteLayer], wire: &Wire, params: &RouteParams) -> Self {
-        let inputs = layer_range(layers, wire).map_or(Vec::new(), |range| {
+        let inputs = layer_range(layers, wire, params).map_or(Vec::new(), |range| {
             range
                 .map(|l| LayerInput {
                     index: l,
@@ -112,6 +133,7 @@ impl Search {
                     islands: layers[l].islands.clone(),
                     original: layers[l].islands.clone(),
                     blocked: Vec::new(),
+                    penalty: Vec::new(),
                 })
                 .collect()
         });
@@ -168,8 +190,20 @@ impl Search {
             expansions: 0,
             min_weight,
             change_cost,
+            cost_limit: f64::INFINITY,
         };
         if search.state == SearchState::Running {
+            // The limit is in cost, the detour in length: a route of length L costs at least
+            // L × the smallest weight.
+            let straight = search.heuristic(source) / search.min_weight.max(f64::MIN_POSITIVE);
+            search.cost_limit = params.max_detour.max(1.0)
+                * straight.max(0.0)
+                * params.base_weight.max(search.min_weight)
+                + params.detour_slack.max(0.0);
+            if search.layers.iter().any(|l| !l.penalty.is_empty()) {
+                // A rip-up probe may run through other traces: room for 5 mm of them.
+                search.cost_limit += PENALTY_FACTOR * 5.0;
+            }
             search.grow();
             search.g[source as usize] = 0.0;
             let f = search.heuristic(source);
@@ -210,6 +244,11 @@ impl Search {
         if self.closed[u as usize] || top.g > self.g[u as usize] {
             return self.state;
         }
+        if top.f > self.cost_limit {
+            // Every route left costs more than the detour limit allows.
+            self.state = SearchState::Failed;
+            return self.state;
+        }
         self.closed[u as usize] = true;
         if u == self.target {
             self.state = SearchState::Found;
@@ -222,9 +261,17 @@ impl Search {
         }
         self.explore_grid(u);
         self.explore_layers(u);
+        let penalised = !self.layer(self.graph.layer(u)).penalty.is_empty();
         for k in 0..self.graph.adj[u as usize].len() {
             let e = self.graph.adj[u as usize][k];
-            self.relax(u, e.to, e.cost, None);
+            let mut cost = e.cost;
+            if penalised && self.graph.layer(e.to) == self.graph.layer(u) {
+                let mid = lerp(self.graph.pos(u), self.graph.pos(e.to), 0.5);
+                if self.layer(self.graph.layer(u)).penalty.contains(mid) {
+                    cost *= PENALTY_FACTOR;
+                }
+            }
+            self.relax(u, e.to, cost, None);
         }
         self.state
     }
@@ -330,12 +377,16 @@ impl Search {
         let step = scaled(self.params.grid_step).max(1);
         let reuse = (step as f64 * GRID_REUSE) as i64;
         let base = self.params.base_weight;
-        for k in 0..8 {
-            let angle = k as f64 * std::f64::consts::FRAC_PI_4;
-            let q = Point2::new(
-                p.x + (step as f64 * angle.cos()).round() as i64,
-                p.y + (step as f64 * angle.sin()).round() as i64,
-            );
+        // Grid points lie on one lattice of `grid_step` for every layer: steps from a lattice
+        // point are exact 45° steps, steps from a ring or pad vertex land on the nearest
+        // lattice point, and the same points recur on neighbouring layers (exact inter-layer
+        // matches) instead of each vertex seeding a lattice of its own.
+        let snap = |v: i64| (v as f64 / step as f64).round() as i64 * step;
+        for (dx, dy) in GRID_DIRECTIONS {
+            let q = Point2::new(snap(p.x + dx * step), snap(p.y + dy * step));
+            if q == p {
+                continue;
+            }
             if let Some(v) = self.graph.nearest(l, q, reuse) {
                 if self.in_infill(v, tol)
                     && self.grid_edge_ok(self.layer(l), p, self.graph.pos(v), tol)

@@ -13,7 +13,7 @@
 
 use super::RouteParams;
 use super::index::{dist, point_segment_distance};
-use crate::geom::{ExPolygon, Point2, Point3, Polygon, scaled, union};
+use crate::geom::{ExPolygon, Join, Point2, Point3, Polygon, offset, scaled, union};
 use std::f64::consts::PI;
 
 /// Sides of the polygons standing for round joints and pads.
@@ -36,6 +36,27 @@ fn circumscribed(half: f64) -> f64 {
 /// a margin.
 pub(crate) fn keep_out_radius(params: &RouteParams) -> f64 {
     2.0 * circumscribed(params.channel_half_width()) + KEEP_OUT_MARGIN_MM
+}
+
+/// Chord deviation of the round corners of grown pad outlines, mm; added to their growth so the
+/// chords stay outside the true rounded outline.
+const PAD_ROUND_MM: f64 = 0.005;
+
+/// Another net's pad seen from a wire: the copper grown by half the channel clearance
+/// (`channel_extra / 2`), which the wire's channel may not overlap (a hole in its islands),
+/// and that grown by a channel half-width, where the wire's centre may not run (a keep-out).
+/// A channel then keeps `channel_extra` clear of foreign copper, as between two traces.
+pub(crate) fn pad_obstacle(outline: &Polygon, params: &RouteParams) -> [Vec<ExPolygon>; 2] {
+    let copper = [ExPolygon {
+        contour: outline.clone(),
+        holes: Vec::new(),
+    }];
+    let grow = |d: f64| offset(&copper, d + PAD_ROUND_MM, Join::Round(PAD_ROUND_MM));
+    let clearance = params.channel_extra / 2.0;
+    [
+        grow(clearance),
+        grow(clearance + circumscribed(params.channel_half_width()) + KEEP_OUT_MARGIN_MM),
+    ]
 }
 
 /// A regular 16-gon around `center` circumscribing the circle of radius `radius_mm`, as one

@@ -14,7 +14,8 @@
 //!   `outside_weight`; sections inside a keep-out or bridging two separate islands are left out.
 //!   The split points are inserted into the ring edges they lie on, connecting the two.
 //! - **Endpoints**: each pad becomes a vertex on its layer, joined to the nearest point of every
-//!   ring within the perimeter zone (plus a grid step) and to every vertex within a grid step.
+//!   ring within the perimeter zone (plus a grid step), to the first point of every ring in each
+//!   of the eight 45° directions within that reach, and to every vertex within a grid step.
 //!
 //! Rings and sections are supersampled so consecutive vertices are at most
 //! `min(interlayer_overlap, grid_step)` apart. Ring samples sit at fixed arc lengths from the
@@ -84,7 +85,13 @@ pub(crate) struct LayerInput {
     /// Where no trace centre of this wire may run (other nets' traces grown by two channel
     /// half-widths).
     pub blocked: Vec<ExPolygon>,
+    /// Where links cost [`PENALTY_FACTOR`] times more: other nets' traces, when a rip-up probe
+    /// looks for the route that runs into the fewest of them. Empty in a normal search.
+    pub penalty: Vec<ExPolygon>,
 }
+
+/// Cost multiplier of links in a [`LayerInput::penalty`] region.
+pub(crate) const PENALTY_FACTOR: f64 = 25.0;
 
 /// One deflated perimeter trace.
 #[derive(Debug, Clone)]
@@ -117,6 +124,8 @@ pub(crate) struct PreparedLayer {
     pub contours: RegionIndex,
     /// Keep-outs of other nets' traces.
     pub blocked: RegionIndex,
+    /// Where links cost [`PENALTY_FACTOR`] times more.
+    pub penalty: RegionIndex,
 }
 
 impl PreparedLayer {
@@ -127,7 +136,11 @@ impl PreparedLayer {
         let mut areas: Vec<Vec<ExPolygon>> = Vec::new();
         for i in 1..=params.perimeters {
             let inset = i as f64 * params.perimeter_width + half;
-            let area = offset(&input.islands, -inset, Join::Round(ROUND_DEVIATION_MM));
+            let area = decimate(offset(
+                &input.islands,
+                -inset,
+                Join::Round(ROUND_DEVIATION_MM),
+            ));
             let weight = params.perimeter_weight(i);
             for ex in &area {
                 for ring in std::iter::once(&ex.contour).chain(&ex.holes) {
@@ -168,6 +181,7 @@ impl PreparedLayer {
             material: RegionIndex::of_regions(&input.original),
             contours: RegionIndex::new(&contours),
             blocked: RegionIndex::of_regions(&input.blocked),
+            penalty: RegionIndex::of_regions(&input.penalty),
             rings,
         }
     }
@@ -210,6 +224,39 @@ impl PreparedLayer {
             None
         }
     }
+}
+
+/// Ring points closer than this to the previous kept point are dropped (scaled units: 0.2 mm).
+/// Round corners of the deflated traces come in chords a few micrometres long; a vertex every
+/// 0.2 mm is dense enough for routing, and the chords left stray less than 0.01 mm from the arc
+/// for radii above 0.5 mm.
+const RING_POINT_SPACING_NM: i64 = 200_000;
+
+/// `regions` with ring points closer than [`RING_POINT_SPACING_NM`] to the previous kept one
+/// dropped; rings left with fewer than three points are kept whole.
+fn decimate(mut regions: Vec<ExPolygon>) -> Vec<ExPolygon> {
+    let min2 = (RING_POINT_SPACING_NM as i128).pow(2);
+    let thin = |pts: &mut Vec<Point2>| {
+        let mut kept: Vec<Point2> = Vec::with_capacity(pts.len());
+        for &p in pts.iter() {
+            if kept.last().is_none_or(|&q| q.distance_squared(p) >= min2) {
+                kept.push(p);
+            }
+        }
+        while kept.len() > 3 && kept[0].distance_squared(kept[kept.len() - 1]) < min2 {
+            kept.pop();
+        }
+        if kept.len() >= 3 {
+            *pts = kept;
+        }
+    };
+    for ex in &mut regions {
+        thin(&mut ex.contour.points);
+        for h in &mut ex.holes {
+            thin(&mut h.points);
+        }
+    }
+    regions
 }
 
 /// One vertex of the routing graph.
@@ -493,6 +540,29 @@ pub(crate) fn build(
                     pad_links.push((pad, ins.point));
                 }
             }
+            // A pad in a row of other nets' pads can only be left along the gap between its
+            // neighbours, which the nearest ring point may not face: also link it to the
+            // first point of every ring in each of the eight 45° directions.
+            for k in 0..8 {
+                let angle = k as f64 * std::f64::consts::FRAC_PI_4;
+                let end = Point2::new(
+                    pad.x + (reach as f64 * angle.cos()).round() as i64,
+                    pad.y + (reach as f64 * angle.sin()).round() as i64,
+                );
+                let mut seen: Vec<u32> = Vec::new();
+                for h in layer.ring_edges.hits(pad, end) {
+                    if seen.contains(&h.group) {
+                        continue;
+                    }
+                    seen.push(h.group);
+                    inserts[h.group as usize].push(Insert {
+                        edge: h.edge as usize,
+                        u: h.u,
+                        point: h.point,
+                    });
+                    pad_links.push((pad, h.point));
+                }
+            }
         }
         for (ring, ins) in layer.rings.iter().zip(&inserts) {
             let pts = sample_ring(&ring.points, ins, spacing);
@@ -644,6 +714,7 @@ mod tests {
             islands: islands.clone(),
             original: islands,
             blocked: Vec::new(),
+            penalty: Vec::new(),
         }
     }
 

@@ -3,15 +3,130 @@
 //! Place in the pipeline: a helper of the router (`route`), which asks many "is this point in the
 //! material?", "where does this rubberband cross the perimeter traces?" and "does this link cross
 //! a channel?" questions per layer. Edges are sorted into 1 mm bands of y, so a query only looks
-//! at the edges whose y range overlaps the query's.
+//! at the edges whose y range overlaps the query's. A map of 0.5 mm cells marks the cells an
+//! edge's bounding box touches: a query that touches no marked cell is answered without looking
+//! at an edge (no crossing, not near the boundary), and a point in an unmarked cell shares the
+//! inside/outside answer of every point of that cell, which is worked out once and kept.
 //!
 //! Orientation tests are exact (`i128` cross products of nanometre coordinates); only the
 //! parameters of intersection points are `f64`.
 
 use crate::geom::{ExPolygon, Point2};
+use std::cell::Cell;
 
 /// Height of one band of edges, in scaled units (1 mm).
 const BAND: i64 = 1_000_000;
+
+/// Side of a cell of the cell map, scaled units (0.5 mm); larger for regions that would need
+/// more than [`MAX_CELLS`].
+const CELL: i64 = 500_000;
+
+/// Most cells in one cell map.
+const MAX_CELLS: i64 = 1 << 22;
+
+/// Inside/outside of the points of an unmarked cell: not yet known.
+const UNKNOWN: u8 = 0;
+/// ... all inside.
+const INSIDE: u8 = 1;
+/// ... all outside.
+const OUTSIDE: u8 = 2;
+
+/// Which cells of a grid over the edges' bounding box an edge's bounding box touches, and the
+/// inside/outside answer of the untouched ones once asked.
+#[derive(Debug, Clone, Default)]
+struct CellMap {
+    x0: i64,
+    y0: i64,
+    size: i64,
+    nx: i64,
+    ny: i64,
+    marked: Vec<bool>,
+    answer: Vec<Cell<u8>>,
+}
+
+impl CellMap {
+    fn new(edges: &[Edge]) -> Self {
+        let Some((x0, y0, x1, y1)) =
+            edges
+                .iter()
+                .fold(None, |b: Option<(i64, i64, i64, i64)>, e| {
+                    let (lx, ly) = (e.a.x.min(e.b.x), e.a.y.min(e.b.y));
+                    let (hx, hy) = (e.a.x.max(e.b.x), e.a.y.max(e.b.y));
+                    Some(b.map_or((lx, ly, hx, hy), |b| {
+                        (b.0.min(lx), b.1.min(ly), b.2.max(hx), b.3.max(hy))
+                    }))
+                })
+        else {
+            return Self::default();
+        };
+        let mut size = CELL;
+        while ((x1 - x0) / size + 1) * ((y1 - y0) / size + 1) > MAX_CELLS {
+            size *= 2;
+        }
+        let (nx, ny) = ((x1 - x0) / size + 1, (y1 - y0) / size + 1);
+        let mut map = Self {
+            x0,
+            y0,
+            size,
+            nx,
+            ny,
+            marked: vec![false; (nx * ny) as usize],
+            answer: vec![Cell::new(UNKNOWN); (nx * ny) as usize],
+        };
+        for e in edges {
+            let (cx0, cy0) = map.cell(e.a.x.min(e.b.x), e.a.y.min(e.b.y));
+            let (cx1, cy1) = map.cell(e.a.x.max(e.b.x), e.a.y.max(e.b.y));
+            for cy in cy0..=cy1 {
+                for cx in cx0..=cx1 {
+                    map.marked[(cy * nx + cx) as usize] = true;
+                }
+            }
+        }
+        map
+    }
+
+    /// The cell holding `(x, y)`, clamped to the grid.
+    fn cell(&self, x: i64, y: i64) -> (i64, i64) {
+        (
+            ((x - self.x0).div_euclid(self.size)).clamp(0, self.nx - 1),
+            ((y - self.y0).div_euclid(self.size)).clamp(0, self.ny - 1),
+        )
+    }
+
+    /// Whether the box `lo..=hi` reaches past the grid or touches a marked cell: whether an edge
+    /// may pass through it.
+    fn may_touch(&self, lo: Point2, hi: Point2) -> bool {
+        if self.marked.is_empty() {
+            return false;
+        }
+        let (cx0, cy0) = self.cell(lo.x, lo.y);
+        let (cx1, cy1) = self.cell(hi.x, hi.y);
+        (cy0..=cy1).any(|cy| (cx0..=cx1).any(|cx| self.marked[(cy * self.nx + cx) as usize]))
+    }
+
+    /// The unmarked cell holding `p`, if `p` is on the grid and its cell is unmarked.
+    fn free_cell(&self, p: Point2) -> Option<usize> {
+        if self.marked.is_empty()
+            || p.x < self.x0
+            || p.y < self.y0
+            || (p.x - self.x0) / self.size >= self.nx
+            || (p.y - self.y0) / self.size >= self.ny
+        {
+            return None;
+        }
+        let k = (((p.y - self.y0) / self.size) * self.nx + (p.x - self.x0) / self.size) as usize;
+        (!self.marked[k]).then_some(k)
+    }
+
+    /// Whether `p` lies outside the box of all edges (and so outside the region).
+    fn off_grid(&self, p: Point2) -> bool {
+        self.marked.is_empty()
+            || p.x < self.x0
+            || p.y < self.y0
+            || p.x > self.x0 + self.nx * self.size
+            || p.y > self.y0 + self.ny * self.size
+    }
+}
 
 /// One edge of a ring, with the group it belongs to and its index within its ring.
 #[derive(Debug, Clone, Copy)]
@@ -48,6 +163,7 @@ pub(crate) struct RegionIndex {
     first_band: Vec<u32>,
     y0: i64,
     bands: Vec<Vec<u32>>,
+    cells: CellMap,
 }
 
 fn orient(a: Point2, b: Point2, p: Point2) -> i128 {
@@ -153,11 +269,13 @@ impl RegionIndex {
             }
             first_band.push(lo as u32);
         }
+        let cells = CellMap::new(&edges);
         Self {
             edges,
             first_band,
             y0,
             bands,
+            cells,
         }
     }
 
@@ -200,6 +318,25 @@ impl RegionIndex {
     /// Whether `p` is strictly inside (even-odd over all rings). Points exactly on an edge may go
     /// either way; use [`Self::inside_or_on`] where the boundary matters.
     pub(crate) fn contains(&self, p: Point2) -> bool {
+        if self.cells.off_grid(p) {
+            return false;
+        }
+        let Some(k) = self.cells.free_cell(p) else {
+            return self.ray_parity(p);
+        };
+        match self.cells.answer[k].get() {
+            INSIDE => true,
+            OUTSIDE => false,
+            _ => {
+                let inside = self.ray_parity(p);
+                self.cells.answer[k].set(if inside { INSIDE } else { OUTSIDE });
+                inside
+            }
+        }
+    }
+
+    /// Even-odd parity of the edges a ray from `p` towards +x crosses.
+    fn ray_parity(&self, p: Point2) -> bool {
         let mut inside = false;
         for &i in self.band_at(p.y) {
             let e = self.edges[i as usize];
@@ -219,6 +356,13 @@ impl RegionIndex {
 
     /// Whether `p` lies within `tol` (scaled units) of an edge.
     pub(crate) fn near_boundary(&self, p: Point2, tol: i64) -> bool {
+        let (lo, hi) = (
+            Point2::new(p.x - tol, p.y - tol),
+            Point2::new(p.x + tol, p.y + tol),
+        );
+        if !self.cells.may_touch(lo, hi) {
+            return false;
+        }
         self.edges_between(p.y - tol, p.y + tol).any(|e| {
             e.a.x.min(e.b.x) - tol <= p.x
                 && e.a.x.max(e.b.x) + tol >= p.x
@@ -298,6 +442,11 @@ impl RegionIndex {
 
     /// Whether the segment `a`–`b` properly crosses an edge (touching does not count).
     pub(crate) fn crosses(&self, a: Point2, b: Point2) -> bool {
+        let lo = Point2::new(a.x.min(b.x), a.y.min(b.y));
+        let hi = Point2::new(a.x.max(b.x), a.y.max(b.y));
+        if !self.cells.may_touch(lo, hi) {
+            return false;
+        }
         self.edges_between(a.y.min(b.y), a.y.max(b.y))
             .any(|e| proper_crossing(a, b, e))
     }

@@ -9,8 +9,9 @@
 //! 1. walk `u`'s best path back, along this layer (including a staircase overlap this layer
 //!    started with), until the walked length exceeds `interlayer_overlap + grid_step`;
 //! 2. every point of that piece must have a match on the neighbour layer: a vertex at the same
-//!    xy (within `align_tolerance`), or a point inside the neighbour's first deflated area (where
-//!    a channel fits) and out of its keep-outs; no piece edge may cross a keep-out;
+//!    xy (within `align_tolerance`) inside the material, or a point inside the neighbour's first
+//!    deflated area (where a channel fits) and out of its keep-outs; no piece edge may cross a
+//!    keep-out;
 //! 3. then `u` is joined to its match on the neighbour layer, at the cost of the piece (length ×
 //!    `base_weight`) plus `layer_change_penalty`, and the piece is kept: the route prints it on
 //!    both layers, at the end of this layer's segment and the start of the next.
@@ -76,8 +77,10 @@ pub(crate) fn walk_back(
 
 /// Whether every point of `piece` can be printed on `layer` (see the module docs).
 pub(crate) fn piece_fits(piece: &[Point2], graph: &Graph, layer: &PreparedLayer, tol: i64) -> bool {
+    // A vertex of the neighbour layer at the same xy is a match only inside its material:
+    // direct connections also run across holes and cavities, where no trace may be printed.
     let fits = |p: Point2| {
-        graph.nearest(layer.index, p, tol).is_some()
+        (graph.nearest(layer.index, p, tol).is_some() && layer.material.inside_or_on(p, tol))
             || (layer.clearance.inside_or_on(p, tol) && !layer.blocked.contains(p))
     };
     piece.iter().all(|&p| fits(p))

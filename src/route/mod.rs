@@ -21,14 +21,19 @@
 //!    piece is printed on both layers (the staircase overlap), so the traces of consecutive layers
 //!    touch over at least `interlayer_overlap` mm.
 //! 3. **A\*** (`astar.rs`) per wire, steppable ([`Search::step`]), deterministic.
-//! 4. **Collisions and order** (`order.rs`, `channels.rs`): wires are routed one after another,
-//!    fewest rubberband collisions first, then shortest; each routed wire's channel becomes a hole
-//!    in the islands of the following wires of other nets (new perimeter traces form around it)
-//!    and a keep-out for their direct connections.
+//! 4. **Collisions and order** (`order.rs`, `channels.rs`, `board.rs`): wires are routed one
+//!    after another, fewest rubberband collisions first, then shortest; each routed wire's
+//!    channel becomes a hole in the islands of the following wires of other nets (new perimeter
+//!    traces form around it) and a keep-out for their direct connections, on its own layer and
+//!    on the layers just above and below: a trace fills its channel to the layer's top, so traces
+//!    of adjacent layers would touch, and one route passes over another only with a layer of
+//!    plastic between them. Other nets' pads are holes and keep-outs on their layer. Wires that
+//!    fail get rounds of rip-up and reroute: the wires in their way are routed again after them.
 //!
 //! Units: millimetres in the public types, nanometre integers ([`Point2`]) inside.
 
 mod astar;
+mod board;
 mod channels;
 mod graph;
 mod index;
@@ -43,8 +48,7 @@ pub use astar::{Search, SearchState, route_wire};
 pub use channels::trace_channel;
 pub use order::{collision_counts, wire_order};
 
-use crate::geom::{ExPolygon, Point2, Point3, difference, union};
-use graph::LayerInput;
+use crate::geom::{ExPolygon, Point2, Point3, Polygon};
 
 /// One planar layer as the router sees it.
 #[derive(Debug, Clone, PartialEq)]
@@ -66,6 +70,32 @@ pub struct Wire {
     pub from: Point3,
     /// End pad, mm.
     pub to: Point3,
+}
+
+/// The copper of one pad: an obstacle to the traces of every net but its own.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PadCopper {
+    /// Net of the pad; `None` for a pin no net uses, which every trace keeps clear of.
+    pub net: Option<String>,
+    /// Seating plane, mm: the pad lies on the layer whose top this is (see [`layer_of`]).
+    pub z: f64,
+    /// Copper outline in xy, counter-clockwise.
+    pub outline: Polygon,
+}
+
+impl PadCopper {
+    /// A round pad of `diameter` mm centred on `at` (16-gon circumscribing the circle).
+    pub fn round(net: Option<&str>, at: Point3, diameter: f64) -> Self {
+        let outline = channels::disc(Point2::from_mm(at.x, at.y), diameter / 2.0)
+            .pop()
+            .map(|e| e.contour)
+            .unwrap_or_else(|| Polygon::new(vec![Point2::from_mm(at.x, at.y)]));
+        Self {
+            net: net.map(str::to_owned),
+            z: at.z,
+            outline,
+        }
+    }
 }
 
 /// Parameters of the router. Lengths in mm; weights are cost multipliers per mm of trace.
@@ -99,6 +129,21 @@ pub struct RouteParams {
     pub interlayer_overlap: f64,
     /// Fixed cost of one layer change, in mm-equivalents (default 5.0).
     pub layer_change_penalty: f64,
+    /// Layers below the lower pad's layer and above the upper pad's a route may use (default
+    /// 3). Traces of different nets on adjacent layers touch, so one route passes another
+    /// at least two layers away.
+    pub layer_span: usize,
+    /// Rounds of rip-up and reroute for wires that fail (default 3; 0 routes each wire once,
+    /// in order).
+    pub rip_up_rounds: usize,
+    /// Longest route worth printing, as a multiple of the straight 3D distance between the
+    /// pads, plus `detour_slack` (default 4): a conductive trace's resistance grows with its
+    /// length, so a wire that needs a longer route is reported unrouted, and the search stops
+    /// there instead of exploring the whole object.
+    pub max_detour: f64,
+    /// Cost added to the detour limit, in mm-equivalents (default 40: room for several layer
+    /// changes and a way round a part even on the shortest wires).
+    pub detour_slack: f64,
     /// Safety cap on A* expansions per wire; a wire that needs more is reported unrouted
     /// (default 2 000 000).
     pub max_expansions: usize,
@@ -121,6 +166,10 @@ impl Default for RouteParams {
             grid_step: 1.0,
             interlayer_overlap: 2.0,
             layer_change_penalty: 5.0,
+            layer_span: 3,
+            rip_up_rounds: 3,
+            max_detour: 4.0,
+            detour_slack: 40.0,
             max_expansions: 2_000_000,
             align_tolerance: 0.05,
         }
@@ -203,95 +252,26 @@ pub fn layer_of(layers: &[RouteLayer], z: f64) -> Option<usize> {
         .map(|(_, _, i)| i)
 }
 
-/// A routed wire's channel and keep-out on one layer.
-struct Placed {
-    net: String,
-    channel: Vec<ExPolygon>,
-    keep_out: Vec<ExPolygon>,
+/// Smallest distance (mm) between the centrelines of two traces of different nets on one
+/// layer: two channel widths' worth, `conductive_width + channel_extra`, plus what the polygonal
+/// channels add.
+pub fn min_trace_spacing(params: &RouteParams) -> f64 {
+    channels::keep_out_radius(params)
 }
 
 /// Routes every wire through the layers, in the order of [`wire_order`], each wire avoiding the
-/// channels of the wires of other nets routed before it. Wires that cannot be routed are
-/// reported with `routed = false`; routing goes on with the others.
-pub fn route(layers: &[RouteLayer], wires: &[Wire], params: &RouteParams) -> RouteResult {
-    let half = params.channel_half_width();
-    let keep_out_radius = channels::keep_out_radius(params);
-    let mut placed: Vec<Vec<Placed>> = (0..layers.len()).map(|_| Vec::new()).collect();
-    // Pads of every wire: other nets' pads are holes for a wire, so no trace runs over them.
-    let pads: Vec<(usize, &str, Point2)> = wires
-        .iter()
-        .flat_map(|w| [(w, w.from), (w, w.to)])
-        .filter_map(|(w, p)| {
-            layer_of(layers, p.z).map(|l| (l, w.net.as_str(), Point2::from_mm(p.x, p.y)))
-        })
-        .collect();
-    let mut routes: Vec<Option<WireRoute>> = vec![None; wires.len()];
-    for i in wire_order(wires, params) {
-        let wire = &wires[i];
-        let Some(range) = astar::layer_range(layers, wire) else {
-            routes[i] = Some(trace::unrouted(wire));
-            continue;
-        };
-        let inputs: Vec<LayerInput> = range
-            .map(|l| {
-                let mut holes: Vec<ExPolygon> = Vec::new();
-                let mut blocked: Vec<ExPolygon> = Vec::new();
-                for p in placed[l].iter().filter(|p| p.net != wire.net) {
-                    holes.extend(p.channel.iter().cloned());
-                    blocked.extend(p.keep_out.iter().cloned());
-                }
-                for &(_, _, at) in pads
-                    .iter()
-                    .filter(|(pl, net, _)| *pl == l && *net != wire.net)
-                {
-                    holes.extend(channels::disc(at, half));
-                    blocked.extend(channels::disc(at, keep_out_radius));
-                }
-                let original = layers[l].islands.clone();
-                let islands = if holes.is_empty() {
-                    original.clone()
-                } else {
-                    difference(&original, &union(&holes))
-                };
-                LayerInput {
-                    index: l,
-                    z: layers[l].z,
-                    islands,
-                    original,
-                    blocked: if blocked.is_empty() {
-                        blocked
-                    } else {
-                        union(&blocked)
-                    },
-                }
-            })
-            .collect();
-        let mut search = Search::with_layers(inputs, layers, wire, params);
-        while search.step() == SearchState::Running {}
-        let result = search.result();
-        for (l, points) in &result.segments {
-            let xy: Vec<Point2> = points.iter().map(|p| Point2::from_mm(p.x, p.y)).collect();
-            placed[*l].push(Placed {
-                net: wire.net.clone(),
-                channel: channels::polyline_channel(&xy, half),
-                keep_out: channels::polyline_channel(&xy, keep_out_radius),
-            });
-        }
-        routes[i] = Some(result);
-    }
-    let channels = placed
-        .iter()
-        .map(|ps| {
-            let all: Vec<ExPolygon> = ps.iter().flat_map(|p| p.channel.iter().cloned()).collect();
-            if all.is_empty() { all } else { union(&all) }
-        })
-        .collect();
-    RouteResult {
-        wires: routes
-            .into_iter()
-            .zip(wires)
-            .map(|(r, w)| r.unwrap_or_else(|| trace::unrouted(w)))
-            .collect(),
-        channels,
-    }
+/// channels of the wires of other nets routed before it (on its layer and the adjacent ones)
+/// and the copper of other nets' pads and of unconnected pads (on the pad's layer). Wires that
+/// cannot be routed are reported with `routed = false`; routing goes on with the others, and
+/// failed wires get `rip_up_rounds` rounds of rip-up and reroute (see `board.rs`).
+pub fn route(
+    layers: &[RouteLayer],
+    wires: &[Wire],
+    pads: &[PadCopper],
+    params: &RouteParams,
+) -> RouteResult {
+    let mut board = board::Board::new(layers, wires, pads, params);
+    board.route_all();
+    let (wires, channels) = board.finish();
+    RouteResult { wires, channels }
 }

@@ -1,7 +1,7 @@
 //! Routing scenarios on hand-built layers: an annulus plate, a solid plate, two separate blocks.
 
 use super::*;
-use crate::geom::{Polygon, intersection};
+use crate::geom::{Polygon, intersection, union};
 
 const LAYER_HEIGHT: f64 = 0.2;
 
@@ -51,6 +51,14 @@ fn wire(net: &str, from: (f64, f64, f64), to: (f64, f64, f64)) -> Wire {
         from: Point3::new(from.0, from.1, from.2),
         to: Point3::new(to.0, to.1, to.2),
     }
+}
+
+/// A round 1 mm pad on each end of every wire, on the wire's net.
+fn end_pads(wires: &[Wire]) -> Vec<PadCopper> {
+    wires
+        .iter()
+        .flat_map(|w| [w.from, w.to].map(|p| PadCopper::round(Some(&w.net), p, 1.0)))
+        .collect()
 }
 
 fn top(layers: &[RouteLayer]) -> f64 {
@@ -121,7 +129,12 @@ fn annulus_route_follows_the_perimeters_around_the_hole() {
     let z = top(&layers);
     let params = RouteParams::default();
     let w = wire("sig", (5.0, 30.0, z), (55.0, 30.0, z));
-    let result = route(&layers, std::slice::from_ref(&w), &params);
+    let result = route(
+        &layers,
+        std::slice::from_ref(&w),
+        &end_pads(std::slice::from_ref(&w)),
+        &params,
+    );
     let r = &result.wires[0];
     assert!(r.routed, "{r:?}");
     assert_eq!(r.lower_bound, 50.0);
@@ -164,20 +177,64 @@ fn crossing_rubberbands_get_disjoint_channels() {
         wire("a", (5.0, 5.0, z), (35.0, 35.0, z)),
         wire("b", (5.0, 35.0, z), (35.0, 5.0, z)),
     ];
-    let result = route(&layers, &wires, &params);
+    let result = route(&layers, &wires, &end_pads(&wires), &params);
     for r in &result.wires {
         assert!(r.routed, "{r:?}");
         assert!(r.length >= r.lower_bound - 1e-6);
     }
-    for l in 0..layers.len() {
-        let a = wire_channel(&result.wires[0], l, &params);
-        let b = wire_channel(&result.wires[1], l, &params);
-        let common = area(&intersection(&a, &b));
-        assert!(common < 1e-6, "layer {l}: channels share {common} mm²");
-    }
+    // Traces of adjacent layers touch where they overlap, so the channels of the two nets are
+    // disjoint on each layer and between each layer and the next.
+    assert!(!channels_touch(
+        &result.wires[0],
+        &result.wires[1],
+        layers.len(),
+        &params
+    ));
     // One of them had to change layer (or go around the other's end): it is longer.
     let longest = result.wires.iter().map(|r| r.length / r.lower_bound);
     assert!(longest.fold(0.0, f64::max) > 1.0);
+}
+
+/// Whether the channels of routes `a` and `b` share area on one layer or on two adjacent ones.
+fn channels_touch(a: &WireRoute, b: &WireRoute, layers: usize, params: &RouteParams) -> bool {
+    (0..layers).any(|l| {
+        (l.saturating_sub(1)..=(l + 1).min(layers - 1)).any(|m| {
+            let common = intersection(&wire_channel(a, l, params), &wire_channel(b, m, params));
+            area(&common) > 1e-6
+        })
+    })
+}
+
+#[test]
+fn wall_to_wall_wires_cross_with_a_plastic_layer_between() {
+    // Both wires span the plate from wall to wall, so neither can go around the other: the
+    // second passes under the first, two layers down, so a layer of plastic parts them.
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 6);
+    let z = top(&layers);
+    let params = RouteParams::default();
+    let wires = [
+        wire("a", (0.6, 20.0, z), (39.4, 20.0, z)),
+        wire("b", (20.0, 0.6, z), (20.0, 39.4, z)),
+    ];
+    let result = route(&layers, &wires, &end_pads(&wires), &params);
+    let (a, b) = (&result.wires[0], &result.wires[1]);
+    assert!(a.routed && b.routed, "{a:?} {b:?}");
+    assert!(!channels_touch(a, b, layers.len(), &params));
+    let lowest = |r: &WireRoute| {
+        r.segments
+            .iter()
+            .map(|(l, _)| *l)
+            .min()
+            .unwrap_or(usize::MAX)
+    };
+    assert!(lowest(a).min(lowest(b)) <= 3, "{a:?} {b:?}");
+    // With a span of one layer there is no way past.
+    let narrow = RouteParams {
+        layer_span: 1,
+        ..params.clone()
+    };
+    let result = route(&layers, &wires, &end_pads(&wires), &narrow);
+    assert_eq!(result.wires.iter().filter(|r| r.routed).count(), 1);
 }
 
 #[test]
@@ -246,7 +303,7 @@ fn pad_on_a_separate_island_is_unrouted_and_the_rest_goes_on() {
         wire("gap", (5.0, 10.0, z), (40.0, 10.0, z)),
         wire("ok", (3.0, 3.0, z), (17.0, 17.0, z)),
     ];
-    let result = route(&layers, &wires, &RouteParams::default());
+    let result = route(&layers, &wires, &end_pads(&wires), &RouteParams::default());
     let gap = &result.wires[0];
     assert!(!gap.routed);
     assert!(gap.segments.is_empty());
@@ -267,8 +324,8 @@ fn routing_is_deterministic() {
         wire("a", (35.0, 35.0, z5), (35.0, 20.0, z5)),
     ];
     let params = RouteParams::default();
-    let first = route(&layers, &wires, &params);
-    let second = route(&layers, &wires, &params);
+    let first = route(&layers, &wires, &end_pads(&wires), &params);
+    let second = route(&layers, &wires, &end_pads(&wires), &params);
     assert_eq!(first, second);
     assert!(first.wires.iter().filter(|w| w.routed).count() >= 3);
 }
@@ -315,7 +372,7 @@ fn wires_of_one_net_may_share_a_pad() {
         wire("gnd", (20.0, 20.0, z), (38.0, 20.0, z)),
         wire("sig", (20.0, 5.0, z), (20.0, 35.0, z)),
     ];
-    let result = route(&layers, &wires, &RouteParams::default());
+    let result = route(&layers, &wires, &end_pads(&wires), &RouteParams::default());
     assert!(result.wires.iter().all(|w| w.routed), "{result:?}");
     // The two gnd wires run straight into their shared pad.
     assert!((result.wires[0].length - 18.0).abs() < 1e-6);
@@ -323,4 +380,29 @@ fn wires_of_one_net_may_share_a_pad() {
     // The gnd line leaves no room for a trace at its ends: the signal crosses it on another
     // layer and comes back.
     assert!(result.wires[2].layer_changes >= 2, "{:?}", result.wires[2]);
+}
+
+#[test]
+fn routes_longer_than_the_detour_limit_are_not_searched_for() {
+    // Round the hole is about 1.45 times the straight 50 mm.
+    let layers = annulus_plate();
+    let z = top(&layers);
+    let w = wire("sig", (5.0, 30.0, z), (55.0, 30.0, z));
+    let with = |max_detour: f64| RouteParams {
+        max_detour,
+        detour_slack: 0.0,
+        ..RouteParams::default()
+    };
+    let long = route_wire(&layers, &w, &with(2.0));
+    assert!(
+        long.routed && long.length > 1.4 * long.lower_bound,
+        "{long:?}"
+    );
+    let mut search = Search::new(&layers, &w, &with(1.2));
+    while search.step() == SearchState::Running {}
+    assert_eq!(search.state(), SearchState::Failed);
+    // It gave up well before exploring what the longer limit needed.
+    let mut full = Search::new(&layers, &w, &with(2.0));
+    while full.step() == SearchState::Running {}
+    assert!(search.expansions() < full.expansions());
 }

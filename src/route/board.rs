@@ -1,0 +1,375 @@
+//! The routing board: the wires routed so far and their channels, with rip-up and reroute.
+//!
+//! Place in the pipeline: the driver of [`route`](super::route). It routes the wires one after
+//! another (order from `order.rs`), each as an A* search (`astar.rs`) on layers from which the
+//! channels of other nets' wires (on the layer and the two next to it) and the copper of other
+//! nets' pads are removed.
+//!
+//! Sequential routing fails when an early wire walls off a later one, for example by passing
+//! round a connector whose pins still have to be reached. A failed wire then gets a **rip-up
+//! and reroute** round: it is searched again with other nets' traces as no obstacle but a cost
+//! (each mm inside one costs 25 times more, so the probe runs into as few as it can; pads still
+//! count), the routed wires whose channels that probe route runs into (on its layer or an
+//! adjacent one) are ripped up, the failed wire is routed first, and the ripped wires are routed again after
+//! it. A round that leaves fewer wires routed than before it is undone, and rounds stop at the
+//! first one that routes nothing more or after `rip_up_rounds`.
+
+use super::astar::{Search, SearchState, layer_range};
+use super::graph::LayerInput;
+use super::{PadCopper, wire_order};
+use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
+use crate::geom::{ExPolygon, Point2, difference, intersection, union};
+
+/// A channel area (mm²) below which two channels count as not touching: polygon noise.
+const TOUCH_MM2: f64 = 1e-6;
+
+/// Extra margin of a wire's routing window beyond the farthest its route may go, mm.
+const WINDOW_MARGIN_MM: f64 = 2.0;
+
+/// An axis-aligned box, scaled units: `[min x, min y, max x, max y]`.
+type BBox = [i64; 4];
+
+/// The box around every point of `regions` (an empty box for none).
+fn bbox_of(regions: &[ExPolygon]) -> BBox {
+    let mut b = [i64::MAX, i64::MAX, i64::MIN, i64::MIN];
+    for p in regions.iter().flat_map(|ex| &ex.contour.points) {
+        b = [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)];
+    }
+    b
+}
+
+/// Whether box `inner` lies within box `outer`.
+fn bbox_within(inner: &BBox, outer: &BBox) -> bool {
+    outer[0] <= inner[0] && outer[1] <= inner[1] && inner[2] <= outer[2] && inner[3] <= outer[3]
+}
+
+/// Whether two boxes share a point.
+fn overlaps(a: &BBox, b: &BBox) -> bool {
+    a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3]
+}
+
+/// A routed wire's channel and keep-out on one layer.
+#[derive(Debug, Clone)]
+struct Placed {
+    wire: usize,
+    net: String,
+    channel: Vec<ExPolygon>,
+    keep_out: Vec<ExPolygon>,
+    /// Box of the keep-out (which holds the channel).
+    bbox: BBox,
+}
+
+/// Another net's pad as an obstacle: its layer, net, hole and keep-out.
+#[derive(Debug, Clone)]
+struct PadObstacle<'a> {
+    layer: usize,
+    net: Option<&'a str>,
+    hole: Vec<ExPolygon>,
+    keep_out: Vec<ExPolygon>,
+    /// Box of the keep-out (which holds the hole).
+    bbox: BBox,
+}
+
+/// The state of routing: every wire's route so far and the channels on every layer.
+#[derive(Debug, Clone)]
+pub(crate) struct Board<'a> {
+    layers: &'a [RouteLayer],
+    wires: &'a [Wire],
+    params: &'a RouteParams,
+    pads: Vec<PadObstacle<'a>>,
+    placed: Vec<Vec<Placed>>,
+    routes: Vec<Option<WireRoute>>,
+}
+
+impl<'a> Board<'a> {
+    /// An empty board: nothing routed yet.
+    pub(crate) fn new(
+        layers: &'a [RouteLayer],
+        wires: &'a [Wire],
+        pads: &'a [PadCopper],
+        params: &'a RouteParams,
+    ) -> Self {
+        let pads = pads
+            .iter()
+            .filter_map(|p| {
+                let [hole, keep_out] = channels::pad_obstacle(&p.outline, params);
+                Some(PadObstacle {
+                    layer: layer_of(layers, p.z)?,
+                    net: p.net.as_deref(),
+                    bbox: bbox_of(&keep_out),
+                    hole,
+                    keep_out,
+                })
+            })
+            .collect();
+        Self {
+            layers,
+            wires,
+            params,
+            pads,
+            placed: vec![Vec::new(); layers.len()],
+            routes: vec![None; wires.len()],
+        }
+    }
+
+    /// Routes every wire in [`wire_order`], then runs the rip-up and reroute rounds.
+    pub(crate) fn route_all(&mut self) {
+        for i in wire_order(self.wires, self.params) {
+            self.route_one(i);
+        }
+        for _ in 0..self.params.rip_up_rounds {
+            let before = self.routed_count();
+            if before == self.wires.len() {
+                break;
+            }
+            let saved = self.clone();
+            self.rip_up_round();
+            let after = self.routed_count();
+            if after < before {
+                *self = saved;
+            }
+            if after <= before {
+                break;
+            }
+        }
+    }
+
+    /// Number of wires with a route.
+    fn routed_count(&self) -> usize {
+        self.routes
+            .iter()
+            .filter(|r| r.as_ref().is_some_and(|r| r.routed))
+            .count()
+    }
+
+    /// The routes, one per wire in input order, and the union of the channels per layer.
+    pub(crate) fn finish(self) -> (Vec<WireRoute>, Vec<Vec<ExPolygon>>) {
+        let channels = self
+            .placed
+            .iter()
+            .map(|ps| {
+                let all: Vec<ExPolygon> =
+                    ps.iter().flat_map(|p| p.channel.iter().cloned()).collect();
+                if all.is_empty() { all } else { union(&all) }
+            })
+            .collect();
+        let routes = self
+            .routes
+            .into_iter()
+            .zip(self.wires)
+            .map(|(r, w)| r.unwrap_or_else(|| trace::unrouted(w)))
+            .collect();
+        (routes, channels)
+    }
+
+    /// One rip-up and reroute round over the wires that failed, in wire order.
+    fn rip_up_round(&mut self) {
+        let failed: Vec<usize> = wire_order(self.wires, self.params)
+            .into_iter()
+            .filter(|&i| !self.routes[i].as_ref().is_some_and(|r| r.routed))
+            .collect();
+        for f in failed {
+            if self.routes[f].as_ref().is_some_and(|r| r.routed) {
+                continue;
+            }
+            let probe = self.search(f, false);
+            if !probe.routed {
+                continue; // unroutable even on an empty board
+            }
+            let blockers = self.blockers(f, &probe);
+            if blockers.is_empty() {
+                continue;
+            }
+            for &b in &blockers {
+                self.rip_up(b);
+            }
+            self.route_one(f);
+            for b in blockers {
+                self.route_one(b);
+            }
+        }
+    }
+
+    /// Routes wire `i` on the board as it stands and places its channels.
+    fn route_one(&mut self, i: usize) {
+        let result = self.search(i, true);
+        let half = self.params.channel_half_width();
+        let keep_out_radius = channels::keep_out_radius(self.params);
+        for (l, points) in &result.segments {
+            let xy: Vec<Point2> = points.iter().map(|p| Point2::from_mm(p.x, p.y)).collect();
+            let keep_out = channels::polyline_channel(&xy, keep_out_radius);
+            self.placed[*l].push(Placed {
+                wire: i,
+                net: self.wires[i].net.clone(),
+                channel: channels::polyline_channel(&xy, half),
+                bbox: bbox_of(&keep_out),
+                keep_out,
+            });
+        }
+        self.routes[i] = Some(result);
+    }
+
+    /// Removes wire `i`'s route and channels.
+    fn rip_up(&mut self, i: usize) {
+        for layer in &mut self.placed {
+            layer.retain(|p| p.wire != i);
+        }
+        self.routes[i] = None;
+    }
+
+    /// The routed wires of other nets whose channels the route `probe` of wire `i` runs into,
+    /// on its layer or an adjacent one; by increasing index.
+    fn blockers(&self, i: usize, probe: &WireRoute) -> Vec<usize> {
+        let half = self.params.channel_half_width();
+        let net = &self.wires[i].net;
+        let mut out: Vec<usize> = Vec::new();
+        for (l, points) in &probe.segments {
+            let xy: Vec<Point2> = points.iter().map(|p| Point2::from_mm(p.x, p.y)).collect();
+            let mine = channels::polyline_channel(&xy, half);
+            for p in self.near(*l).filter(|p| &p.net != net) {
+                if out.contains(&p.wire) {
+                    continue;
+                }
+                let common = intersection(&mine, &p.channel);
+                if common.iter().map(ExPolygon::area_mm2).sum::<f64>() > TOUCH_MM2 {
+                    out.push(p.wire);
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
+    /// The channels placed on layer `l` and the layers just below and above it: a trace fills
+    /// its channel up to the layer's top and the next layer is printed on it, so traces of
+    /// adjacent layers touch where they overlap.
+    fn near(&self, l: usize) -> impl Iterator<Item = &Placed> {
+        let near = l.saturating_sub(1)..=(l + 1).min(self.layers.len() - 1);
+        self.placed[near].iter().flatten()
+    }
+
+    /// Runs the A* search of wire `i`; with `traces` the channels of other nets' wires are in
+    /// the way, without only the pads are.
+    fn search(&self, i: usize, traces: bool) -> WireRoute {
+        let wire = &self.wires[i];
+        let Some(range) = layer_range(self.layers, wire, self.params) else {
+            return trace::unrouted(wire);
+        };
+        let window = self.window(wire, traces);
+        let inputs: Vec<LayerInput> = range
+            .map(|l| self.input(l, wire, traces, &window))
+            .collect();
+        let mut search = Search::with_layers(inputs, self.layers, wire, self.params);
+        while search.step() == SearchState::Running {}
+        search.result()
+    }
+
+    /// The routing window of `wire`: the box no route within the detour limit leaves. A route
+    /// of length at most `L` between pads `d` apart lies in the ellipse with the pads as foci
+    /// and `L` as major axis, whose box is the pads' box grown by `(L - d) / 2`. `L` is the
+    /// search's cost limit over the smallest weight per mm (see `astar.rs`).
+    fn window(&self, wire: &Wire, traces: bool) -> Vec<ExPolygon> {
+        let p = self.params;
+        let d = ((wire.to.x - wire.from.x).powi(2)
+            + (wire.to.y - wire.from.y).powi(2)
+            + (wire.to.z - wire.from.z).powi(2))
+        .sqrt();
+        let min_weight = p
+            .perimeter_weights
+            .iter()
+            .chain([&p.base_weight, &p.outside_weight])
+            .copied()
+            .fold(f64::INFINITY, f64::min)
+            .max(1e-9);
+        // The limit also counts the layer changes the heuristic adds: at most one per layer
+        // in the wire's range, a cost that only lengthens the allowance.
+        let layers = layer_range(self.layers, wire, p).map_or(0, |r| r.count()) as f64;
+        let change = p.layer_change_penalty + p.interlayer_overlap * p.base_weight;
+        let mut limit = p.max_detour.max(1.0)
+            * (d + change * layers / min_weight)
+            * p.base_weight.max(min_weight)
+            + p.detour_slack.max(0.0);
+        if !traces {
+            limit += super::graph::PENALTY_FACTOR * 5.0;
+        }
+        let grow = ((limit / min_weight - d) / 2.0).max(0.0) + WINDOW_MARGIN_MM;
+        if !grow.is_finite() {
+            return Vec::new();
+        }
+        let (x0, x1) = (
+            wire.from.x.min(wire.to.x) - grow,
+            wire.from.x.max(wire.to.x) + grow,
+        );
+        let (y0, y1) = (
+            wire.from.y.min(wire.to.y) - grow,
+            wire.from.y.max(wire.to.y) + grow,
+        );
+        vec![ExPolygon {
+            contour: crate::geom::Polygon::new(vec![
+                Point2::from_mm(x0, y0),
+                Point2::from_mm(x1, y0),
+                Point2::from_mm(x1, y1),
+                Point2::from_mm(x0, y1),
+            ]),
+            holes: Vec::new(),
+        }]
+    }
+
+    /// Layer `l` as `wire` sees it within `window` (everything if empty): the islands less the
+    /// holes of other nets' channels and pads, and their keep-outs; without `traces`, other
+    /// nets' traces are no obstacle but a penalty (their keep-outs).
+    fn input(&self, l: usize, wire: &Wire, traces: bool, window: &[ExPolygon]) -> LayerInput {
+        let mut holes: Vec<ExPolygon> = Vec::new();
+        let mut blocked: Vec<ExPolygon> = Vec::new();
+        let mut penalty: Vec<ExPolygon> = Vec::new();
+        let frame = if window.is_empty() {
+            [i64::MIN, i64::MIN, i64::MAX, i64::MAX]
+        } else {
+            bbox_of(window)
+        };
+        for p in self
+            .near(l)
+            .filter(|p| p.net != wire.net && overlaps(&p.bbox, &frame))
+        {
+            if traces {
+                holes.extend(p.channel.iter().cloned());
+                blocked.extend(p.keep_out.iter().cloned());
+            } else {
+                penalty.extend(p.keep_out.iter().cloned());
+            }
+        }
+        for pad in self.pads.iter().filter(|p| {
+            p.layer == l && p.net != Some(wire.net.as_str()) && overlaps(&p.bbox, &frame)
+        }) {
+            holes.extend(pad.hole.iter().cloned());
+            blocked.extend(pad.keep_out.iter().cloned());
+        }
+        let original =
+            if window.is_empty() || bbox_within(&bbox_of(&self.layers[l].islands), &frame) {
+                self.layers[l].islands.clone()
+            } else {
+                intersection(&self.layers[l].islands, window)
+            };
+        let islands = if holes.is_empty() {
+            original.clone()
+        } else {
+            difference(&original, &union(&holes))
+        };
+        LayerInput {
+            index: l,
+            z: self.layers[l].z,
+            islands,
+            original,
+            blocked: if blocked.is_empty() {
+                blocked
+            } else {
+                union(&blocked)
+            },
+            penalty: if penalty.is_empty() {
+                penalty
+            } else {
+                union(&penalty)
+            },
+        }
+    }
+}
