@@ -39,17 +39,17 @@ pub struct RouteSettings {
     pub layer_change_penalty: f64,
     /// Layers below the lower pad and above the upper pad a route may use to pass other
     /// traces. Traces of different nets on adjacent layers would touch, so a crossing needs a
-    /// layer in between: at least 2 for routes to cross at all. Default 3.
+    /// layer in between: at least 2 for routes to cross at all. Default 2.
     pub layer_span: usize,
     /// Rounds of rip-up and reroute for wires that could not be routed: the wires in their way
     /// are routed again after them. 0 routes each wire once. Default 3.
     pub rip_up_rounds: usize,
     /// Longest route worth printing, as a multiple of the straight distance between the pads
     /// (plus `detour_slack`): a trace's resistance grows with its length, so a wire that needs a
-    /// longer route is reported unrouted. Default 4.
+    /// longer route is reported unrouted. Default 3.
     pub max_detour: f64,
     /// Allowance added to the detour limit, mm: room for layer changes and a way round a part on
-    /// short wires. Default 40.
+    /// short wires. Default 30.
     pub detour_slack: f64,
     /// Put a conductive drop (a small disc of trace) on every pad, also on pins no net uses,
     /// so a part's leads sit in paste. Default false.
@@ -71,10 +71,10 @@ impl Default for RouteSettings {
             grid_step: 1.0,
             interlayer_overlap: 2.0,
             layer_change_penalty: 5.0,
-            layer_span: 3,
+            layer_span: 2,
             rip_up_rounds: 3,
-            max_detour: 4.0,
-            detour_slack: 40.0,
+            max_detour: 3.0,
+            detour_slack: 30.0,
             pad_drops: false,
         }
     }

@@ -281,9 +281,14 @@ impl<'a> Board<'a> {
             .copied()
             .fold(f64::INFINITY, f64::min)
             .max(1e-9);
-        // The limit also counts the layer changes the heuristic adds: at most one per layer
-        // in the wire's range, a cost that only lengthens the allowance.
-        let layers = layer_range(self.layers, wire, p).map_or(0, |r| r.count()) as f64;
+        // The limit also counts the layer changes between the pads, as the heuristic does.
+        let layers = match (
+            layer_of(self.layers, wire.from.z),
+            layer_of(self.layers, wire.to.z),
+        ) {
+            (Some(a), Some(b)) => a.abs_diff(b) as f64,
+            _ => return Vec::new(),
+        };
         let change = p.layer_change_penalty + p.interlayer_overlap * p.base_weight;
         let mut limit = p.max_detour.max(1.0)
             * (d + change * layers / min_weight)

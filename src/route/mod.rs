@@ -130,19 +130,19 @@ pub struct RouteParams {
     /// Fixed cost of one layer change, in mm-equivalents (default 5.0).
     pub layer_change_penalty: f64,
     /// Layers below the lower pad's layer and above the upper pad's a route may use (default
-    /// 3). Traces of different nets on adjacent layers touch, so one route passes another
+    /// 2). Traces of different nets on adjacent layers touch, so one route passes another
     /// at least two layers away.
     pub layer_span: usize,
     /// Rounds of rip-up and reroute for wires that fail (default 3; 0 routes each wire once,
     /// in order).
     pub rip_up_rounds: usize,
     /// Longest route worth printing, as a multiple of the straight 3D distance between the
-    /// pads, plus `detour_slack` (default 4): a conductive trace's resistance grows with its
+    /// pads, plus `detour_slack` (default 3): a conductive trace's resistance grows with its
     /// length, so a wire that needs a longer route is reported unrouted, and the search stops
     /// there instead of exploring the whole object.
     pub max_detour: f64,
-    /// Cost added to the detour limit, in mm-equivalents (default 40: room for several layer
-    /// changes and a way round a part even on the shortest wires).
+    /// Cost added to the detour limit, in mm-equivalents (default 30: room for layer changes and
+    /// a way round a part even on the shortest wires).
     pub detour_slack: f64,
     /// Safety cap on A* expansions per wire; a wire that needs more is reported unrouted
     /// (default 2 000 000).
@@ -166,10 +166,10 @@ impl Default for RouteParams {
             grid_step: 1.0,
             interlayer_overlap: 2.0,
             layer_change_penalty: 5.0,
-            layer_span: 3,
+            layer_span: 2,
             rip_up_rounds: 3,
-            max_detour: 4.0,
-            detour_slack: 40.0,
+            max_detour: 3.0,
+            detour_slack: 30.0,
             max_expansions: 2_000_000,
             align_tolerance: 0.05,
         }
