@@ -33,25 +33,11 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
         write_atomically(report, |f| f.write_all(&json))
             .with_context(|| format!("{}: cannot write report", report.display()))?;
     }
-    let r = &view.report;
-    eprintln!(
-        "{}: {} layers drawn; {} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
+    let lead = format!(
+        "{}: {} layers drawn; ",
         args.out_dir.display(),
-        view.layers.len(),
-        r.parts.len(),
-        r.routed,
-        r.routed + r.unrouted,
-        r.total_length,
-        r.total_lower_bound
+        view.layers.len()
     );
-    for w in &r.warnings {
-        eprintln!("warning: {w}");
-    }
-    for w in r.wires.iter().filter(|w| !w.routed) {
-        eprintln!(
-            "warning: net {} could not be routed ({} to {})",
-            w.net, w.from, w.to
-        );
-    }
+    super::slice::print_routing(&view.report, &lead);
     Ok(())
 }

@@ -58,25 +58,31 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         summary.gcode.estimated_time_s / 60.0
     );
     if let Some(r) = &summary.electronics {
-        eprintln!(
-            "{} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
-            r.parts.len(),
-            r.routed,
-            r.routed + r.unrouted,
-            r.total_length,
-            r.total_lower_bound
-        );
-        for w in &r.warnings {
-            eprintln!("warning: {w}");
-        }
-        for w in r.wires.iter().filter(|w| !w.routed) {
-            eprintln!(
-                "warning: net {} could not be routed ({} to {})",
-                w.net, w.from, w.to
-            );
-        }
+        print_routing(r, "");
     }
     Ok(())
+}
+
+/// The routing summary line (after `lead`), the report's warnings and one line per wire that
+/// could not be routed, on stderr.
+pub(crate) fn print_routing(r: &conduit::pipeline::ElectronicsReport, lead: &str) {
+    eprintln!(
+        "{lead}{} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
+        r.parts.len(),
+        r.routed,
+        r.routed + r.unrouted,
+        r.total_length,
+        r.total_lower_bound
+    );
+    for w in &r.warnings {
+        eprintln!("warning: {w}");
+    }
+    for w in r.wires.iter().filter(|w| !w.routed) {
+        eprintln!(
+            "warning: net {} could not be routed ({} to {})",
+            w.net, w.from, w.to
+        );
+    }
 }
 
 /// One scene of every object of `models`, in order; reader warnings go to stderr.

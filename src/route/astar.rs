@@ -97,6 +97,43 @@ pub(crate) fn layer_range(
     Some(a.min(b).saturating_sub(span)..=(a.max(b) + span).min(layers.len() - 1))
 }
 
+/// Smallest cost per mm of any edge.
+pub(crate) fn min_weight(params: &RouteParams) -> f64 {
+    params
+        .perimeter_weights
+        .iter()
+        .chain([&params.base_weight, &params.outside_weight])
+        .copied()
+        .fold(f64::INFINITY, f64::min)
+        .max(0.0)
+}
+
+/// Least cost of one layer change: its penalty and the overlap printed twice.
+pub(crate) fn change_cost(params: &RouteParams) -> f64 {
+    (params.layer_change_penalty + params.interlayer_overlap * params.base_weight).max(0.0)
+}
+
+/// The cost above which the search of a wire gives up, for pads `distance` mm apart (3D) and
+/// `layer_changes` layers apart: `max_detour` times the least cost the heuristic promises, in
+/// base-weight mm, plus `detour_slack`; a rip-up probe (`probe`) may also run through 5 mm of
+/// other traces. A route within the limit is at most `limit / min_weight` mm long.
+pub(crate) fn cost_limit(
+    params: &RouteParams,
+    distance: f64,
+    layer_changes: usize,
+    probe: bool,
+) -> f64 {
+    let least = min_weight(params);
+    let straight = distance.max(0.0)
+        + change_cost(params) * layer_changes as f64 / least.max(f64::MIN_POSITIVE);
+    let mut limit = params.max_detour.max(1.0) * straight * params.base_weight.max(least)
+        + params.detour_slack.max(0.0);
+    if probe {
+        limit += PENALTY_FACTOR * 5.0;
+    }
+    limit
+}
+
 /// The A* search of one wire's route, one expansion per [`Search::step`].
 #[derive(Debug, Clone)]
 pub struct Search {
@@ -152,13 +189,8 @@ impl Search {
             .iter()
             .map(|i| PreparedLayer::new(i, params))
             .collect();
-        let weights = params
-            .perimeter_weights
-            .iter()
-            .chain([&params.base_weight, &params.outside_weight]);
-        let min_weight = weights.copied().fold(f64::INFINITY, f64::min).max(0.0);
-        let change_cost =
-            (params.layer_change_penalty + params.interlayer_overlap * params.base_weight).max(0.0);
+        let min_weight = min_weight(params);
+        let change_cost = change_cost(params);
         let ends = match (layer_of(all, wire.from.z), layer_of(all, wire.to.z)) {
             (Some(from_layer), Some(to_layer)) if !layers.is_empty() => Some(Ends {
                 from: Point2::from_mm(wire.from.x, wire.from.y),
@@ -193,17 +225,13 @@ impl Search {
             cost_limit: f64::INFINITY,
         };
         if search.state == SearchState::Running {
-            // The limit is in cost, the detour in length: a route of length L costs at least
-            // L × the smallest weight.
-            let straight = search.heuristic(source) / search.min_weight.max(f64::MIN_POSITIVE);
-            search.cost_limit = params.max_detour.max(1.0)
-                * straight.max(0.0)
-                * params.base_weight.max(search.min_weight)
-                + params.detour_slack.max(0.0);
-            if search.layers.iter().any(|l| !l.penalty.is_empty()) {
-                // A rip-up probe may run through other traces: room for 5 mm of them.
-                search.cost_limit += PENALTY_FACTOR * 5.0;
-            }
+            let (a, b) = (search.graph.pos(source), search.graph.pos(target));
+            let (la, lb) = (search.graph.layer(source), search.graph.layer(target));
+            let dz = search.layer(la).z - search.layer(lb).z;
+            let dxy = unscaled(1) * dist(a, b);
+            let probe = search.layers.iter().any(|l| !l.penalty.is_empty());
+            search.cost_limit =
+                cost_limit(params, (dxy * dxy + dz * dz).sqrt(), la.abs_diff(lb), probe);
             search.grow();
             search.g[source as usize] = 0.0;
             let f = search.heuristic(source);

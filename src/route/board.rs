@@ -14,7 +14,7 @@
 //! it. A round that leaves fewer wires routed than before it is undone, and rounds stop at the
 //! first one that routes nothing more or after `rip_up_rounds`.
 
-use super::astar::{Search, SearchState, layer_range};
+use super::astar::{Search, SearchState, cost_limit, layer_range, min_weight};
 use super::graph::LayerInput;
 use super::{PadCopper, wire_order};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
@@ -267,36 +267,23 @@ impl<'a> Board<'a> {
     /// The routing window of `wire`: the box no route within the detour limit leaves. A route
     /// of length at most `L` between pads `d` apart lies in the ellipse with the pads as foci
     /// and `L` as major axis, whose box is the pads' box grown by `(L - d) / 2`. `L` is the
-    /// search's cost limit over the smallest weight per mm (see `astar.rs`).
+    /// search's [`cost_limit`] over the smallest weight per mm. (The search measures `d` between
+    /// the pads' vertices, which may sit up to `align_tolerance` away; the window's margin
+    /// covers that.)
     fn window(&self, wire: &Wire, traces: bool) -> Vec<ExPolygon> {
         let p = self.params;
         let d = ((wire.to.x - wire.from.x).powi(2)
             + (wire.to.y - wire.from.y).powi(2)
             + (wire.to.z - wire.from.z).powi(2))
         .sqrt();
-        let min_weight = p
-            .perimeter_weights
-            .iter()
-            .chain([&p.base_weight, &p.outside_weight])
-            .copied()
-            .fold(f64::INFINITY, f64::min)
-            .max(1e-9);
-        // The limit also counts the layer changes between the pads, as the heuristic does.
-        let layers = match (
+        let (Some(a), Some(b)) = (
             layer_of(self.layers, wire.from.z),
             layer_of(self.layers, wire.to.z),
-        ) {
-            (Some(a), Some(b)) => a.abs_diff(b) as f64,
-            _ => return Vec::new(),
+        ) else {
+            return Vec::new();
         };
-        let change = p.layer_change_penalty + p.interlayer_overlap * p.base_weight;
-        let mut limit = p.max_detour.max(1.0)
-            * (d + change * layers / min_weight)
-            * p.base_weight.max(min_weight)
-            + p.detour_slack.max(0.0);
-        if !traces {
-            limit += super::graph::PENALTY_FACTOR * 5.0;
-        }
+        let limit = cost_limit(p, d, a.abs_diff(b), !traces);
+        let min_weight = min_weight(p).max(1e-9);
         let grow = ((limit / min_weight - d) / 2.0).max(0.0) + WINDOW_MARGIN_MM;
         if !grow.is_finite() {
             return Vec::new();
