@@ -411,10 +411,10 @@ fn openlog_accounts_for_every_wire_and_routes_most() {
     let e = board.slice(&openlog_config());
     let failed = board.check_accounted(&e);
     println!("OpenLog: unrouted nets {failed:?}");
-    // A regression guard until every net routes (the ignored test below): at least 70 %.
+    // A regression guard until every net routes (the ignored test below): at least 80 %.
     let routed = e["routed"].as_u64().expect("routed") as usize;
     assert!(
-        10 * routed >= 7 * board.expected,
+        10 * routed >= 8 * board.expected,
         "{routed} of {}",
         board.expected
     );
@@ -423,7 +423,7 @@ fn openlog_accounts_for_every_wire_and_routes_most() {
 }
 
 #[test]
-#[ignore = "bug: 10 of OpenLog's 46 wires (nets 3.3V, CS, GND, MISO, MOSI, N$1, N$2, RXI, TXO, all at the TQFP U1 or the microSD socket U3) are not routed: sequential routing with rip-up and reroute walls in pads around U1; a negotiated-congestion router is the next step"]
+#[ignore = "bug: 7 of OpenLog's 46 wires (nets CS, GND, MOSI, N$2, N$4, RXI, TXO, at the TQFP U1 and the microSD socket U3) are not routed: sequential routing with rip-up and reroute leaves no way out of U1's pad rows for them; history-cost passes gave 40-42 of 46, not 46"]
 fn openlog_routes_completely() {
     let Some(board) = Board::load("OpenLog") else {
         return;

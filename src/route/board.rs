@@ -2,8 +2,8 @@
 //!
 //! Place in the pipeline: the driver of [`route`](super::route). It routes the wires one after
 //! another (order from `order.rs`), each as an A* search (`astar.rs`) on layers from which the
-//! channels of other nets' wires (on the layer and the two next to it) and the copper of other
-//! nets' pads are removed.
+//! channels of other nets' wires and the copper of other nets' pads (each on its layer and the
+//! two next to it) are removed.
 //!
 //! Sequential routing fails when an early wire walls off a later one, for example by passing
 //! round a connector whose pins still have to be reached. A failed wire then gets a **rip-up
@@ -330,8 +330,13 @@ impl<'a> Board<'a> {
                 penalty.extend(p.keep_out.iter().cloned());
             }
         }
+        // A pad is an obstacle on the layers just below and above its own too: its net's trace
+        // leaves it on the pad's layer, and another net's trace under or over that start would
+        // touch it (as between any two traces of adjacent layers) and wall the pad in.
         for pad in self.pads.iter().filter(|p| {
-            p.layer == l && p.net != Some(wire.net.as_str()) && overlaps(&p.bbox, &frame)
+            p.layer.abs_diff(l) <= 1
+                && p.net != Some(wire.net.as_str())
+                && overlaps(&p.bbox, &frame)
         }) {
             holes.extend(pad.hole.iter().cloned());
             blocked.extend(pad.keep_out.iter().cloned());

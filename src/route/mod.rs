@@ -27,8 +27,9 @@
 //!    traces form around it) and a keep-out for their direct connections, on its own layer and
 //!    on the layers just above and below: a trace fills its channel to the layer's top, so traces
 //!    of adjacent layers would touch, and one route passes over another only with a layer of
-//!    plastic between them. Other nets' pads are holes and keep-outs on their layer. Wires that
-//!    fail get rounds of rip-up and reroute: the wires in their way are routed again after them.
+//!    plastic between them. Other nets' pads are holes and keep-outs on their layer and the two
+//!    next to it (where the start of their own trace would be touched). Wires that fail get
+//!    rounds of rip-up and reroute: the wires in their way are routed again after them.
 //!
 //! Units: millimetres in the public types, nanometre integers ([`Point2`]) inside.
 
@@ -261,9 +262,10 @@ pub fn min_trace_spacing(params: &RouteParams) -> f64 {
 
 /// Routes every wire through the layers, in the order of [`wire_order`], each wire avoiding the
 /// channels of the wires of other nets routed before it (on its layer and the adjacent ones)
-/// and the copper of other nets' pads and of unconnected pads (on the pad's layer). Wires that
-/// cannot be routed are reported with `routed = false`; routing goes on with the others, and
-/// failed wires get `rip_up_rounds` rounds of rip-up and reroute (see `board.rs`).
+/// and the copper of other nets' pads and of unconnected pads (on the pad's layer and the two
+/// next to it). Wires that cannot be routed are reported with `routed = false`; routing goes on
+/// with the others, and failed wires get `rip_up_rounds` rounds of rip-up and reroute (see
+/// `board.rs`).
 pub fn route(
     layers: &[RouteLayer],
     wires: &[Wire],

@@ -406,3 +406,40 @@ fn routes_longer_than_the_detour_limit_are_not_searched_for() {
     while full.step() == SearchState::Running {}
     assert!(search.expansions() < full.expansions());
 }
+
+#[test]
+fn other_nets_pads_are_kept_clear_on_the_layers_next_to_them() {
+    // A pad of net "p" sits on layer 3, right over the straight way of a wire of net "b" on
+    // layer 2: a trace under the pad would touch the start of the pad's own trace, so the route
+    // keeps the pad's clearance on layer 2 as it does on layer 3.
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 6);
+    let params = RouteParams::default();
+    let z = layers[2].z;
+    let w = wire("b", (5.0, 20.0, z), (35.0, 20.0, z));
+    let mut pads = end_pads(std::slice::from_ref(&w));
+    pads.push(PadCopper::round(
+        Some("p"),
+        Point3::new(20.0, 20.0, layers[3].z),
+        1.0,
+    ));
+    let result = route(&layers, std::slice::from_ref(&w), &pads, &params);
+    let r = &result.wires[0];
+    assert!(r.routed, "{r:?}");
+    let clear = 0.5 + params.channel_extra / 2.0 + params.channel_half_width();
+    let centre = Point3::new(20.0, 20.0, 0.0);
+    for (l, points) in r.segments.iter().filter(|(l, _)| (2..=4).contains(l)) {
+        let flat: Vec<Point3> = points.iter().map(|p| Point3::new(p.x, p.y, 0.0)).collect();
+        let d = distance_to_polyline(&centre, &flat);
+        assert!(d >= clear - 1e-3, "layer {l}: {d} mm from the pad");
+    }
+    // The pad's own net may run under it.
+    let own = wire("p", (5.0, 20.0, z), (35.0, 20.0, z));
+    let mut pads = end_pads(std::slice::from_ref(&own));
+    pads.push(PadCopper::round(
+        Some("p"),
+        Point3::new(20.0, 20.0, layers[3].z),
+        1.0,
+    ));
+    let r = &route(&layers, std::slice::from_ref(&own), &pads, &params).wires[0];
+    assert!(r.routed && (r.length - 30.0).abs() < 0.5, "{r:?}");
+}
