@@ -231,3 +231,45 @@ fn outputs_get_ordinary_file_permissions_and_keep_existing_ones() {
     assert!(run().status.success());
     assert_eq!(mode(&out), 0o640, "a replaced output keeps its permissions");
 }
+
+#[test]
+fn missing_config_circuit_and_placement_are_named_with_their_cause_once() {
+    let dir = temp_dir();
+    let out = dir.path().join("out.gcode");
+    let model = sample("l_bracket.obj");
+    let circuit = sample("circuit_demo/led_coin.sch");
+    let placement = sample("circuit_demo/placement.toml");
+    let missing = dir.path().join("missing");
+    let cases: [(&str, Vec<&std::ffi::OsStr>); 3] = [
+        ("missing/config.toml", vec!["-c".as_ref()]),
+        (
+            "missing/board.sch",
+            vec![
+                "--placement".as_ref(),
+                placement.as_os_str(),
+                "--circuit".as_ref(),
+            ],
+        ),
+        (
+            "missing/parts.toml",
+            vec![
+                "--circuit".as_ref(),
+                circuit.as_os_str(),
+                "--placement".as_ref(),
+            ],
+        ),
+    ];
+    for (name, flags) in cases {
+        let path = missing.join(name.trim_start_matches("missing/"));
+        let mut args: Vec<&std::ffi::OsStr> = vec!["slice".as_ref(), model.as_os_str()];
+        args.extend(flags);
+        args.extend([path.as_os_str(), "-o".as_ref(), out.as_os_str()]);
+        let o = conduit(args);
+        assert_eq!(o.status.code(), Some(1), "{name}");
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+        assert!(err.contains(&*path.to_string_lossy()), "{name}: {err}");
+        assert_eq!(err.matches("os error").count(), 1, "{name}: {err}");
+        assert!(!out.exists());
+    }
+}

@@ -215,25 +215,26 @@ pub struct Circuit {
 /// # How to fix
 /// Pass an EAGLE 6+ XML schematic (`.sch`) or board (`.brd`); re-save older binary files in
 /// EAGLE. The wrapped [`conduit_eagle::EagleError`] says what is wrong inside the file.
+///
+/// A variant that wraps another error shows it in its own message rather than chaining it as
+/// a source, so an error printed with its chain names the cause once.
 #[derive(Debug, thiserror::Error)]
 pub enum CircuitError {
     /// The file could not be read.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The I/O error.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file is not a readable EAGLE schematic or board.
-    #[error("{path}: {source}")]
+    #[error("{path}: EAGLE: {error}")]
     Eagle {
         /// The file.
         path: PathBuf,
         /// What the EAGLE reader found.
-        #[source]
-        source: Box<conduit_eagle::EagleError>,
+        error: Box<conduit_eagle::EagleError>,
     },
     /// The file is an EAGLE library, which holds no circuit.
     #[error("{path}: an EAGLE library (.lbr) holds no circuit; pass a schematic or a board")]
@@ -292,9 +293,9 @@ impl Circuit {
     /// # Errors
     /// [`CircuitError`] naming the file.
     pub fn load(path: &Path) -> Result<Self, CircuitError> {
-        let bytes = std::fs::read(path).map_err(|source| CircuitError::Io {
+        let bytes = std::fs::read(path).map_err(|error| CircuitError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         })?;
         match conduit_eagle::read(&bytes) {
             Ok(conduit_eagle::Document::Schematic(s)) => Ok(Self::from_schematic(&s)),
@@ -302,9 +303,9 @@ impl Circuit {
             Ok(conduit_eagle::Document::Library) => Err(CircuitError::Library {
                 path: path.to_path_buf(),
             }),
-            Err(source) => Err(CircuitError::Eagle {
+            Err(error) => Err(CircuitError::Eagle {
                 path: path.to_path_buf(),
-                source: Box::new(source),
+                error: Box::new(error),
             }),
         }
     }
@@ -544,8 +545,8 @@ pub(crate) mod tests {
                 continue;
             }
             let binary = |r: &Result<Circuit, CircuitError>| match r {
-                Err(CircuitError::Eagle { source, .. }) => {
-                    matches!(**source, conduit_eagle::EagleError::BinaryFormat)
+                Err(CircuitError::Eagle { error, .. }) => {
+                    matches!(**error, conduit_eagle::EagleError::BinaryFormat)
                 }
                 _ => false,
             };

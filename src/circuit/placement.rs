@@ -293,16 +293,18 @@ impl std::fmt::Display for Problem {
 /// File errors name the file and line; [`PlacementError::Invalid`] lists every part, net, pin
 /// and waypoint that does not match the circuit: fix the names in the placement file (part
 /// names as in the schematic, pins as `PART.PAD`).
+///
+/// A variant that wraps another error shows it in its own message rather than chaining it as
+/// a source, so an error printed with its chain names the cause once.
 #[derive(Debug, thiserror::Error)]
 pub enum PlacementError {
     /// The file could not be read.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The I/O error.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file name ends in neither `.toml` nor `.3de`.
     #[error("{path}: unknown placement format; expected a .toml or .3de file")]
@@ -327,13 +329,12 @@ pub enum PlacementError {
         message: String,
     },
     /// An error in the file `path`.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     WithPath {
         /// The file.
         path: PathBuf,
         /// The error.
-        #[source]
-        source: Box<PlacementError>,
+        error: Box<PlacementError>,
     },
     /// The placement does not match the circuit.
     #[error("{}", .0.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "))]
@@ -378,13 +379,13 @@ impl Placement {
                 });
             }
         };
-        let text = std::fs::read_to_string(path).map_err(|source| PlacementError::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| PlacementError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         })?;
         parse(&text).map_err(|e| PlacementError::WithPath {
             path: path.to_path_buf(),
-            source: Box::new(e),
+            error: Box::new(e),
         })
     }
 

@@ -10,7 +10,13 @@ use conduit::config::{self, Config};
 pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
     let (mut cfg, mut warnings) = match &src.config {
         Some(path) => {
-            config::load(path).with_context(|| format!("loading config {}", path.display()))?
+            // Every error of `load` names the file but a failed validation.
+            config::load(path).map_err(|e| match e {
+                config::ConfigError::Invalid { .. } => {
+                    anyhow::Error::new(e).context(path.display().to_string())
+                }
+                other => other.into(),
+            })?
         }
         None => (Config::default(), Vec::new()),
     };

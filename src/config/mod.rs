@@ -417,17 +417,20 @@ impl Default for Config {
 }
 
 /// Why a configuration could not be read or changed.
+///
+/// A variant that wraps another error shows it in its own message rather than chaining it as
+/// a source, so an error printed with its chain names the cause once.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     /// The file could not be read.
     ///
     /// How to fix: check the path and the file's permissions.
-    #[error("cannot read config {}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// The operating system's error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file's extension is neither `.toml` nor `.ini`.
     ///
@@ -528,9 +531,9 @@ pub fn load(path: &Path) -> Result<(Config, Vec<String>), ConfigError> {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     let text = || {
-        std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+        std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         })
     };
     match ext.as_deref() {

@@ -70,6 +70,9 @@ use estimate::format_duration;
 use writer::{Writer, used_tools};
 
 /// Why G-code could not be written.
+///
+/// A variant that wraps another error shows it in its own message rather than chaining it as
+/// a source, so an error printed with its chain names the cause once.
 #[derive(Debug, thiserror::Error)]
 pub enum EmitError {
     /// Writing the output failed.
@@ -94,12 +97,12 @@ pub enum EmitError {
     /// Filling a template failed for another reason.
     ///
     /// How to fix: see the wrapped error.
-    #[error("{template}: {source}")]
+    #[error("{template}: {error}")]
     Config {
         /// Which template.
         template: String,
         /// The config's error.
-        source: Box<ConfigError>,
+        error: Box<ConfigError>,
     },
     /// The program uses a tool the config does not define.
     ///

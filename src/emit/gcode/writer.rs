@@ -54,9 +54,9 @@ fn render(
             template: name.to_owned(),
             placeholder,
         }),
-        Err(source) => Err(EmitError::Config {
+        Err(error) => Err(EmitError::Config {
             template: name.to_owned(),
-            source: Box::new(source),
+            error: Box::new(error),
         }),
     }
 }
