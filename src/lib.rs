@@ -19,6 +19,8 @@
 //! - [`emit`]: G-code (Marlin, RepRapFirmware, Klipper) from a program.
 //! - [`check`]: replaying any G-code to find problems and measure it.
 //! - [`pipeline`]: the stages above as one walk, scene to G-code.
+//! - [`postprocess`]: slicer plugin mode — another slicer's G-code read into layers (z, widths,
+//!   extrusions, printed regions) to be edited in place.
 //!
 //! The `conduit` binary (`src/main.rs`, `src/cli/`) turns command lines into calls of these modules.
 
@@ -29,6 +31,7 @@ pub mod emit;
 pub mod geom;
 pub mod mesh;
 pub mod pipeline;
+pub mod postprocess;
 pub mod program;
 pub mod region;
 pub mod route;

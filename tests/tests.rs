@@ -7,6 +7,7 @@ mod cli;
 mod conformance;
 mod electronics;
 mod electronics_corpus;
+mod postprocess;
 mod preview;
 mod roundtrip;
 mod slice;

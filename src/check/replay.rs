@@ -156,6 +156,12 @@ impl Replay {
         self.tool
     }
 
+    /// Whether E values are read as relative now: after `M83`, or after `G91` where the flavour
+    /// makes E follow it (see the [module docs](super)).
+    pub fn e_is_relative(&self) -> bool {
+        self.e_relative()
+    }
+
     fn e_relative(&self) -> bool {
         match self.flavor {
             Flavor::Klipper => self.coord_relative || self.e_relative_flag,

@@ -31,6 +31,10 @@ pub enum Command {
     /// Place a circuit in models and route its nets, without G-code: a report and one SVG per
     /// layer (material, cavities, channels, traces).
     Route(RouteArgs),
+    /// Slicer plugin mode: read another slicer's G-code (PrusaSlicer, SuperSlicer, OrcaSlicer,
+    /// Cura, Slic3r...) with its settings (unless `-c` is given) and edit it in place; without a
+    /// circuit it only reports what it finds.
+    Postprocess(PostprocessArgs),
 }
 
 /// Where settings come from: a config file plus `--set` overrides.
@@ -92,6 +96,36 @@ pub struct RouteArgs {
     /// perimeter crossings; totals).
     #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
+}
+
+/// Arguments of `conduit postprocess`.
+#[derive(Debug, Args)]
+pub struct PostprocessArgs {
+    /// The host's G-code, edited in place (PrusaSlicer, SuperSlicer and OrcaSlicer pass the path
+    /// of a temporary copy). Binary G-code (.bgcode) is refused.
+    #[arg(value_name = "GCODE")]
+    pub file: PathBuf,
+    /// Settings (default: the host's own, from the `SLIC3R_*` environment of the call and the
+    /// settings written into the G-code).
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// Circuit to build into the print: an EAGLE schematic or board (.sch, .brd). Needs
+    /// `--placement`. Inserting a circuit is not available yet: the circuit and placement are
+    /// checked and the command fails, leaving the file unchanged.
+    #[arg(long, value_name = "X.sch|X.brd", requires = "placement")]
+    pub circuit: Option<PathBuf>,
+    /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.
+    #[arg(long, value_name = "P.toml|P.3de", requires = "circuit")]
+    pub placement: Option<PathBuf>,
+    /// Also write a JSON report (host, layers with z, height, lines, widths per feature, tools,
+    /// E mode, retraction; whether the file changed).
+    #[arg(long, value_name = "R.json")]
+    pub report: Option<PathBuf>,
+    /// Ask the host to give its output this file name: written to `GCODE.output_name`, which
+    /// PrusaSlicer, SuperSlicer and OrcaSlicer read after the script (a name without folder
+    /// stays in the output folder).
+    #[arg(long, value_name = "NAME")]
+    pub output_name: Option<String>,
 }
 
 /// Arguments of `conduit check`.

@@ -6,6 +6,7 @@ mod check;
 mod config;
 mod convert;
 mod info;
+mod postprocess;
 mod preview;
 mod progress;
 mod route;
@@ -54,6 +55,7 @@ pub fn run() -> ExitCode {
         args::Command::Config(a) => config::run(a),
         args::Command::Preview(a) => preview::run(a),
         args::Command::Route(a) => route::run(a),
+        args::Command::Postprocess(a) => postprocess::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

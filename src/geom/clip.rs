@@ -304,6 +304,75 @@ pub fn clip_polylines(lines: &[Polyline], region: &[ExPolygon]) -> Vec<Polyline>
     out
 }
 
+/// How [`stroke`] closes the two ends of each polyline.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Cap {
+    /// Cut flat at the end points.
+    Butt,
+    /// Extended by half the width past the end points, cut flat.
+    Square,
+    /// Half discs, approximated by chords that stray at most this far (mm) from the true arc,
+    /// as for [`Join::Round`].
+    Round(f64),
+}
+
+/// The area covered by the open `lines` drawn `width_mm` wide (the region a nozzle leaves when
+/// it extrudes a bead of that width along each line), united into non-overlapping ExPolygons in
+/// canonical order. Corners are built by `join` and the ends by `cap`; points repeated in a row
+/// are ignored, and lines with fewer than two distinct points or a width below 2 nm give nothing.
+///
+/// ```
+/// use conduit::geom::{Cap, Join, Point2, Polyline, stroke};
+/// let line = Polyline { points: vec![Point2::from_mm(0.0, 0.0), Point2::from_mm(10.0, 0.0)] };
+/// let band = stroke(&[line], 0.5, Join::Miter(2.0), Cap::Butt);
+/// assert_eq!(band.len(), 1);
+/// assert!((band[0].area_mm2() - 5.0).abs() < 1e-9);
+/// ```
+pub fn stroke(lines: &[Polyline], width_mm: f64, join: Join, cap: Cap) -> Vec<ExPolygon> {
+    use i_overlay::mesh::int::stroke::offset::IntStrokeOffset;
+    use i_overlay::mesh::int::style::{IntLineCap, IntStrokeStyle};
+
+    let width = scaled(width_mm);
+    if width < 2 {
+        return Vec::new();
+    }
+    let paths: Vec<IntContour<i64>> = lines
+        .iter()
+        .map(|line| {
+            let mut path: IntContour<i64> = Vec::with_capacity(line.points.len());
+            for p in &line.points {
+                if path.last() != Some(&to_int(*p)) {
+                    path.push(to_int(*p));
+                }
+            }
+            path
+        })
+        .filter(|path| path.len() >= 2)
+        .collect();
+    if paths.is_empty() {
+        return Vec::new();
+    }
+    let half = width / 2;
+    let int_cap = match cap {
+        Cap::Butt => IntLineCap::Butt,
+        Cap::Square => IntLineCap::Square,
+        Cap::Round(deviation_mm) => match int_join(Join::Round(deviation_mm), half) {
+            IntLineJoin::Round(options) => IntLineCap::Round(options),
+            _ => IntLineCap::Round(ArcOptions::default()),
+        },
+    };
+    let style = IntStrokeStyle::<i64>::new(width)
+        .line_join(int_join(join, half))
+        .start_cap(int_cap.clone())
+        .end_cap(int_cap);
+    match paths.as_slice().stroke(&style, false) {
+        Ok(shapes) => shapes_to_expolygons(shapes),
+        // As for `outline` in `offset`: only a coordinate-range check can fail, which nanometre
+        // coordinates never reach.
+        Err(_) => Vec::new(),
+    }
+}
+
 /// Arc-length position (in scaled units, as f64) of the point of `line` nearest to `p`.
 fn position_along(line: &[Point2], p: Point2) -> f64 {
     let mut best = (f64::INFINITY, 0.0);

@@ -12,7 +12,8 @@ mod tolerances;
 mod transform;
 
 pub use clip::{
-    FillRule, Join, clip_polylines, difference, intersection, offset, polygons_to_expolygons, union,
+    Cap, FillRule, Join, clip_polylines, difference, intersection, offset, polygons_to_expolygons,
+    stroke, union,
 };
 pub use point::{Coord, Point2, Point3, Vector3, scaled, unscaled};
 pub use polygon::{ExPolygon, Polygon, Polyline};

@@ -1,0 +1,110 @@
+//! `conduit postprocess`: the slicer plugin entry point. Reads the host's G-code and settings,
+//! rebuilds its layers, applies the edits a circuit asks for and writes the file back in place
+//! (a temporary file beside it, then a rename) — only when something changed, so a run without
+//! circuit leaves the file exactly as the host wrote it.
+
+use super::{Failure, args::ConfigSource, args::PostprocessArgs, config::resolve};
+use anyhow::Context;
+use conduit::circuit::{Circuit, Placement};
+use conduit::config::Config;
+use conduit::pipeline::Electronics;
+use conduit::postprocess::{
+    Edit, HostPrint, HostSettings, LayerParams, PostprocessReport, detect_host, edit,
+    output_name_file, read_gcode,
+};
+use conduit::scene::write_atomically;
+use std::io::Write;
+
+pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
+    let path = &args.file;
+    let bytes =
+        std::fs::read(path).with_context(|| format!("{}: cannot read file", path.display()))?;
+    let gcode = read_gcode(&bytes).with_context(|| path.display().to_string())?;
+    let host = detect_host(&gcode);
+    let settings = HostSettings::collect(&gcode, host.host, host_environment());
+    let config = settings_config(&args.config, &settings)?;
+    let electronics = load_electronics(&args)?;
+    let params = LayerParams::from_config(&config).for_host(host.host);
+    let print = HostPrint::read_with(&gcode, host, settings, &params);
+    let changed = match edit(&gcode, &print, electronics.as_ref(), &config)
+        .with_context(|| path.display().to_string())?
+    {
+        Edit::Unchanged => false,
+        Edit::Rewritten(edited) => {
+            write_atomically(path, |f| edited.write_to(f))
+                .with_context(|| format!("{}: cannot write G-code", path.display()))?;
+            true
+        }
+    };
+    if let Some(name) = &args.output_name {
+        let target = output_name_file(path);
+        write_atomically(&target, |f| writeln!(f, "{name}"))
+            .with_context(|| format!("{}: cannot write", target.display()))?;
+    }
+    let report = PostprocessReport::new(&print, changed);
+    if let Some(report_path) = &args.report {
+        let json = serde_json::to_vec_pretty(&report).context("serialising the report")?;
+        write_atomically(report_path, |f| f.write_all(&json))
+            .with_context(|| format!("{}: cannot write report", report_path.display()))?;
+    }
+    let outcome = if changed {
+        "rewritten"
+    } else {
+        "left unchanged"
+    };
+    eprintln!("{}: {report}; {outcome}", path.display());
+    Ok(())
+}
+
+/// The environment of the call as text; variables that are not UTF-8 are skipped (only the
+/// host's `SLIC3R_*` variables are used, and those are text).
+fn host_environment() -> Vec<(String, String)> {
+    std::env::vars_os()
+        .filter_map(|(k, v)| Some((k.into_string().ok()?, v.into_string().ok()?)))
+        .collect()
+}
+
+/// The config of the run: the `-c` file when given, otherwise the host's settings; then the
+/// `--set` overrides. The host's settings serve the user rather than configure conduit, so
+/// their mapping notes (settings conduit has no use for) are not shown, their validation
+/// warnings only when `--set` changed something, and settings that do not make a valid config fall back to
+/// conduit's defaults with a warning.
+fn settings_config(src: &ConfigSource, settings: &HostSettings) -> Result<Config, Failure> {
+    if src.config.is_some() {
+        return resolve(src);
+    }
+    let from_host = settings
+        .to_config()
+        .and_then(|(cfg, _notes)| cfg.validate().map(|_| cfg));
+    let mut cfg = match from_host {
+        Ok(cfg) => cfg,
+        Err(e) => {
+            eprintln!("warning: the host's settings: {e}; using conduit's defaults");
+            Config::default()
+        }
+    };
+    for kv in &src.set {
+        cfg.apply_set(kv)
+            .map_err(|e| Failure::Usage(e.to_string()))?;
+    }
+    let warnings = cfg.validate().context("invalid configuration")?;
+    if !src.set.is_empty() {
+        for w in warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    Ok(cfg)
+}
+
+/// The circuit and placement, loaded and checked against each other, when both are given.
+fn load_electronics(args: &PostprocessArgs) -> Result<Option<Electronics>, Failure> {
+    let (Some(circuit_path), Some(placement_path)) = (&args.circuit, &args.placement) else {
+        return Ok(None);
+    };
+    let circuit = Circuit::load(circuit_path).map_err(anyhow::Error::from)?;
+    let placement = Placement::load(placement_path).map_err(anyhow::Error::from)?;
+    placement
+        .validate(&circuit)
+        .with_context(|| format!("{}", placement_path.display()))?;
+    Ok(Some(Electronics { circuit, placement }))
+}

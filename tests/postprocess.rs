@@ -1,0 +1,412 @@
+//! `conduit postprocess`, the slicer plugin mode: host files left byte for byte without a
+//! circuit, layers rebuilt from every host's comments (or Z heights), host settings from the
+//! environment, binary G-code and bad inputs refused with the file untouched, and the Cura
+//! script run against the binary.
+
+use crate::support::{conduit, corpus, root, sample, stderr, temp_dir};
+use conduit::postprocess::{
+    EMode, Host, HostPrint, LayerMethod, RegionParams, SettingSource, ZSource, printed_regions,
+};
+use conduit::program::Role;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Every host file the plugin mode is tested on: the peer slicers' 20 mm cubes and the G-code
+/// files of gcode-preview (PrusaSlicer 2.7, Slic3r PE, Cura 2.3, FullControl, Mach3).
+fn host_files(corpus: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    let mut folders = vec![corpus.join("peer-gcode"), corpus.join("gcode-preview")];
+    while let Some(dir) = folders.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                folders.push(path);
+            } else if path.extension().is_some_and(|e| e == "gcode") {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+/// Runs `conduit postprocess` with `args` and the extra environment `env`.
+fn postprocess(args: &[&std::ffi::OsStr], env: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_conduit"));
+    cmd.arg("postprocess").args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("the conduit binary runs")
+}
+
+/// Copies `src` into `dir` and returns the copy's path.
+fn copy_into(dir: &Path, src: &Path) -> PathBuf {
+    let name = src.file_name().expect("a file name");
+    let dst = dir.join(name);
+    std::fs::copy(src, &dst).expect("copy into the temp dir");
+    dst
+}
+
+#[test]
+fn without_circuit_every_host_file_is_left_byte_identical() {
+    let Some(corpus) = corpus() else { return };
+    let files = host_files(&corpus);
+    assert!(files.len() >= 10, "{files:?}");
+    let dir = temp_dir();
+    for src in &files {
+        let file = copy_into(dir.path(), src);
+        let before = std::fs::read(&file).expect("copy readable");
+        let modified = std::fs::metadata(&file).and_then(|m| m.modified()).ok();
+        let o = postprocess(&[file.as_os_str()], &[]);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}: {}",
+            src.display(),
+            stderr(&o)
+        );
+        assert!(stderr(&o).contains("left unchanged"), "{}", stderr(&o));
+        assert_eq!(
+            std::fs::read(&file).expect("still there"),
+            before,
+            "{}",
+            src.display()
+        );
+        // Not rewritten at all: the host's file keeps its timestamp.
+        let after = std::fs::metadata(&file).and_then(|m| m.modified()).ok();
+        assert_eq!(modified, after, "{}", src.display());
+    }
+}
+
+#[test]
+fn peer_cubes_have_100_layers_every_0_2_mm() {
+    let Some(corpus) = corpus() else { return };
+    for (name, host, method_is_comments) in [
+        ("20mm_cube.prusaslicer-2.5.gcode", Host::PrusaSlicer, true),
+        (
+            "20mm_cube.prusaslicer-2.5-arachne.gcode",
+            Host::PrusaSlicer,
+            true,
+        ),
+        ("20mm_cube.curaengine-4.13.gcode", Host::Cura, true),
+        ("20mm_cube.slic3r-1.3.gcode", Host::Slic3r, false),
+        (
+            "20mm_cube.slic3r-1.3-gcode_comments.gcode",
+            Host::Slic3r,
+            true,
+        ),
+    ] {
+        let bytes = std::fs::read(corpus.join("peer-gcode").join(name)).expect("corpus file");
+        let g = conduit_gcode::parse(&bytes).expect("parses");
+        let (print, _config) = HostPrint::read(&g, Vec::new()).expect("settings read");
+        assert_eq!(print.host.host, host, "{name}");
+        assert_eq!(
+            matches!(print.layers.method, LayerMethod::Comments(_)),
+            method_is_comments,
+            "{name}"
+        );
+        let layers = &print.layers.layers;
+        assert_eq!(layers.len(), 100, "{name}");
+        for (k, layer) in layers.iter().enumerate() {
+            let z = 0.2 * (k + 1) as f64;
+            assert!(
+                (layer.z - z).abs() < 1e-6,
+                "{name} layer {k}: z {}",
+                layer.z
+            );
+            // PrusaSlicer writes `;HEIGHT:0.200001` on some layers.
+            assert!(
+                (layer.height - 0.2).abs() < 1e-5,
+                "{name} layer {k}: {}",
+                layer.height
+            );
+            assert!(!layer.paths.is_empty(), "{name} layer {k}");
+            assert_eq!(layer.tools, vec![0], "{name} layer {k}");
+            assert_eq!(layer.e_mode, EMode::Absolute, "{name}");
+            // The layer's lines hold its extrusions.
+            let (first, last) = (layer.first_extrusion_line, layer.last_extrusion_line);
+            assert!(
+                first.is_some_and(|f| layer.lines.contains(&f))
+                    && last.is_some_and(|l| layer.lines.contains(&l)),
+                "{name} layer {k}"
+            );
+        }
+        // Layers follow each other without gaps.
+        for pair in layers.windows(2) {
+            assert_eq!(pair[0].lines.end, pair[1].lines.start, "{name}");
+        }
+        assert_eq!(layers[99].lines.end, g.lines.len(), "{name}");
+        // The outside of a middle layer is the cube's 20 mm square (the external perimeter's
+        // outer edge), and every width is near the profile's 0.45 mm lines.
+        let middle = &layers[50];
+        let regions = printed_regions(&middle.paths, &RegionParams::default());
+        let outer: f64 = regions.iter().map(|r| r.contour.area_mm2().abs()).sum();
+        assert!((outer - 400.0).abs() < 4.0, "{name}: {outer}");
+        for w in &middle.widths {
+            assert!((w.width - 0.45).abs() < 0.03, "{name}: {w:?}");
+        }
+        if host == Host::Cura {
+            assert_eq!(print.layers.declared_layer_count, Some(100));
+            assert_eq!(middle.host_number, Some(50));
+            assert_eq!(middle.z_source, ZSource::Moves);
+        }
+        if name == "20mm_cube.prusaslicer-2.5.gcode" {
+            assert_eq!(middle.z_source, ZSource::Comment);
+            let external = middle.width_of(Role::ExternalPerimeter);
+            assert!(
+                external.is_some_and(|w| (w - 0.45).abs() < 1e-12),
+                "{external:?}"
+            );
+            assert_eq!(print.settings.layer_height(), Some(0.2));
+            assert_eq!(print.settings.perimeters(), Some(2));
+            assert_eq!(print.settings.count_from(SettingSource::Gcode), 264);
+        }
+    }
+}
+
+/// A small OrcaSlicer file with the Bambu comment set.
+const ORCA: &str = "\
+; HEADER_BLOCK_START
+; generated by OrcaSlicer 2.1.1 on 2026-01-01 at 10:00:00
+; total layer number: 2
+; HEADER_BLOCK_END
+; CONFIG_BLOCK_START
+; layer_height = 0.2
+; wall_loops = 3
+; CONFIG_BLOCK_END
+M83
+G28
+; CHANGE_LAYER
+; Z_HEIGHT: 0.2
+; LAYER_HEIGHT: 0.2
+G1 X10 Y10 Z0.2 F30000
+; FEATURE: Outer wall
+; LINE_WIDTH: 0.42
+G1 X20 Y10 E.5
+G1 X20 Y20 E.5
+; FEATURE: Sparse infill
+; LINE_WIDTH: 0.45
+G1 X10 Y20 E.5
+G1 E-.8 F1800
+; CHANGE_LAYER
+; Z_HEIGHT: 0.4
+; LAYER_HEIGHT: 0.2
+G1 Z0.4
+G1 E.8
+; FEATURE: Inner wall
+; LINE_WIDTH: 0.45
+G1 X10 Y10 E.5
+";
+
+#[test]
+fn orca_comment_set_and_slic3r_environment_through_the_command() {
+    let dir = temp_dir();
+    let file = dir.path().join("part.gcode.pp");
+    std::fs::write(&file, ORCA).expect("write");
+    let report = dir.path().join("report.json");
+    let o = postprocess(
+        &[
+            file.as_os_str(),
+            "--report".as_ref(),
+            report.as_os_str(),
+            "--output-name".as_ref(),
+            "part_with_circuit.gcode".as_ref(),
+        ],
+        &[
+            ("SLIC3R_LAYER_HEIGHT", "0.2"),
+            ("SLIC3R_NOZZLE_DIAMETER", "0.4"),
+            ("SLIC3R_PP_OUTPUT_NAME", "/home/user/part.gcode"),
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&file).expect("readable"), ORCA);
+    let line = stderr(&o);
+    assert!(
+        line.contains("OrcaSlicer 2.1.1, 2 layers (; CHANGE_LAYER)"),
+        "{line}"
+    );
+    assert!(line.contains("relative E, retraction 0.8 mm"), "{line}");
+    assert!(line.contains("(3 from the environment)"), "{line}");
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    assert_eq!(v["host"], "OrcaSlicer");
+    assert_eq!(v["layer_count"], 2);
+    assert_eq!(v["declared_layer_count"], 2);
+    assert_eq!(v["settings_from_environment"], 3);
+    assert_eq!(v["changed"], false);
+    let layer0 = &v["layers"][0];
+    assert_eq!(layer0["z"], 0.2);
+    assert_eq!(layer0["first_line"], 11);
+    assert_eq!(layer0["widths"][0]["feature"], "Outer wall");
+    assert_eq!(layer0["widths"][0]["role"], "External perimeter");
+    assert_eq!(layer0["widths"][0]["width"], 0.42);
+    assert_eq!(layer0["widths"][1]["role"], "Internal infill");
+    assert_eq!(v["layers"][1]["widths"][0]["role"], "Perimeter");
+    let name = std::fs::read_to_string(dir.path().join("part.gcode.pp.output_name"))
+        .expect("the output name file");
+    assert_eq!(name, "part_with_circuit.gcode\n");
+}
+
+#[test]
+fn cura_comment_set_from_a_small_file() {
+    let file = "\
+;FLAVOR:Marlin
+;Layer height: 0.2
+;Generated with Cura_SteamEngine 5.2.1
+M82 ;absolute extrusion mode
+G28
+G92 E0
+;LAYER_COUNT:2
+;LAYER:0
+;MESH:box.stl
+G0 F3600 X10 Y10 Z0.2
+;TYPE:WALL-OUTER
+G1 F1800 X20 Y10 E0.33258
+G1 X20 Y20 E0.66516
+;TYPE:FILL
+G1 X10 Y20 E0.99774
+;MESH:NONMESH
+G0 F600 X10 Y20 Z0.4
+;LAYER:1
+;TYPE:WALL-INNER
+;MESH:box.stl
+G1 F1800 X10 Y10 E1.33032
+;End of Gcode
+";
+    let g = conduit_gcode::parse(file.as_bytes()).expect("parses");
+    let (print, _) = HostPrint::read(&g, Vec::new()).expect("read");
+    assert_eq!(print.host.host, Host::Cura);
+    assert_eq!(print.settings.layer_height(), Some(0.2));
+    let layers = &print.layers.layers;
+    assert_eq!(layers.len(), 2);
+    assert_eq!(
+        (layers[0].z, layers[1].z, layers[1].height),
+        (0.2, 0.4, 0.2)
+    );
+    assert_eq!(layers[0].host_number, Some(0));
+    assert_eq!(layers[1].lines, 17..22);
+    let roles: Vec<Option<Role>> = layers
+        .iter()
+        .flat_map(|l| &l.paths)
+        .map(|p| p.role)
+        .collect();
+    assert_eq!(
+        roles,
+        vec![
+            Some(Role::ExternalPerimeter),
+            Some(Role::SparseInfill),
+            Some(Role::Perimeter)
+        ]
+    );
+    // E per 10 mm is 0.33258 mm of 1.75 mm filament: 0.4 × 0.2 mm in Cura's rectangle model.
+    for p in layers.iter().flat_map(|l| &l.paths) {
+        assert!((p.width - 0.4).abs() < 1e-4, "{}", p.width);
+    }
+}
+
+#[test]
+fn binary_gcode_is_refused_and_left_untouched() {
+    let dir = temp_dir();
+    let mut files = vec![dir.path().join("made.bgcode")];
+    std::fs::write(&files[0], b"GCDE\x01\x00\x00\x00\x01\x00binary blocks").expect("write");
+    if let Some(corpus) = corpus() {
+        let real = corpus.join("gcode-preview-chestnut/test-data/fixtures/bgcode/prim-cube.bgcode");
+        if real.is_file() {
+            files.push(copy_into(dir.path(), &real));
+        }
+    }
+    for file in files {
+        let before = std::fs::read(&file).expect("readable");
+        let o = postprocess(&[file.as_os_str()], &[]);
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        let message = stderr(&o);
+        assert!(message.contains(&file.display().to_string()), "{message}");
+        assert!(message.contains("binary G-code"), "{message}");
+        assert!(
+            message.contains("Printer Settings > General > Firmware > \"Supports binary G-code\""),
+            "{message}"
+        );
+        assert_eq!(std::fs::read(&file).expect("still there"), before);
+    }
+}
+
+#[test]
+fn bad_inputs_fail_naming_the_file_and_leave_it_untouched() {
+    let dir = temp_dir();
+    let file = dir.path().join("host.gcode");
+    std::fs::write(&file, ORCA).expect("write");
+    let missing = dir.path().join("nowhere.gcode");
+    let o = postprocess(&[missing.as_os_str()], &[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("nowhere.gcode"), "{}", stderr(&o));
+
+    let nul = dir.path().join("nul.gcode");
+    std::fs::write(&nul, b"G1 X1\nG1 \0X2\n").expect("write");
+    let o = postprocess(&[nul.as_os_str()], &[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("nul.gcode") && stderr(&o).contains("line 2"));
+
+    let no_circuit = dir.path().join("board.sch");
+    let o = postprocess(
+        &[
+            file.as_os_str(),
+            "--circuit".as_ref(),
+            no_circuit.as_os_str(),
+            "--placement".as_ref(),
+            sample("circuit_demo/placement.toml").as_os_str(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("board.sch"), "{}", stderr(&o));
+
+    // A valid circuit: checked, then refused (inserting is not available yet), file untouched.
+    let o = postprocess(
+        &[
+            file.as_os_str(),
+            "--circuit".as_ref(),
+            sample("circuit_demo/led_coin.sch").as_os_str(),
+            "--placement".as_ref(),
+            sample("circuit_demo/placement.toml").as_os_str(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("not available yet"), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"));
+    assert_eq!(std::fs::read_to_string(&file).expect("readable"), ORCA);
+
+    let o = conduit([
+        "postprocess".as_ref(),
+        file.as_os_str(),
+        "--circuit".as_ref(),
+        "x.sch".as_ref(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "--circuit needs --placement");
+}
+
+#[test]
+fn cura_script_runs_the_binary() {
+    let python = Command::new("python3").arg("--version").output();
+    if !python.is_ok_and(|o| o.status.success()) {
+        println!("skipped: python3 not found");
+        return;
+    }
+    let o = Command::new("python3")
+        .arg(root().join("plugins/cura/test_conduit_script.py"))
+        .env("CONDUIT_BIN", env!("CARGO_BIN_EXE_conduit"))
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .output()
+        .expect("python3 runs");
+    assert!(
+        o.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        stderr(&o)
+    );
+}
