@@ -20,7 +20,8 @@
 //!    `interlayer_overlap + grid_step` millimetres can be printed on the neighbour layer too; that
 //!    piece is printed on both layers (the staircase overlap), so the traces of consecutive layers
 //!    touch over at least `interlayer_overlap` mm.
-//! 3. **A\*** (`astar.rs`) per wire, steppable ([`Search::step`]), deterministic.
+//! 3. **A\*** (`astar.rs`) per wire, steppable ([`Search::step`]), deterministic; the path found
+//!    is pulled taut layer by layer (`smooth.rs`) before it becomes the trace (`trace.rs`).
 //! 4. **Collisions and order** (`order.rs`, `channels.rs`, `board.rs`): wires are routed one
 //!    after another, fewest rubberband collisions first, then shortest; each routed wire's
 //!    channel becomes a hole in the islands of the following wires of other nets (new perimeter
@@ -40,6 +41,7 @@ mod graph;
 mod index;
 mod interlayer;
 mod order;
+mod smooth;
 mod trace;
 
 #[cfg(test)]

@@ -6,6 +6,7 @@
 
 use super::graph::{Graph, PreparedLayer, VertexId};
 use super::index::{RegionIndex, lerp};
+use super::smooth::pull_taut;
 use super::{Wire, WireRoute};
 use crate::geom::{Point2, Point3, unscaled};
 
@@ -48,8 +49,17 @@ fn boundary_crossings(points: &[Point2], region: &RegionIndex, tol: i64) -> usiz
     sides.windows(2).filter(|s| s[0] != s[1]).count()
 }
 
+/// One visit of a layer by a route: the staircase piece it starts with (printed here too,
+/// already counted on the layer before) and its own points.
+struct Run {
+    layer: usize,
+    piece: Vec<Point2>,
+    own: Vec<Point2>,
+}
+
 /// The route of `wire` along `path` (vertices from source to target, each with the staircase
-/// piece of the layer change into it, if any); `tol` (scaled units) is the boundary tolerance.
+/// piece of the layer change into it, if any), each layer's run pulled taut (`smooth.rs`);
+/// `tol` (scaled units) is the boundary tolerance.
 pub(crate) fn assemble(
     wire: &Wire,
     layers: &[PreparedLayer],
@@ -60,41 +70,61 @@ pub(crate) fn assemble(
 ) -> WireRoute {
     let lo = layers.first().map_or(0, |l| l.index);
     let z_of = |l: usize| layers[l - lo].z;
-    let mut segments: Vec<(usize, Vec<Point2>)> = Vec::new();
-    let mut length = 0.0;
-    let mut layer_changes = 0;
-    let mut prev: Option<Point3> = Some(wire.from);
+    let mut runs: Vec<Run> = Vec::new();
     for &(v, piece) in path {
         let (l, p) = (graph.layer(v), graph.pos(v));
-        let here = at(p, z_of(l));
-        if let Some(q) = prev {
-            length += (here - q).norm();
+        match runs.last_mut() {
+            Some(run) if run.layer == l => {
+                if run.own.last() != Some(&p) {
+                    run.own.push(p);
+                }
+            }
+            _ => runs.push(Run {
+                layer: l,
+                piece: match (runs.is_empty(), piece) {
+                    (false, Some(k)) => overlaps[k as usize].clone(),
+                    _ => Vec::new(),
+                },
+                own: vec![p],
+            }),
         }
-        prev = Some(here);
-        match segments.last_mut() {
-            Some((sl, pts)) if *sl == l => {
+    }
+    // Pull each run taut, keeping its ends and the points the next layer's piece repeats.
+    for k in 0..runs.len() {
+        let keep: Vec<Point2> = runs.get(k + 1).map_or(Vec::new(), |r| r.piece.clone());
+        let run = &mut runs[k];
+        let last = run.own.len().saturating_sub(1);
+        let fixed: Vec<bool> = run
+            .own
+            .iter()
+            .enumerate()
+            .map(|(i, p)| i == 0 || i == last || keep.contains(p))
+            .collect();
+        run.own = pull_taut(&run.own, &fixed, &layers[run.layer - lo], tol);
+    }
+    let mut length = 0.0;
+    let mut prev = wire.from;
+    for run in &runs {
+        for &p in &run.own {
+            let here = at(p, z_of(run.layer));
+            length += (here - prev).norm();
+            prev = here;
+        }
+    }
+    length += (wire.to - prev).norm();
+    let layer_changes = runs.len().saturating_sub(1);
+    let segments: Vec<(usize, Vec<Point2>)> = runs
+        .into_iter()
+        .map(|run| {
+            let mut pts = run.piece;
+            for p in run.own {
                 if pts.last() != Some(&p) {
                     pts.push(p);
                 }
             }
-            _ => {
-                let mut pts: Vec<Point2> = Vec::new();
-                if !segments.is_empty() {
-                    layer_changes += 1;
-                    if let Some(k) = piece {
-                        pts.extend(overlaps[k as usize].iter().copied());
-                    }
-                }
-                if pts.last() != Some(&p) {
-                    pts.push(p);
-                }
-                segments.push((l, pts));
-            }
-        }
-    }
-    if let Some(q) = prev {
-        length += (wire.to - q).norm();
-    }
+            (run.layer, pts)
+        })
+        .collect();
     let perimeter_crossings = segments
         .iter()
         .map(|(l, pts)| boundary_crossings(pts, &layers[l - lo].material, tol))
