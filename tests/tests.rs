@@ -8,6 +8,7 @@ mod conformance;
 mod electronics;
 mod electronics_corpus;
 mod postprocess;
+mod postprocess_e2e;
 mod preview;
 mod roundtrip;
 mod slice;

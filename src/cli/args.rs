@@ -110,8 +110,10 @@ pub struct PostprocessArgs {
     #[command(flatten)]
     pub config: ConfigSource,
     /// Circuit to build into the print: an EAGLE schematic or board (.sch, .brd). Needs
-    /// `--placement`. Inserting a circuit is not available yet: the circuit and placement are
-    /// checked and the command fails, leaving the file unchanged.
+    /// `--placement`. Its parts get cavities cut from the host's extrusion, its wires are routed
+    /// in channels and printed on the conductive tool at layer ends, with part events; the
+    /// placement is in the host's bed coordinates (`origin = "model"`) or relative to the
+    /// printed object's centre (`origin = "bbox_center"`).
     #[arg(long, value_name = "X.sch|X.brd", requires = "placement")]
     pub circuit: Option<PathBuf>,
     /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.

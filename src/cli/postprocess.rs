@@ -8,8 +8,9 @@ use anyhow::Context;
 use conduit::circuit::{Circuit, Placement};
 use conduit::config::Config;
 use conduit::pipeline::Electronics;
+use conduit::postprocess::rewrite::SUMMARY_PREFIX;
 use conduit::postprocess::{
-    Edit, HostPrint, HostSettings, LayerParams, PostprocessReport, detect_host, edit,
+    Edit, HostPrint, HostSettings, LayerParams, PostprocessReport, detect_host, edit, edit_circuit,
     output_name_file, read_gcode,
 };
 use conduit::scene::write_atomically;
@@ -26,13 +27,24 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
     let electronics = load_electronics(&args)?;
     let params = LayerParams::from_config(&config).for_host(host.host);
     let print = HostPrint::read_with(&gcode, host, settings, &params);
-    let changed = match edit(&gcode, &print, electronics.as_ref(), &config)
-        .with_context(|| path.display().to_string())?
-    {
-        Edit::Unchanged => false,
-        Edit::Rewritten(edited) => {
-            write_atomically(path, |f| edited.write_to(f))
-                .with_context(|| format!("{}: cannot write G-code", path.display()))?;
+    let changed = match &electronics {
+        None => {
+            match edit(&gcode, &print, None, &config).with_context(|| path.display().to_string())? {
+                Edit::Unchanged => false,
+                Edit::Rewritten(edited) => {
+                    write_edited(path, &edited)?;
+                    true
+                }
+            }
+        }
+        Some(e) => {
+            let done = edit_circuit(&gcode, &print, e, &config)
+                .with_context(|| path.display().to_string())?;
+            write_edited(path, &done.gcode)?;
+            for line in &done.summary {
+                let text = line.strip_prefix(SUMMARY_PREFIX).unwrap_or(line);
+                eprintln!("{}:{text}", path.display());
+            }
             true
         }
     };
@@ -54,6 +66,12 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
     };
     eprintln!("{}: {report}; {outcome}", path.display());
     Ok(())
+}
+
+/// Writes the edited file in place of the host's (a temporary file beside it, then a rename).
+fn write_edited(path: &std::path::Path, edited: &conduit_gcode::Gcode) -> anyhow::Result<()> {
+    write_atomically(path, |f| edited.write_to(f))
+        .with_context(|| format!("{}: cannot write G-code", path.display()))
 }
 
 /// The environment of the call as text; variables that are not UTF-8 are skipped (only the

@@ -16,21 +16,33 @@
 //!    tools, retraction style, extrusions as polylines with role and width ([`comments`] reads the
 //!    structured comments, [`roles`] maps feature names to conduit's roles).
 //! 5. [`regions`]: the area printed in each layer ([`printed_regions`]).
-//! 6. [`edit`]: the changes a circuit asks for. Inserting a circuit is not available yet:
-//!    [`edit`] leaves a file without circuit unchanged and refuses one with a circuit
-//!    ([`PostprocessError::CircuitsNotYetSupported`]).
-//! 7. [`report`]: what was found and done, for `--report` and the one-line summary.
+//! 6. [`plan`]: with a circuit, the electronics stage of `conduit slice` run on the host's
+//!    layers ([`plan_circuit`]): the printed areas stand in for sliced islands, the circuit is
+//!    placed in bed coordinates, and cavities, channels, traces and part events come out per
+//!    host layer.
+//! 7. [`rewrite`] (with [`cut`]): the file edited for the plan — extrusion removed from
+//!    cavities and channels with E kept exact, traces and part events inserted at layer ends in
+//!    the host's own retraction style, a summary at the top; every other line untouched.
+//!    [`edit`] runs steps 6 and 7 ([`edit_circuit`] also returns what was done).
+//! 8. [`verify`]: an independent check of an edited file against the host's original (lines
+//!    kept in order, no plastic left in a cavity, traces on the conductive tool, parts placed
+//!    after their cavities are done, `conduit check` clean).
+//! 9. [`report`]: what was found and done, for `--report` and the one-line summary.
 //!
 //! The `conduit postprocess` command (`src/cli/postprocess.rs`) runs these steps and writes the
 //! file back only when something changed (a temporary file beside it, then a rename).
 
 pub mod comments;
+pub mod cut;
 pub mod host;
 pub mod layers;
+pub mod plan;
 pub mod regions;
 pub mod report;
+pub mod rewrite;
 pub mod roles;
 pub mod settings;
+pub mod verify;
 
 pub use comments::{HostComment, LayerMarker, read_comment};
 pub use host::{Host, HostInfo, detect_host};
@@ -38,17 +50,22 @@ pub use layers::{
     EMode, ExtrusionPath, HostLayer, HostLayers, LayerMethod, LayerParams, PathMove,
     RetractionStyle, RoleWidth, WidthSource, Z_TOLERANCE, ZSource, read_layers,
 };
+pub use plan::{CircuitPlan, LayerPlan, host_islands, plan_circuit};
 pub use regions::{RegionParams, printed_regions};
 pub use report::PostprocessReport;
+pub use rewrite::{RewriteStats, rewrite};
 pub use roles::role_of;
 pub use settings::{HostSettings, Setting, SettingSource};
+pub use verify::{VerifyReport, verify};
 
 use std::path::{Path, PathBuf};
 
 use conduit_gcode::{Gcode, GcodeError};
 
 use crate::config::{Config, ConfigError};
+use crate::emit::gcode::EmitError;
 use crate::pipeline::Electronics;
+use crate::pipeline::electronics::ElectronicsError;
 
 /// Why a host file cannot be post-processed.
 #[derive(Debug, thiserror::Error)]
@@ -67,23 +84,54 @@ pub enum PostprocessError {
     /// `-c`.
     #[error("the host's settings: {0}")]
     Settings(#[from] ConfigError),
-    /// A circuit was given, but inserting circuits into a host's G-code is not available in
-    /// this version.
+    /// The circuit does not fit the print: the placement names unknown parts or pins, a part
+    /// lies outside every layer, or the config has no conductive tool.
     ///
     /// # How to fix
-    /// Slice the model with `conduit slice --circuit ... --placement ...`, or run
-    /// `conduit postprocess` without a circuit (it then only reports what it finds).
+    /// The message names the problem; correct the placement, or pass a conduit config with
+    /// `-c` whose `route.conductive_tool` is one of its `[tools.N]`.
+    #[error("{0}")]
+    Electronics(#[from] ElectronicsError),
+    /// The file prints nothing conduit can place a circuit in.
+    ///
+    /// # How to fix
+    /// Post-process the G-code of a print with at least one layer of extrusion.
+    #[error("the file has no printed layers to place the circuit in")]
+    NothingPrinted,
+    /// A layer is not above the one before it, as when the host prints several objects one
+    /// after the other (sequential printing).
+    ///
+    /// # How to fix
+    /// Turn off sequential printing ("complete objects") in the host.
     #[error(
-        "inserting a circuit into another slicer's G-code is not available yet: the circuit and \
-         placement are valid ({parts} parts, {nets} nets), but the file was left unchanged; \
-         use `conduit slice --circuit ... --placement ...` meanwhile"
+        "layer {layer} is at z {z} mm, not above the layer before it (z {below} mm): \
+         sequential printing is not supported"
     )]
-    CircuitsNotYetSupported {
-        /// Parts in the circuit.
-        parts: usize,
-        /// Nets in the circuit.
-        nets: usize,
+    LayersNotAscending {
+        /// The layer's 0-based index.
+        layer: usize,
+        /// Its z, mm.
+        z: f64,
+        /// The z of the layer before it, mm.
+        below: f64,
     },
+    /// The machine is in a state conduit cannot write moves in at a place it must edit.
+    ///
+    /// # How to fix
+    /// Let the host write absolute coordinates in millimetres (`G90`, `G21`) while printing.
+    #[error("line {line}: cannot insert moves while the machine is in {what}")]
+    MachineState {
+        /// 1-based line number.
+        line: usize,
+        /// What is in force.
+        what: &'static str,
+    },
+    /// The inserted G-code could not be written (a tool the config lacks, a bad template).
+    ///
+    /// # How to fix
+    /// The message names the tool or template; correct the config given with `-c`.
+    #[error("{0}")]
+    Emit(#[from] EmitError),
 }
 
 /// Parses a host's G-code for post-processing. Any text is accepted (lines that are not G-code
@@ -153,26 +201,137 @@ pub enum Edit {
     Rewritten(Gcode),
 }
 
-/// Plans the edits of `gcode` (read as `print`) for `electronics`: none without a circuit.
+/// Plans the edits of `gcode` (read as `print`) for `electronics`, with the tools, routing and
+/// part-event settings of `config`: none without a circuit; with one, see [`edit_circuit`].
 ///
 /// # Errors
-/// [`PostprocessError::CircuitsNotYetSupported`] when a circuit is given: inserting cavities,
-/// channels and traces into a host's G-code is not available in this version.
+/// See [`edit_circuit`].
 pub fn edit(
     gcode: &Gcode,
     print: &HostPrint,
     electronics: Option<&Electronics>,
     config: &Config,
 ) -> Result<Edit, PostprocessError> {
-    // The file, its layers and the config are what inserting a circuit works from.
-    let _ = (gcode, print, config);
     match electronics {
         None => Ok(Edit::Unchanged),
-        Some(e) => Err(PostprocessError::CircuitsNotYetSupported {
-            parts: e.circuit.parts.len(),
-            nets: e.circuit.nets.len(),
-        }),
+        Some(e) => Ok(Edit::Rewritten(
+            edit_circuit(gcode, print, e, config)?.gcode,
+        )),
     }
+}
+
+/// A host file with a circuit built in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CircuitEdit {
+    /// The edited file.
+    pub gcode: Gcode,
+    /// The circuit on the host's layers.
+    pub plan: CircuitPlan,
+    /// What the rewrite changed.
+    pub stats: RewriteStats,
+    /// The summary lines written at the top of the file.
+    pub summary: Vec<String>,
+}
+
+/// Builds `electronics` into `gcode`: plans the circuit on the host's layers
+/// ([`plan_circuit`]) and rewrites the file for it ([`rewrite()`]). The result is the same for
+/// the same inputs, byte for byte.
+///
+/// # Errors
+/// [`PostprocessError::Electronics`] when the placement does not fit the circuit or the config
+/// has no conductive tool, [`PostprocessError::NothingPrinted`],
+/// [`PostprocessError::LayersNotAscending`] (sequential printing),
+/// [`PostprocessError::MachineState`] and [`PostprocessError::Emit`] (see [`rewrite()`]).
+pub fn edit_circuit(
+    gcode: &Gcode,
+    print: &HostPrint,
+    electronics: &Electronics,
+    config: &Config,
+) -> Result<CircuitEdit, PostprocessError> {
+    let plan = plan_circuit(print, electronics, config)?;
+    let mut summary = Vec::new();
+    let (gcode, stats) = rewrite(gcode, print, &plan, config, |stats| {
+        summary = summary_lines(&plan, stats, electronics, config);
+        summary.clone()
+    })?;
+    Ok(CircuitEdit {
+        gcode,
+        plan,
+        stats,
+        summary,
+    })
+}
+
+/// The summary block: one `; conduit postprocess: ...` line per item. No line holds ` = `, so
+/// hosts that read `; key = value` settings from comments do not take them for settings.
+fn summary_lines(
+    plan: &CircuitPlan,
+    stats: &RewriteStats,
+    e: &Electronics,
+    config: &Config,
+) -> Vec<String> {
+    use conduit_gcode::fmt_xyz;
+    use rewrite::SUMMARY_PREFIX as P;
+    let origin = match e.placement.origin {
+        crate::circuit::Origin::Model => "bed coordinates (origin model)".to_owned(),
+        crate::circuit::Origin::BboxCenter => format!(
+            "x, y from the object's centre ({}, {}), z from the bed (origin bbox_center)",
+            fmt_xyz((plan.bbox.min[0] + plan.bbox.max[0]) / 2.0),
+            fmt_xyz((plan.bbox.min[1] + plan.bbox.max[1]) / 2.0)
+        ),
+    };
+    let r = &plan.report;
+    let names = |parts: &mut dyn Iterator<Item = String>| parts.collect::<Vec<_>>().join(", ");
+    let mut lines = vec![
+        format!(
+            "{P} circuit of {} parts and {} nets, placed in {origin}",
+            e.circuit.parts.len(),
+            e.circuit.nets.len()
+        ),
+        format!(
+            "{P} {} cavities ({})",
+            plan.cavities.len(),
+            names(&mut plan.parts.iter().map(|p| {
+                format!(
+                    "{} z {}-{}",
+                    p.name,
+                    fmt_xyz(p.position.z),
+                    fmt_xyz(p.position.z + p.body_height)
+                )
+            }))
+        ),
+        format!(
+            "{P} {} traces ({} mm) on tool {}, {} of {} wires routed",
+            plan.trace_count(),
+            fmt_xyz(plan.trace_length()),
+            config.route.conductive_tool,
+            r.routed,
+            r.wires.len()
+        ),
+        format!(
+            "{P} {} part events ({})",
+            plan.event_count(),
+            names(&mut r.parts.iter().map(|p| format!(
+                "{} {} after z {}",
+                p.name,
+                p.method,
+                fmt_xyz(p.placed_after_z)
+            )))
+        ),
+        format!(
+            "{P} {} extrusion moves cut ({} mm of extrusion, {} mm of filament removed)",
+            stats.cut_moves,
+            fmt_xyz(stats.removed_length),
+            fmt_xyz(stats.removed_e)
+        ),
+    ];
+    for w in r.wires.iter().filter(|w| !w.routed) {
+        lines.push(format!("{P} wire {} {}-{} not routed", w.net, w.from, w.to));
+    }
+    for w in &r.warnings {
+        lines.push(format!("{P} warning: {}", w.replace(" = ", " ")));
+    }
+    lines
 }
 
 /// The file through which a post-processing script renames the host's output: `<path>.output_name`

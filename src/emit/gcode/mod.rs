@@ -45,6 +45,12 @@
 //! and Klipper, `G10 P S R`/`M116 P` on RepRapFirmware (which handles standby itself);
 //! firmware retraction is `G10`/`G11` on all three.
 //!
+//! # Blocks in another program
+//!
+//! [`write_block`] writes paths and events into another slicer's G-code (the slicer plugin
+//! mode): the writer takes over the machine state where the block goes ([`Resume`]) and leaves
+//! it as it found it — same tool (primed), position, E register and feed rate.
+//!
 //! Every number goes through [`conduit_gcode::fmt_xyz`], [`conduit_gcode::fmt_e`] and
 //! [`conduit_gcode::fmt_f`]; nothing depends on clocks, hashing or thread count, so the output is
 //! byte-identical across runs.
@@ -65,7 +71,8 @@ use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
 use serde::Serialize;
 
 use crate::config::{Config, ConfigError, ToolKind};
-use crate::program::Program;
+use crate::geom::Point3;
+use crate::program::{LayerItem, Program};
 use estimate::format_duration;
 use writer::{Writer, used_tools};
 
@@ -176,6 +183,55 @@ pub fn write_program<S: GcodeSink>(
         w.layer(layer)?;
     }
     w.finish(program)
+}
+
+/// The machine state at the place in another program's G-code where conduit writes a block
+/// (see [`write_block`]): what the other program expects to find again after it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Resume {
+    /// The active tool.
+    pub tool: usize,
+    /// The nozzle position, machine coordinates, mm.
+    pub position: Point3,
+    /// Whether E is relative (`M83`).
+    pub relative_e: bool,
+    /// The E register (absolute E mode), mm.
+    pub e: f64,
+    /// The feed rate in force, mm/s.
+    pub feed: f64,
+    /// The layer the block follows: its index (for first-layer temperatures and templates) and
+    /// its print height, mm (part events lift `pnp.lift` above it).
+    pub layer_index: usize,
+    /// See [`Resume::layer_index`].
+    pub layer_z: f64,
+}
+
+/// Writes `items` (paths and events, as in a [`crate::program::Layer`]) as a block to insert
+/// into another program's G-code where the machine is in state `at`, with the tool
+/// (temperatures, offsets, paste snippets), retraction and part-event settings of `cfg`.
+///
+/// The block leaves the machine as it found it: the tool at `at` is the primed tool `at.tool`
+/// (the writer retracts it before its first tool change or part event and un-retracts it at the
+/// end), and after the paths and events the block selects `at.tool` again (with the usual tool
+/// change: snippets, standby and wait), travels back to `at.position` (over the current layer
+/// when a part event lifted the nozzle), un-retracts, and restores the E register
+/// (`G92 E<at.e>`, absolute E) and the feed rate (`G1 F`) when they changed. `E` words follow
+/// `at.relative_e` whatever `cfg` says. Nothing is written for an empty `items`.
+///
+/// # Errors
+/// [`EmitError::UnknownTool`] when `at.tool` or a path's tool is not in `cfg`; template errors
+/// of the tool-change snippets.
+pub fn write_block<S: GcodeSink>(
+    items: &[LayerItem],
+    cfg: &Config,
+    at: &Resume,
+    sink: &mut S,
+) -> Result<(), EmitError> {
+    if items.is_empty() {
+        return Ok(());
+    }
+    let mut w = Writer::new(cfg, sink)?;
+    w.block(items, at)
 }
 
 /// Writes a complete G-code file for `program` to `w`: header, body ([`write_program`]) and

@@ -5,7 +5,7 @@ use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
 use super::estimate::move_time;
 use super::flavor::{Dialect, fan, set_bed, wait_bed};
 use super::sink::{GcodeSink, Motion, MotionKind};
-use super::{EmitError, GcodeStats, ToolStats};
+use super::{EmitError, GcodeStats, Resume, ToolStats};
 use crate::config::{Config, ConfigError, ToolKind};
 use crate::geom::Point3;
 use crate::program::{Event, Feed, Layer, LayerItem, Program, Toolpath};
@@ -469,6 +469,47 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         }
         self.type_name = None;
         self.width = None;
+        Ok(())
+    }
+
+    /// Writes `items` into another program's G-code at the machine state `at` (see
+    /// [`super::write_block`]): the writer takes over `at`'s tool, position, E and feed, writes
+    /// the paths and events, then selects `at.tool` again, travels back to `at.position`,
+    /// un-retracts, and restores the E register (absolute E) and the feed rate.
+    pub fn block(&mut self, items: &[LayerItem], at: &Resume) -> Result<(), EmitError> {
+        if at.tool >= self.tools.len() {
+            return Err(EmitError::UnknownTool {
+                tool: at.tool,
+                count: self.tools.len(),
+            });
+        }
+        self.tool = Some(at.tool);
+        self.pos = Some(at.position);
+        self.set_z(at.position.z);
+        self.e = at.e;
+        self.relative_e = at.relative_e;
+        self.feed = Some(fmt_f(at.feed * 60.0));
+        self.layer_index = at.layer_index;
+        self.layer_z = at.layer_z;
+        self.used = vec![at.tool];
+        // The other program has brought the tool to its temperature.
+        self.tools[at.tool].waited = true;
+        for item in items {
+            match item {
+                LayerItem::Path(p) => self.path(p)?,
+                LayerItem::Event(e) => self.event(e)?,
+            }
+        }
+        self.tool_change(at.tool)?;
+        self.travel_to(at.position);
+        self.unretract();
+        if !self.relative_e && fmt_e(self.e) != fmt_e(at.e) {
+            self.line(&format!("G92 E{}", fmt_e(at.e)));
+            self.e = at.e;
+        }
+        if let Some(f) = self.feed_word(at.feed) {
+            self.line(&format!("G1{f}"));
+        }
         Ok(())
     }
 
