@@ -734,3 +734,46 @@ fn circuit_is_built_into_an_orcaslicer_file() {
     assert_eq!(report.replaced_lines, prusa_report.replaced_lines);
     assert_eq!(report.blocks, prusa_report.blocks);
 }
+
+#[test]
+fn the_hosts_tool_change_gcode_switches_to_the_conductive_tool() {
+    let Some(corpus) = corpus() else { return };
+    let dir = temp_dir();
+    let file = copy_into(
+        dir.path(),
+        &corpus.join("peer-gcode/20mm_cube.prusaslicer-2.5.gcode"),
+    );
+    let (sch, toml) = (
+        sample("postprocess/cube_led.sch"),
+        sample("postprocess/cube_led.toml"),
+    );
+    // PrusaSlicer hands its settings to the script as SLIC3R_ variables; its tool-change G-code
+    // selects the tool itself.
+    let snippet = "G1 Z{layer_z} F600 ; lift\\nT[next_extruder] ; from [previous_extruder]";
+    let o = postprocess(
+        &[
+            file.as_os_str(),
+            "--circuit".as_ref(),
+            sch.as_os_str(),
+            "--placement".as_ref(),
+            toml.as_os_str(),
+        ],
+        &[("SLIC3R_TOOLCHANGE_GCODE", snippet)],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&file).expect("edited");
+    assert!(
+        text.contains("\nT1 ; from 0\n"),
+        "no host-style change to T1"
+    );
+    assert!(
+        text.contains("\nT0 ; from 1\n"),
+        "no host-style change back"
+    );
+    // (A bare `T0` still follows a part event: the active tool is selected again after a
+    // placement.)
+    let bare = text.lines().filter(|l| *l == "T1").count();
+    assert_eq!(bare, 0, "a second T line beside the host's");
+    let check = conduit(["check".as_ref(), file.as_os_str()]);
+    assert_eq!(check.status.code(), Some(0), "{}", stdout(&check));
+}

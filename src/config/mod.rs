@@ -109,7 +109,8 @@ pub struct Printer {
     /// G-code template written after the print: heaters and fan off, lift, home X/Y, motors off.
     pub end_gcode: String,
     /// G-code template written before every tool change (`{previous_tool}` and `{next_tool}`
-    /// are available). Default empty.
+    /// are available); when it has a `T{next_tool}` line, that line selects the tool and no
+    /// other `T` is written. PrusaSlicer's `toolchange_gcode` imports here. Default empty.
     pub before_tool_change_gcode: String,
     /// G-code template written after every tool change (`{previous_tool}` and `{next_tool}` are
     /// available). Default empty.

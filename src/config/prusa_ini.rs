@@ -399,6 +399,19 @@ fn convert(
             *field = g;
         }
     }
+    // PrusaSlicer's tool-change G-code runs before each tool change, as conduit's
+    // `before_tool_change_gcode` does; its extruder placeholders are conduit's tool ones.
+    if let Some(g) = p.gcode("toolchange_gcode") {
+        let g = tool_placeholders(&g);
+        if has_macros(&g) {
+            warnings.push(
+                "toolchange_gcode uses PrusaSlicer macros ({if …} or expressions) that conduit \
+                 cannot fill; edit printer.before_tool_change_gcode"
+                    .to_owned(),
+            );
+        }
+        pr.before_tool_change_gcode = g;
+    }
     for (key, field) in [
         ("bed_temperature", &mut pr.bed_temperature),
         (
@@ -633,6 +646,22 @@ fn parse_xy(s: &str) -> Option<[f64; 2]> {
 }
 
 /// True when a template has `{…}` that is not a plain `{key}` / `{key[N]}` placeholder.
+/// `g` with PrusaSlicer's extruder placeholders (`{next_extruder}`, `[next_extruder]`,
+/// `{previous_extruder}`, `[previous_extruder]`) written as conduit's `{next_tool}` and
+/// `{previous_tool}`.
+fn tool_placeholders(g: &str) -> String {
+    let mut out = g.to_owned();
+    for (prusa, conduit) in [
+        ("next_extruder", "{next_tool}"),
+        ("previous_extruder", "{previous_tool}"),
+    ] {
+        out = out
+            .replace(&format!("{{{prusa}}}"), conduit)
+            .replace(&format!("[{prusa}]"), conduit);
+    }
+    out
+}
+
 fn has_macros(g: &str) -> bool {
     g.split('{').skip(1).any(|part| {
         let inner = part.split('}').next().unwrap_or_default();
@@ -837,6 +866,26 @@ gcode_comments = 0
             "{err:?}"
         );
         assert!(from_ini_str("printer_technology = SLA").is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn toolchange_gcode_becomes_the_before_tool_change_snippet() -> Result<(), ConfigError> {
+        let (cfg, warnings) = from_ini_str(
+            "toolchange_gcode = G1 Z{layer_z} ; from [previous_extruder]\\nT{next_extruder}\n",
+        )?;
+        assert_eq!(
+            cfg.printer.before_tool_change_gcode,
+            "G1 Z{layer_z} ; from {previous_tool}\nT{next_tool}"
+        );
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let (_, warnings) = from_ini_str("toolchange_gcode = {if next_extruder==1}T1{endif}\n")?;
+        assert!(
+            warnings
+                .iter()
+                .any(|w| w.starts_with("toolchange_gcode uses")),
+            "{warnings:?}"
+        );
         Ok(())
     }
 }

@@ -29,7 +29,8 @@
 //!   ([`crate::program::extrusion`]). Paste tools: `paste_on_gcode`, moves without E,
 //!   `paste_off_gcode`.
 //! - Tool changes: retract, `before_tool_change_gcode` (`{previous_tool}`, `{next_tool}`), the
-//!   old tool to its standby temperature, `T<n>`, heat-and-wait for the new tool,
+//!   old tool to its standby temperature, `T<n>` (left out when the snippet selects the tool
+//!   itself, as PrusaSlicer does for `T{next_extruder}`), heat-and-wait for the new tool,
 //!   `after_tool_change_gcode`, `G92 E0` (absolute E). Coordinates of tool `n` are the program's
 //!   minus `tools.n.offset` (PrusaSlicer's `extruder_offset` convention). Flavour differences
 //!   are listed in [`flavor`](self#flavours).

@@ -289,6 +289,24 @@ fn two_tool_program() -> Program {
 }
 
 #[test]
+fn a_before_snippet_that_selects_the_tool_replaces_the_t_line() {
+    let mut cfg = two_tool_config();
+    cfg.printer.before_tool_change_gcode = "G1 Z5 ; lift\nT{next_tool} ; host style".to_owned();
+    let (text, _) = write(&two_tool_program(), &cfg);
+    let (lines, moves) = replay(&text);
+    // One T per change, the snippet's; the new tool still heats and waits before it prints.
+    let selects: Vec<&String> = lines.iter().filter(|l| l.starts_with('T')).collect();
+    assert_eq!(
+        selects,
+        ["T0", "T1 ; host style", "T0 ; host style"],
+        "{text}"
+    );
+    assert!(moves.iter().any(|m| m.tool == 1 && m.de > 0.0), "{text}");
+    let at = |s: &str| lines.iter().position(|l| l == s).unwrap_or(usize::MAX);
+    assert!(at("T1 ; host style") < at("M109 T1 S235"), "{text}");
+}
+
+#[test]
 fn two_tools_standby_wait_before_first_use_and_offsets() {
     let cfg = two_tool_config();
     let (text, stats) = write(&two_tool_program(), &cfg);

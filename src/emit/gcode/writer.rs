@@ -452,7 +452,15 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             // A tool that cooled to standby must be waited for again.
             t.waited = false;
         }
-        self.line(&format!("T{tool}"));
+        // A before snippet that selects the new tool itself (PrusaSlicer's convention for
+        // `T{next_extruder}` in its tool-change G-code) replaces conduit's own `T` line.
+        let selects = |l: &String| {
+            let code = l.split(';').next().unwrap_or_default().trim();
+            code.strip_prefix('T') == Some(tool.to_string().as_str())
+        };
+        if !before.iter().any(selects) {
+            self.line(&format!("T{tool}"));
+        }
         self.tool = Some(tool);
         self.wait_for_tool(tool);
         let after = render(
