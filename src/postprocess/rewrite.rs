@@ -10,8 +10,8 @@
 //!
 //! An extruding move of a layer with cuts is split at the cut boundary ([`split_move`]): pieces
 //! outside keep extruding, with the move's E scaled by their share of its length, pieces inside
-//! become travels (`G1 X Y`, no E). A travel longer than `printer.retract_before_travel` is
-//! wrapped in the host's own retraction (`G10`/`G11`, or `G1 E-<length> F<speed>` and back), so
+//! become travels (`G1 X Y`, no E; `G0` where the host writes its travels with `G0`). A travel
+//! longer than `printer.retract_before_travel` is wrapped in the host's own retraction (`G10`/`G11`, or `G1 E-<length> F<speed>` and back), so
 //! the nozzle does not ooze into the cavity. The first piece carries the move's `F`; a piece that
 //! follows a retraction sets the move's feed again. An arc (`G2`/`G3`) that is cut is written as
 //! the straight segments of its samples. The pieces keep the line's comment (Slic3r describes
@@ -282,6 +282,13 @@ pub fn rewrite(
     let mut out: Vec<Line> = Vec::with_capacity(gcode.lines.len() + cuts.len() * 4);
     let new_line = |text: String| Line::new(text, ending);
     let fallback_style = print.layers.retraction();
+    // Travels inside a cut are written as the host writes its travels: `G0` when it uses `G0`
+    // for moves (Cura), else `G1`.
+    let travel = if gcode.lines.iter().any(|l| l.is_command(b'G', 0)) {
+        "G0"
+    } else {
+        "G1"
+    };
     for (i, line) in gcode.lines.iter().enumerate() {
         let e_before = state.e;
         let mv = state.step(i, line);
@@ -302,6 +309,7 @@ pub fn rewrite(
                     feed_changed: line.get(b'F').is_some(),
                     style,
                     retract_before_travel: cfg.printer.retract_before_travel,
+                    travel,
                 };
                 let lines = pieces.write();
                 stats.cut_moves += 1;
@@ -354,6 +362,8 @@ struct Pieces<'a> {
     feed_changed: bool,
     style: Option<RetractionStyle>,
     retract_before_travel: f64,
+    /// The host's travel command (`G0` or `G1`).
+    travel: &'static str,
 }
 
 impl Pieces<'_> {
@@ -390,7 +400,8 @@ impl Pieces<'_> {
                 let step = (p[0] - prev[0]).hypot(p[1] - prev[1]);
                 prev = *p;
                 done += step;
-                let mut words = format!("G1 X{} Y{}", fmt_xyz(p[0]), fmt_xyz(p[1]));
+                let code = if piece.extrudes { "G1" } else { self.travel };
+                let mut words = format!("{code} X{} Y{}", fmt_xyz(p[0]), fmt_xyz(p[1]));
                 if z_changes {
                     let t = if cut.length > 0.0 {
                         done / cut.length
@@ -605,6 +616,19 @@ mod tests {
         );
         // The summary follows the leading comment lines; everything else is untouched.
         assert_eq!(body[..3], [";LAYER_CHANGE", ";Z:0.2", "; summary"]);
+    }
+
+    #[test]
+    fn a_host_that_travels_with_g0_gets_g0_travels_in_the_cut() {
+        let text = format!(
+            "{HEAD}M82\nG92 E0\n;TYPE:Internal infill\nG0 X0 Y5 F1200\nG1 X10 Y5 E1.5\nG1 X10 Y6 E1.6\n"
+        );
+        let lines = cut_file(&text, square(4.0, 6.0));
+        let body: Vec<&str> = lines.iter().map(|l| l.trim_end()).collect();
+        assert_eq!(
+            &body[9..12],
+            &["G1 X4 Y5 E0.6", "G0 X6 Y5", "G1 X10 Y5 E1.2"]
+        );
     }
 
     #[test]
