@@ -55,6 +55,10 @@ use crate::program::extrusion::{BeadShape, filament_area};
 /// Two extrusion heights closer than this are the same layer (without layer comments), mm.
 pub const Z_TOLERANCE: f64 = 0.000_5;
 
+/// Smallest and largest climb of a spiral's layer, mm (see `follow_z`).
+const SPIRAL_MIN_STEP: f64 = 0.05;
+const SPIRAL_MAX_STEP: f64 = 1.0;
+
 /// Feed rate of the replay before the file's first `F`, mm/s (Marlin's 1500 mm/min).
 const DEFAULT_FEEDRATE: f64 = 25.0;
 
@@ -718,7 +722,9 @@ impl Walk {
             return;
         }
         if !self.by_comments {
-            self.follow_z(index, mv.to[2]);
+            // An extrusion that climbs while it prints is a spiral (vase mode, FullControl).
+            let spiral = matches!((mv.from[2], mv.to[2]), (Some(a), Some(b)) if b > a);
+            self.follow_z(index, mv.to[2], spiral);
         }
         let e_relative = self.replay.e_is_relative();
         let feature = this_move_feature.or_else(|| self.feature.clone());
@@ -743,14 +749,27 @@ impl Walk {
         }
     }
 
-    /// Without layer comments: opens a new layer when an extrusion leaves the current one's Z.
-    fn follow_z(&mut self, index: usize, z: Option<f64>) {
+    /// Without layer comments: opens a new layer when an extrusion leaves the current one's Z;
+    /// on a `spiral`, one that climbs while it prints, only once it has climbed a layer's
+    /// thickness (taken as the first layer's Z, within 0.05..=1 mm), so a vase gives one layer
+    /// per turn rather than one per move.
+    fn follow_z(&mut self, index: usize, z: Option<f64>, spiral: bool) {
         let current_z = self
             .current
             .as_ref()
             .map(|c| c.first_extrusion.and_then(|(_, z)| z));
+        let first_z = self
+            .done
+            .first()
+            .or(self.current.as_ref())
+            .and_then(|l| l.first_extrusion)
+            .and_then(|(_, z)| z);
+        let step = first_z.map_or(SPIRAL_MIN_STEP, |z| {
+            z.clamp(SPIRAL_MIN_STEP, SPIRAL_MAX_STEP)
+        });
         let opens = match (current_z, z) {
             (None, _) => true,
+            (Some(Some(a)), Some(b)) if spiral => b - a >= step - Z_TOLERANCE,
             (Some(Some(a)), Some(b)) => (a - b).abs() > Z_TOLERANCE,
             (Some(None), Some(_)) => true,
             (Some(_), None) => false,
@@ -920,6 +939,29 @@ G1 F1800 X10 Y10 E1.6
         assert!((a.paths[0].width - expected).abs() < 1e-9);
         assert_eq!(a.paths[0].width_source, WidthSource::Flow);
         assert_eq!(a.lines, 8..20);
+    }
+
+    #[test]
+    fn a_spiral_gives_one_layer_per_turn() {
+        // A first layer at z 0.2, then three turns of a square spiral, each climbing 0.2 mm in
+        // four moves of 0.05 mm.
+        let mut file = String::from("G28\nM83\nG1 Z0.2 F600\nG1 X0 Y0\nG1 X10 Y0 E1\n");
+        let corners = [(10.0, 10.0), (0.0, 10.0), (0.0, 0.0), (10.0, 0.0)];
+        let mut z = 0.2;
+        for _ in 0..3 {
+            for (x, y) in corners {
+                z += 0.05;
+                file.push_str(&format!("G1 X{x} Y{y} Z{z:.2} E0.5\n"));
+            }
+        }
+        let l = layers_of(&file);
+        assert_eq!(l.method, LayerMethod::ZHeights);
+        let zs: Vec<f64> = l.layers.iter().map(|l| l.z).collect();
+        assert_eq!(zs.len(), 4, "{zs:?}");
+        // Each turn's layer starts where it has climbed 0.2 mm over the one before.
+        for pair in zs.windows(2) {
+            assert!((pair[1] - pair[0] - 0.2).abs() < 1e-9, "{zs:?}");
+        }
     }
 
     #[test]
