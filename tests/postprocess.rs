@@ -777,3 +777,51 @@ fn the_hosts_tool_change_gcode_switches_to_the_conductive_tool() {
     let check = conduit(["check".as_ref(), file.as_os_str()]);
     assert_eq!(check.status.code(), Some(0), "{}", stdout(&check));
 }
+
+#[test]
+fn the_report_holds_the_edit_and_the_routing() {
+    let Some(corpus) = corpus() else { return };
+    let dir = temp_dir();
+    let file = copy_into(
+        dir.path(),
+        &corpus.join("peer-gcode/20mm_cube.curaengine-4.13.gcode"),
+    );
+    let report = dir.path().join("report.json");
+    let o = postprocess(
+        &[
+            file.as_os_str(),
+            "--circuit".as_ref(),
+            sample("postprocess/cube_led.sch").as_os_str(),
+            "--placement".as_ref(),
+            sample("postprocess/cube_led.toml").as_os_str(),
+            "--report".as_ref(),
+            report.as_os_str(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    assert_eq!(v["changed"], true);
+    let cut = v["edit"]["cut_moves"].as_u64().expect("cut moves");
+    // The same count as the summary at the top of the file.
+    let text = std::fs::read_to_string(&file).expect("edited");
+    assert!(
+        text.contains(&format!("; conduit postprocess: {cut} extrusion moves cut")),
+        "{cut}"
+    );
+    assert_eq!(v["edit"]["blocks"], 4);
+    let e = &v["electronics"];
+    assert_eq!(
+        (e["routed"].as_u64(), e["unrouted"].as_u64()),
+        (Some(3), Some(0))
+    );
+    let total: f64 = e["wires"]
+        .as_array()
+        .expect("wires")
+        .iter()
+        .map(|w| w["length"].as_f64().expect("length"))
+        .sum();
+    assert!((total - e["total_length"].as_f64().expect("total")).abs() < 1e-9);
+    assert_eq!(e["parts"].as_array().map(Vec::len), Some(3));
+}

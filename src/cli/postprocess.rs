@@ -27,13 +27,13 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
     let electronics = load_electronics(&args)?;
     let params = LayerParams::from_config(&config).for_host(host.host);
     let print = HostPrint::read_with(&gcode, host, settings, &params);
-    let changed = match &electronics {
+    let (changed, done) = match &electronics {
         None => {
             match edit(&gcode, &print, None, &config).with_context(|| path.display().to_string())? {
-                Edit::Unchanged => false,
+                Edit::Unchanged => (false, None),
                 Edit::Rewritten(edited) => {
                     write_edited(path, &edited)?;
-                    true
+                    (true, None)
                 }
             }
         }
@@ -45,7 +45,7 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
                 let text = line.strip_prefix(SUMMARY_PREFIX).unwrap_or(line);
                 eprintln!("{}:{text}", path.display());
             }
-            true
+            (true, Some(done))
         }
     };
     if let Some(name) = &args.output_name {
@@ -53,7 +53,10 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
         write_atomically(&target, |f| writeln!(f, "{name}"))
             .with_context(|| format!("{}: cannot write", target.display()))?;
     }
-    let report = PostprocessReport::new(&print, changed);
+    let mut report = PostprocessReport::new(&print, changed);
+    if let Some(done) = &done {
+        report = report.with_circuit(done);
+    }
     if let Some(report_path) = &args.report {
         let json = serde_json::to_vec_pretty(&report).context("serialising the report")?;
         write_atomically(report_path, |f| f.write_all(&json))

@@ -8,9 +8,12 @@ use std::fmt;
 
 use serde::Serialize;
 
+use super::CircuitEdit;
 use super::layers::{EMode, HostLayer, LayerMethod, RetractionStyle, ZSource};
+use super::rewrite::RewriteStats;
 use super::settings::SettingSource;
 use super::{Host, HostPrint};
+use crate::pipeline::electronics::ElectronicsReport;
 
 /// The report of one post-processing run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -45,6 +48,13 @@ pub struct PostprocessReport {
     pub changed: bool,
     /// Per layer.
     pub layers: Vec<LayerReport>,
+    /// With a circuit: what was cut and inserted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub edit: Option<RewriteStats>,
+    /// With a circuit: its parts, wires (routed or not, lengths, layer changes) and warnings,
+    /// as `conduit slice --report` gives them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub electronics: Option<ElectronicsReport>,
 }
 
 /// One layer in a [`PostprocessReport`].
@@ -157,7 +167,16 @@ impl PostprocessReport {
             settings_from_gcode: print.settings.count_from(SettingSource::Gcode),
             changed,
             layers: layers.layers.iter().map(LayerReport::new).collect(),
+            edit: None,
+            electronics: None,
         }
+    }
+
+    /// This report with what building a circuit in changed (`done`).
+    pub fn with_circuit(mut self, done: &CircuitEdit) -> Self {
+        self.edit = Some(done.stats.clone());
+        self.electronics = Some(done.plan.report.clone());
+        self
     }
 }
 

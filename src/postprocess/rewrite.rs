@@ -71,7 +71,7 @@ pub const PARTS_MARK: &str = "; conduit: parts after layer ";
 pub const END_MARK: &str = "; conduit: end";
 
 /// What the rewrite changed.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct RewriteStats {
     /// Host extrusion moves split or removed.
     pub cut_moves: usize,
