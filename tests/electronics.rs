@@ -322,3 +322,67 @@ fn pad_drops_put_one_drop_on_every_pad() {
     );
     assert_eq!(drops.len(), 6 * 12, "{} drop moves", drops.len());
 }
+
+#[test]
+fn wires_between_two_objects_are_reported_with_a_warning_and_not_routed() {
+    // The demo with LED1 moved into a second block: N1 (R1 to LED1) and GND (LED1 to the
+    // coin cell) would have to leave their object, VCC stays in the first.
+    let dir = temp_dir();
+    let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
+    let second = dir.path().join("second.stl");
+    std::fs::copy(demo("block.stl"), &second).expect("second block");
+    let text = std::fs::read_to_string(demo("placement.toml")).expect("placement");
+    let moved = text.replace(
+        "name = \"LED1\"\nx = 32.0\ny = 22.0",
+        "name = \"LED1\"\nobject = 1\nx = 20.0\ny = 15.0",
+    );
+    assert_ne!(moved, text);
+    let placement = dir.path().join("two.toml");
+    std::fs::write(&placement, moved).expect("placement written");
+    let report = dir.path().join("route.json");
+    let o = conduit([
+        "route".as_ref(),
+        demo("block.stl").as_os_str(),
+        second.as_os_str(),
+        "--circuit".as_ref(),
+        demo("led_coin.sch").as_os_str(),
+        "--placement".as_ref(),
+        placement.as_os_str(),
+        "--out-dir".as_ref(),
+        dir.path().join("layers").as_os_str(),
+        "--report".as_ref(),
+        report.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let wires = v["wires"].as_array().expect("wires");
+    assert_eq!(wires.len(), 4);
+    for w in wires {
+        let crosses = [&w["from"], &w["to"]]
+            .iter()
+            .any(|p| p.as_str().is_some_and(|p| p.starts_with("LED1.")));
+        assert_eq!(w["routed"], Value::Bool(!crosses), "{w}");
+    }
+    assert_eq!(v["routed"], 2);
+    assert_eq!(v["unrouted"], 2);
+    let warnings: Vec<&str> = v["warnings"]
+        .as_array()
+        .expect("warnings")
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    for net in ["N1", "GND"] {
+        assert!(
+            warnings
+                .iter()
+                .any(|w| w.starts_with(&format!("net {net} joins")) && w.contains("object 1")),
+            "{warnings:?}"
+        );
+    }
+    assert!(
+        stderr(&o).contains("cannot leave its object"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -120,6 +120,9 @@ pub struct PlacedCircuit {
 pub struct CircuitWire {
     /// Scene object: the object of its first pin's part (object 0 for waypoint-only wires).
     pub object: usize,
+    /// The object of its second pin's part when that is another object: a trace is printed
+    /// inside one object, so such a wire is reported unrouted with a warning.
+    pub other_object: Option<usize>,
     /// The rubberband, bed coordinates.
     pub wire: Wire,
     /// The start pin as `PART.PAD`, or `waypoint`.
@@ -158,6 +161,7 @@ pub fn place_circuit(
             let object = object_of(&b.from_pin)
                 .or_else(|| object_of(&b.to_pin))
                 .unwrap_or(0);
+            let other_object = object_of(&b.to_pin).filter(|&o| o != object);
             let d = offset(object);
             let shift = |p: Point3| Point3::new(p.x + d[0], p.y + d[1], p.z + d[2]);
             let label = |pin: &Option<crate::circuit::PinRef>| {
@@ -166,6 +170,7 @@ pub fn place_circuit(
             };
             CircuitWire {
                 object,
+                other_object,
                 wire: Wire {
                     net: b.net.clone(),
                     from: shift(b.from),
@@ -274,11 +279,33 @@ pub fn object_stage(
         .collect();
     carve_cavities(islands, &spans, &cavities);
 
-    let mine_wires: Vec<&CircuitWire> = circuit
+    let (mine_wires, between): (Vec<&CircuitWire>, Vec<&CircuitWire>) = circuit
         .wires
         .iter()
         .filter(|w| w.object == object)
-        .collect();
+        .partition(|w| w.other_object.is_none());
+    // A wire between parts on two objects has no material to run in: reported, not routed.
+    for w in between {
+        report.warnings.push(format!(
+            "net {} joins {} on object {} and {} on object {}: a trace cannot leave its \
+             object, so this wire is not routed (join the objects, or wire it by hand)",
+            w.wire.net,
+            w.from,
+            object,
+            w.to,
+            w.other_object.unwrap_or(object)
+        ));
+        report.wires.push(NetRoute {
+            net: w.wire.net.clone(),
+            from: w.from.clone(),
+            to: w.to.clone(),
+            routed: false,
+            length: 0.0,
+            lower_bound: (w.wire.to - w.wire.from).norm(),
+            layer_changes: 0,
+            perimeter_crossings: 0,
+        });
+    }
     let wires: Vec<Wire> = mine_wires.iter().map(|w| w.wire.clone()).collect();
     if object == 0 {
         report
