@@ -234,8 +234,9 @@ impl Pairs {
     }
 }
 
-/// Undoes PrusaSlicer's `escape_string_cstyle`: `\n`, `\r`, `\t`, and `\x` → `x`.
-fn unescape(s: &str) -> String {
+/// Undoes PrusaSlicer's `escape_string_cstyle`: `\n`, `\r`, `\t`, and `\x` → `x`. Cura
+/// escapes the settings JSON it cuts into `;SETTING_3` comments the same way.
+pub(crate) fn unescape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     let mut chars = s.chars();
     while let Some(c) = chars.next() {

@@ -29,7 +29,7 @@ use conduit_gcode::Gcode;
 use serde::Serialize;
 
 use super::host::Host;
-use crate::config::prusa_ini::{from_prusa_pairs, pairs_from_gcode};
+use crate::config::prusa_ini::{from_prusa_pairs, pairs_from_gcode, unescape};
 use crate::config::{Config, ConfigError};
 
 /// Where a setting's value came from.
@@ -313,8 +313,7 @@ fn cura_pairs(gcode: &Gcode) -> Vec<(String, String)> {
             json.push_str(payload);
         }
     }
-    let Ok(serde_json::Value::Object(profiles)) = serde_json::from_str(&unescape_cura(&json))
-    else {
+    let Ok(serde_json::Value::Object(profiles)) = serde_json::from_str(&unescape(&json)) else {
         return pairs;
     };
     let texts = profiles.values().flat_map(|v| match v {
@@ -348,26 +347,6 @@ fn cura_pairs(gcode: &Gcode) -> Vec<(String, String)> {
         }
     }
     pairs
-}
-
-/// Undoes the escaping Cura applies to the JSON before cutting it into comments: `\\` was
-/// `\`, `\n` a newline and `\r` a carriage return.
-fn unescape_cura(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut chars = text.chars();
-    while let Some(c) = chars.next() {
-        if c != '\\' {
-            out.push(c);
-            continue;
-        }
-        match chars.next() {
-            Some('n') => out.push('\n'),
-            Some('r') => out.push('\r'),
-            Some(other) => out.push(other),
-            None => out.push('\\'),
-        }
-    }
-    out
 }
 
 #[cfg(test)]
