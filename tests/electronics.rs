@@ -141,7 +141,8 @@ fn demo_circuit_slices_with_cavities_traces_events_and_placement_files() {
     let r = replay(&text);
     // Traces: on tool 1, on the seating plane's layer (all parts sit at z = 4).
     let traces: Vec<&Extrusion> = r.extrusions.iter().filter(|x| x.tool == 1).collect();
-    assert!(traces.len() > 10, "{} trace moves", traces.len());
+    // At least one move per routed wire (straight runs are one move each).
+    assert!(traces.len() >= 4, "{} trace moves", traces.len());
     assert!(traces.iter().all(|t| t.role == "Conductive trace"));
     assert!(traces.iter().all(|t| (t.z - 4.0).abs() < 1e-9));
     // Plastic stays on tool 0.

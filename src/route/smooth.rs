@@ -12,10 +12,11 @@
 //! weights ask for, so a shortcut never trades the walls for length. Points that must stay
 //! where they are — the pads, the staircase overlap pieces shared with the neighbour layers, and
 //! points outside the innermost area (routes along the outer deflated traces, links into a pad
-//! row, crossings of a hole) — are never skipped.
+//! row, crossings of a hole) — are never skipped. Last, points that lie on the line between
+//! their neighbours (supersampled straight sections) are dropped, so a straight run is one move.
 
 use super::graph::PreparedLayer;
-use super::index::{RegionIndex, dist, lerp};
+use super::index::{RegionIndex, dist, lerp, point_segment_distance, project_param};
 use crate::geom::Point2;
 
 /// Farthest a shortcut looks ahead, in route points: bounds the work per point on long runs.
@@ -50,7 +51,8 @@ pub(crate) fn pull_taut(
         return points.to_vec();
     }
     let movable = |i: usize| !fixed[i] && layer.infill.inside_or_on(points[i], tol);
-    let mut out = vec![points[0]];
+    // Kept points with whether they are fixed.
+    let mut out: Vec<(Point2, bool)> = vec![(points[0], true)];
     let mut i = 0;
     while i + 1 < points.len() {
         // The farthest j reachable in a straight line, skipping only movable points.
@@ -62,12 +64,37 @@ pub(crate) fn pull_taut(
             }
             j += 1;
         }
-        if out.last().is_none_or(|&q| dist(q, points[next]) > 0.0) {
-            out.push(points[next]);
+        if out.last().is_none_or(|&(q, _)| dist(q, points[next]) > 0.0) {
+            out.push((points[next], fixed[next] || next + 1 == points.len()));
         }
         i = next;
     }
-    out
+    drop_collinear(out)
+}
+
+/// Points closer than this to the line through their neighbours are on it (scaled units: 1 µm,
+/// far below the printer's resolution).
+const COLLINEAR_NM: f64 = 1_000.0;
+
+/// `points` without the ones that are not fixed and lie on the line between their kept
+/// neighbours (supersampled straight sections, where no shortcut was needed), so each straight
+/// run of a trace is one G-code move.
+fn drop_collinear(points: Vec<(Point2, bool)>) -> Vec<Point2> {
+    let mut kept: Vec<(Point2, bool)> = Vec::with_capacity(points.len());
+    for (k, &(p, fixed)) in points.iter().enumerate() {
+        let on_line = !fixed
+            && kept.last().is_some_and(|&(prev, _)| {
+                points.get(k + 1).is_some_and(|&(next, _)| {
+                    point_segment_distance(p, prev, next) < COLLINEAR_NM
+                        && project_param(p, prev, next) > 0.0
+                        && project_param(p, prev, next) < 1.0
+                })
+            });
+        if !on_line {
+            kept.push((p, fixed));
+        }
+    }
+    kept.into_iter().map(|(p, _)| p).collect()
 }
 
 #[cfg(test)]
@@ -137,5 +164,22 @@ mod tests {
         ];
         let out = pull_taut(&edge, &[false; 3], &layer, 50_000);
         assert_eq!(out, edge);
+    }
+
+    #[test]
+    fn straight_runs_outside_the_infill_become_one_move() {
+        let layer = plate();
+        // Supersampled along the wall, 1 mm in: outside the innermost area, so no shortcut is
+        // tried, but the points between the ends lie on the line and add nothing.
+        let pts: Vec<Point2> = (0..=10)
+            .map(|k| Point2::from_mm(5.0 + 0.5 * k as f64, 1.0))
+            .collect();
+        let out = pull_taut(&pts, &[false; 11], &layer, 50_000);
+        assert_eq!(out, vec![pts[0], pts[10]]);
+        // A fixed point on the line stays.
+        let mut fixed = [false; 11];
+        fixed[4] = true;
+        let out = pull_taut(&pts, &fixed, &layer, 50_000);
+        assert_eq!(out, vec![pts[0], pts[4], pts[10]]);
     }
 }
