@@ -38,7 +38,14 @@ fn replay(text: &str) -> Replayed {
     };
     let (mut tool, mut role, mut layer_z) = (0usize, String::new(), 0.0f64);
     let (mut pos, mut e, mut relative_e) = ([0.0f64; 3], 0.0f64, false);
+    // The paste valve (the default paste_on/off snippets end in these comments).
+    let mut valve = false;
     for line in text.lines() {
+        if line.ends_with("; paste on") {
+            valve = true;
+        } else if line.ends_with("; paste off") {
+            valve = false;
+        }
         if let Some(r) = line.strip_prefix(";TYPE:") {
             role = r.to_owned();
         } else if let Some(z) = line.strip_prefix(";Z:") {
@@ -84,7 +91,7 @@ fn replay(text: &str) -> Replayed {
                 }
                 let moves_xy = to[0] != pos[0] || to[1] != pos[1];
                 // Paste tools carry no E: their moves with the valve open are the traces.
-                if moves_xy && (de > 0.0 || (tool == 1 && role.starts_with("Conductive"))) {
+                if moves_xy && (de > 0.0 || (tool == 1 && valve)) {
                     out.extrusions.push(Extrusion {
                         tool,
                         role: role.clone(),

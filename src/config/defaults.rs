@@ -235,6 +235,12 @@ const KEYS: &[KeyDoc] = &[
         "This tool's retraction, mm; absent = printer.retract_length.",
         "1.0",
     ),
+    opt(
+        "tools",
+        "travel_lift",
+        "Z lift of this tool's long travels, mm; absent = printer.retract_lift (paste tools: 0.5).",
+        "0.5",
+    ),
     k("slice", "layer_height", "Layer height, mm."),
     k(
         "slice",

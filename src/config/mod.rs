@@ -201,6 +201,12 @@ pub struct Tool {
     /// printer's. Default absent.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub retract_length: Option<f64>,
+    /// Z lift during this tool's travels longer than `printer.retract_before_travel`, mm,
+    /// overriding `printer.retract_lift`; absent = use the printer's. The paste tool's default
+    /// is 0.5: a dispensing nozzle dragged from one trace to the next at the layer's top would
+    /// smear the paste it just laid. Filament default absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub travel_lift: Option<f64>,
 }
 
 /// Pattern of solid (top and bottom) infill.
@@ -321,6 +327,9 @@ G28 X Y
 M84 ; motors off
 ";
 
+/// Z lift of the paste tool's travels by default, mm (see [`Tool::travel_lift`]).
+const PASTE_TRAVEL_LIFT_MM: f64 = 0.5;
+
 impl Tool {
     /// The default filament tool: PLA, 1.75 mm, 0.4 mm nozzle, 210 °C.
     pub fn filament() -> Self {
@@ -339,6 +348,7 @@ impl Tool {
             paste_off_gcode: String::new(),
             paste_flow_mm3_s: 0.0,
             retract_length: None,
+            travel_lift: None,
         }
     }
 
@@ -354,6 +364,7 @@ impl Tool {
             paste_on_gcode: "M42 P6 S255 ; paste on".to_owned(),
             paste_off_gcode: "M42 P6 S0 ; paste off".to_owned(),
             paste_flow_mm3_s: 0.5,
+            travel_lift: Some(PASTE_TRAVEL_LIFT_MM),
             ..Self::filament()
         }
     }
@@ -698,6 +709,15 @@ impl Config {
         self.slice.object_tools.get(object).copied().unwrap_or(0)
     }
 
+    /// The z lift of tool `tool`'s long travels, mm: its own `travel_lift` or the printer's
+    /// `retract_lift`.
+    pub fn travel_lift(&self, tool: usize) -> f64 {
+        self.tools
+            .get(tool)
+            .and_then(|t| t.travel_lift)
+            .unwrap_or(self.printer.retract_lift)
+    }
+
     /// The retraction length of tool `tool`, mm: its own override or the printer's.
     pub fn retract_length(&self, tool: usize) -> f64 {
         self.tools
@@ -805,6 +825,7 @@ struct ToolSpec {
     paste_off_gcode: Option<String>,
     paste_flow_mm3_s: Option<f64>,
     retract_length: Option<f64>,
+    travel_lift: Option<f64>,
 }
 
 impl<'de> Deserialize<'de> for Tool {
@@ -828,6 +849,7 @@ impl<'de> Deserialize<'de> for Tool {
             paste_off_gcode: s.paste_off_gcode.unwrap_or(d.paste_off_gcode),
             paste_flow_mm3_s: s.paste_flow_mm3_s.unwrap_or(d.paste_flow_mm3_s),
             retract_length: s.retract_length.or(d.retract_length),
+            travel_lift: s.travel_lift.or(d.travel_lift),
         })
     }
 }

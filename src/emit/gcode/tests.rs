@@ -449,6 +449,61 @@ fn paste_tool_is_switched_on_and_off_without_e() {
 }
 
 #[test]
+fn the_paste_tool_lifts_over_its_traces_on_long_travels() {
+    let mut cfg = test_config();
+    cfg.tools[1].offset = [0.0, 0.0];
+    let mut program = one_layer_program();
+    for x in [80.0, 100.0] {
+        program.layers[0].items.push(LayerItem::Path(square(
+            x,
+            10.0,
+            5.0,
+            0.2,
+            Role::ConductiveTrace,
+            1,
+        )));
+    }
+    let (text, _) = write(&program, &cfg);
+    let (lines, moves) = replay(&text);
+    let on = lines
+        .iter()
+        .position(|l| l == "M42 P6 S255 ; paste on")
+        .unwrap_or(usize::MAX);
+    // Every travel of the paste tool longer than retract_before_travel runs 0.5 mm (the paste
+    // tool's travel_lift) above the layer; its printing moves stay on it.
+    let lift = cfg.travel_lift(1);
+    assert_eq!(lift, 0.5);
+    // Whether the paste flows at each line.
+    let mut flowing = Vec::with_capacity(lines.len());
+    let mut state = false;
+    for l in &lines {
+        if l.contains("paste on") {
+            state = true;
+        } else if l.contains("paste off") {
+            state = false;
+        }
+        flowing.push(state);
+    }
+    let (mut printed, mut travels) = (0, 0);
+    for m in moves
+        .iter()
+        .filter(|m| m.tool == 1 && m.line > on && m.moves_xy())
+    {
+        if flowing[m.line] {
+            printed += 1;
+            assert!((m.to[2] - 0.2).abs() < 1e-9, "{}", lines[m.line]);
+        } else if m.xy_len() > cfg.printer.retract_before_travel {
+            travels += 1;
+            assert!((m.to[2] - (0.2 + lift)).abs() < 1e-9, "{}", lines[m.line]);
+        }
+    }
+    assert_eq!(printed, 8, "{text}");
+    assert!(travels >= 1, "{text}");
+    // Filament tools keep the printer's lift (none by default).
+    assert_eq!(cfg.travel_lift(0), cfg.printer.retract_lift);
+}
+
+#[test]
 fn relative_and_absolute_e_give_the_same_moves() {
     let program = two_tool_program();
     let mut cfg = two_tool_config();

@@ -370,7 +370,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         if long {
             self.retract();
         }
-        let lift = self.cfg.printer.retract_lift;
+        let lift = self
+            .tool
+            .map_or(self.cfg.printer.retract_lift, |t| self.cfg.travel_lift(t));
         let hop = long && lift > 0.0;
         if hop {
             self.move_z(cur.z + lift);
