@@ -14,6 +14,8 @@
 //!   a G-code listing) and writing meshes back out.
 //! - [`config`]: the one TOML configuration (printer, tools, slicing), PrusaSlicer `.ini` import.
 //! - [`slice`]: meshes cut into layers of polygons with holes.
+//! - [`curved`]: non-planar top surfaces — top solid layers of gentle top surfaces projected onto
+//!   the mesh, with head collision checks (`--curved tops`).
 //! - [`region`]: perimeters, top/bottom skins, infill patterns and skirt per layer.
 //! - [`program`]: toolpaths and events in print order — what every writer consumes.
 //! - [`emit`]: G-code (Marlin, RepRapFirmware, Klipper) from a program.
@@ -27,6 +29,7 @@
 pub mod check;
 pub mod circuit;
 pub mod config;
+pub mod curved;
 pub mod emit;
 pub mod geom;
 pub mod mesh;

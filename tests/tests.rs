@@ -5,6 +5,7 @@
 
 mod cli;
 mod conformance;
+mod curved;
 mod electronics;
 mod electronics_corpus;
 mod postprocess;

@@ -72,6 +72,11 @@ pub struct SliceArgs {
     /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.
     #[arg(long, value_name = "P.toml|P.3de", requires = "circuit")]
     pub placement: Option<PathBuf>,
+    /// Curved layers: `tops` prints the top solid layers of gently sloped top surfaces along
+    /// the surface (the `[curved]` settings apply); `off` keeps every layer planar. Overrides
+    /// `curved.mode`.
+    #[arg(long, value_name = "MODE", value_parser = ["tops", "off"])]
+    pub curved: Option<String>,
 }
 
 /// Arguments of `conduit route`.

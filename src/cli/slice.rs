@@ -10,7 +10,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{IsTerminal, Write};
 
 pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
-    let cfg = resolve(&args.config)?;
+    let mut cfg = resolve(&args.config)?;
+    match args.curved.as_deref() {
+        Some("tops") => cfg.curved.mode = conduit::config::CurvedMode::Tops,
+        Some(_) => cfg.curved.mode = conduit::config::CurvedMode::Off,
+        None => {}
+    }
     let scene = load_models(&args.models)?;
     let electronics = match (&args.circuit, &args.placement) {
         (Some(c), Some(p)) => Some(Electronics {
@@ -59,6 +64,24 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     );
     if let Some(r) = &summary.electronics {
         print_routing(r, "");
+    }
+    if let Some(c) = &summary.curved {
+        let slowed = if c.z_speed_limited > 0 {
+            format!(
+                ", {} moves slowed for curved.max_z_speed",
+                c.z_speed_limited
+            )
+        } else {
+            String::new()
+        };
+        eprintln!(
+            "curved tops: {} region(s) curved, {} kept planar{slowed}",
+            c.regions.len(),
+            c.rejections.len()
+        );
+        for r in &c.rejections {
+            eprintln!("warning: {r}");
+        }
     }
     Ok(())
 }

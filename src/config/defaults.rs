@@ -56,6 +56,10 @@ const SECTION_DOCS: &[(&str, &str)] = &[
         "pnp",
         "Part placement: what the machine does to place a part.",
     ),
+    (
+        "curved",
+        "Non-planar top surfaces: top solid layers of gentle top surfaces follow the surface.",
+    ),
 ];
 
 const KEYS: &[KeyDoc] = &[
@@ -508,6 +512,46 @@ const KEYS: &[KeyDoc] = &[
         "pnp",
         "lift",
         "How far the nozzle lifts above the layer before a part is placed, mm.",
+    ),
+    k(
+        "curved",
+        "mode",
+        "\"off\" or \"tops\" (curved top surfaces; also `conduit slice --curved tops`).",
+    ),
+    k(
+        "curved",
+        "max_angle",
+        "Steepest top-surface slope printed curved, degrees from the horizontal.",
+    ),
+    k(
+        "curved",
+        "step",
+        "Longest segment of a curved path, mm (paths also split at surface triangle edges).",
+    ),
+    k(
+        "curved",
+        "head_angle",
+        "Half-angle of the print head's cone around the nozzle, degrees from the vertical.",
+    ),
+    k(
+        "curved",
+        "head_height",
+        "Height of the head's cone above the nozzle tip, mm.",
+    ),
+    k(
+        "curved",
+        "carriage_radius",
+        "Radius of the carriage cylinder around the nozzle axis, mm; 0 = not modelled.",
+    ),
+    k(
+        "curved",
+        "carriage_clearance",
+        "Height of the carriage cylinder's bottom above the nozzle tip, mm.",
+    ),
+    k(
+        "curved",
+        "max_z_speed",
+        "Fastest z motion while extruding, mm/s; faster moves are slowed.",
     ),
 ];
 

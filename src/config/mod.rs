@@ -24,7 +24,8 @@
 //! Every key may be left out and takes its default; `conduit config --defaults` prints them all
 //! with their documentation ([`defaults_toml`]). Unknown keys are errors naming the key, so a
 //! typo never passes silently. `[route]` and `[pnp]` configure cavities, trace routing and part
-//! placement ([`RouteSettings`], [`PnpSettings`]); later sections (`[curve]`, `[conform]`,
+//! placement ([`RouteSettings`], [`PnpSettings`]), `[curved]` non-planar top surfaces
+//! ([`CurvedSettings`]); later sections (`[conform]`,
 //! `[jet]`) will be added as fields of [`Config`] next to them.
 //!
 //! A `[tools.N]` table, when present, defines the tools: the tool numbers must run `0, 1, …`
@@ -37,11 +38,13 @@
 //! Lengths in millimetres, speeds in mm/s, accelerations in mm/s², temperatures in °C,
 //! fan speeds in percent, densities in g/cm³, volumetric flows in mm³/s.
 
+mod curved;
 mod defaults;
 mod electronics;
 pub mod prusa_ini;
 mod template;
 
+pub use curved::{CurvedMode, CurvedSettings};
 pub use defaults::defaults_toml;
 pub use electronics::{PnpSettings, RouteSettings};
 pub use prusa_ini::from_prusa_pairs;
@@ -70,6 +73,8 @@ pub struct Config {
     pub route: RouteSettings,
     /// Part placement commands (`[pnp]`).
     pub pnp: PnpSettings,
+    /// Non-planar top surfaces (`[curved]`).
+    pub curved: CurvedSettings,
 }
 
 /// G-code dialect of the printer's firmware.
@@ -424,6 +429,7 @@ impl Default for Config {
             slice: SliceSettings::default(),
             route: RouteSettings::default(),
             pnp: PnpSettings::default(),
+            curved: CurvedSettings::default(),
         }
     }
 }
@@ -624,6 +630,7 @@ impl Config {
             }
         }
         problems.extend(self.route.problems());
+        problems.extend(self.curved.problems());
         if !(self.pnp.lift.is_finite() && self.pnp.lift >= 0.0) {
             problems.push(format!("pnp.lift must be ≥ 0, got {}", self.pnp.lift));
         }

@@ -9,7 +9,7 @@ pub mod electronics;
 
 pub use electronics::{Electronics, ElectronicsReport};
 
-use crate::config::Config;
+use crate::config::{Config, CurvedMode};
 use crate::emit::gcode::{GcodeStats, write_gcode};
 use crate::geom::{BoundingBox, ExPolygon, Point3, Transform, scaled};
 use crate::mesh::Mesh;
@@ -133,6 +133,9 @@ pub struct SliceSummary {
     pub stage_seconds: Vec<(Stage, f64)>,
     /// Parts, wires and routing totals, when a circuit was given.
     pub electronics: Option<ElectronicsReport>,
+    /// Curved top regions and rejections, with `curved.mode = "tops"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub curved: Option<crate::curved::CurvedReport>,
     /// The placed parts (bed coordinates), when a circuit was given: what the pick-and-place
     /// files list.
     #[serde(skip)]
@@ -214,6 +217,8 @@ struct Front {
     parts: Vec<crate::circuit::PlacedPart>,
     /// Per object: what the electronics stage cut (empty without a circuit).
     cuts: Vec<electronics::ObjectCuts>,
+    /// The placed meshes, kept only when curved tops need them.
+    meshes: Vec<Mesh>,
 }
 
 fn front(
@@ -243,11 +248,17 @@ fn front(
     progress(Stage::Slice);
     let params = SliceParams::new(cfg.slice.region.layer_height, cfg.slice.first_layer_height)?;
     let mut sliced: Vec<_> = meshes.iter().map(|m| slice_mesh(m, &params)).collect();
-    // The meshes are not needed past slicing: keep only what the report says about them.
+    // The meshes are not needed past slicing (unless curved tops follow their surface): keep
+    // only what the report says about them.
     let placed: Vec<(String, Option<BoundingBox>)> = meshes
-        .into_iter()
+        .iter()
         .map(|m| (m.name.clone(), m.bounding_box()))
         .collect();
+    let meshes = if cfg.curved.mode == CurvedMode::Tops {
+        meshes
+    } else {
+        Vec::new()
+    };
     laps.lap(Stage::Slice);
 
     // Electronics: parts on the bed, then per object cavities, routes and channels.
@@ -258,6 +269,7 @@ fn front(
         report: None,
         parts: Vec::new(),
         cuts: Vec::new(),
+        meshes,
     };
     if let Some(e) = circuit {
         progress(Stage::Route);
@@ -393,13 +405,16 @@ pub fn slice_scene_with(
 ) -> Result<(Vec<u8>, Program, SliceSummary), PipelineError> {
     let mut laps = Laps::new();
     let Front {
-        sliced,
+        mut sliced,
         placed,
         extras,
         report,
         parts,
         cuts: _,
+        meshes,
     } = front(scene, cfg, circuit, &mut progress, &mut laps)?;
+    let curved =
+        (cfg.curved.mode == CurvedMode::Tops).then(|| curved_tops(&mut sliced, &meshes, cfg));
 
     progress(Stage::Regions);
     let mut objects = Vec::with_capacity(sliced.len());
@@ -431,8 +446,12 @@ pub fn slice_scene_with(
     laps.lap(Stage::Regions);
 
     progress(Stage::Program);
-    let program = build_program_with(&objects, &extras, &ProgramParams::from_config(cfg));
+    let mut program = build_program_with(&objects, &extras, &ProgramParams::from_config(cfg));
     drop(objects);
+    let curved = curved.map(|(inserts, report)| {
+        crate::curved::insert_curved(&mut program, &inserts);
+        report
+    });
     laps.lap(Stage::Program);
 
     progress(Stage::Emit);
@@ -446,9 +465,53 @@ pub fn slice_scene_with(
         gcode: stats,
         stage_seconds: laps.times,
         electronics: report,
+        curved,
         parts,
     };
     Ok((gcode, program, summary))
+}
+
+/// Plans the curved tops of every object and removes what the curved layers replace from the
+/// sliced islands; returns the curved layers to insert and the report.
+fn curved_tops(
+    sliced: &mut [(Vec<crate::slice::SlicedLayer>, SliceReport)],
+    meshes: &[Mesh],
+    cfg: &Config,
+) -> (
+    Vec<crate::curved::CurvedInsert>,
+    crate::curved::CurvedReport,
+) {
+    let zs: Vec<Vec<LayerZ>> = sliced
+        .iter()
+        .map(|(layers, _)| layers.iter().map(|l| l.z).collect())
+        .collect();
+    let islands: Vec<Vec<Vec<ExPolygon>>> = sliced
+        .iter()
+        .map(|(layers, _)| layers.iter().map(|l| l.islands.clone()).collect())
+        .collect();
+    let objects: Vec<crate::curved::CurvedObject<'_>> = meshes
+        .iter()
+        .zip(&zs)
+        .zip(&islands)
+        .enumerate()
+        .map(
+            |(i, ((mesh, layers), islands))| crate::curved::CurvedObject {
+                mesh,
+                layers,
+                islands,
+                tool: cfg.tool_for_object(i),
+            },
+        )
+        .collect();
+    let plan = crate::curved::plan_tops(&objects, cfg);
+    for ((layers, _), removals) in sliced.iter_mut().zip(&plan.removals) {
+        for (layer, remove) in layers.iter_mut().zip(removals) {
+            if !remove.is_empty() {
+                layer.islands = crate::geom::difference(&layer.islands, remove);
+            }
+        }
+    }
+    (plan.inserts, plan.report)
 }
 
 fn check_fits(meshes: &[Mesh], cfg: &Config) -> Result<(), PipelineError> {
