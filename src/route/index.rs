@@ -440,6 +440,19 @@ impl RegionIndex {
         out
     }
 
+    /// The midpoints of the stretches of the segment `a`–`b` between the points where it meets
+    /// an edge: each stretch lies wholly on one side of the boundary (or along it), so its
+    /// midpoint tells where all of it runs.
+    pub(crate) fn stretch_midpoints(&self, a: Point2, b: Point2) -> Vec<Point2> {
+        let mut ts: Vec<f64> = vec![0.0, 1.0];
+        ts.extend(self.hits(a, b).iter().map(|h| h.t));
+        ts.sort_by(f64::total_cmp);
+        ts.windows(2)
+            .filter(|t| t[1] > t[0])
+            .map(|t| lerp(a, b, (t[0] + t[1]) / 2.0))
+            .collect()
+    }
+
     /// Whether the segment `a`–`b` properly crosses an edge (touching does not count).
     pub(crate) fn crosses(&self, a: Point2, b: Point2) -> bool {
         let lo = Point2::new(a.x.min(b.x), a.y.min(b.y));

@@ -16,21 +16,19 @@
 //! their neighbours (supersampled straight sections) are dropped, so a straight run is one move.
 
 use super::graph::PreparedLayer;
-use super::index::{RegionIndex, dist, lerp, point_segment_distance, project_param};
+use super::index::{RegionIndex, dist, point_segment_distance, project_param};
 use crate::geom::Point2;
 
 /// Farthest a shortcut looks ahead, in route points: bounds the work per point on long runs.
 const LOOKAHEAD: usize = 64;
 
-/// Whether the segment `a`–`b` runs inside (or along the boundary of) `region`: cut at every
-/// boundary crossing, every piece's midpoint is inside or within `tol` of the boundary.
+/// Whether the segment `a`–`b` runs inside (or along the boundary of) `region`: every stretch
+/// between boundary crossings has its midpoint inside or within `tol` of the boundary.
 fn stays_inside(region: &RegionIndex, a: Point2, b: Point2, tol: i64) -> bool {
-    let mut ts: Vec<f64> = vec![0.0, 1.0];
-    ts.extend(region.hits(a, b).iter().map(|h| h.t));
-    ts.sort_by(f64::total_cmp);
-    ts.windows(2)
-        .filter(|t| t[1] > t[0])
-        .all(|t| region.inside_or_on(lerp(a, b, (t[0] + t[1]) / 2.0), tol))
+    region
+        .stretch_midpoints(a, b)
+        .into_iter()
+        .all(|m| region.inside_or_on(m, tol))
 }
 
 /// Whether the route may run straight from `a` to `b` on `layer`.

@@ -5,7 +5,7 @@
 //! wire's channels (`channels.rs`).
 
 use super::graph::{Graph, PreparedLayer, VertexId};
-use super::index::{RegionIndex, lerp};
+use super::index::RegionIndex;
 use super::smooth::pull_taut;
 use super::{Wire, WireRoute};
 use crate::geom::{Point2, Point3, unscaled};
@@ -35,12 +35,7 @@ fn at(p: Point2, z: f64) -> Point3 {
 fn boundary_crossings(points: &[Point2], region: &RegionIndex, tol: i64) -> usize {
     let mut sides: Vec<bool> = Vec::new();
     for w in points.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        let mut ts: Vec<f64> = vec![0.0, 1.0];
-        ts.extend(region.hits(a, b).iter().map(|h| h.t));
-        ts.sort_by(f64::total_cmp);
-        for t in ts.windows(2).filter(|t| t[1] > t[0]) {
-            let m = lerp(a, b, (t[0] + t[1]) / 2.0);
+        for m in region.stretch_midpoints(w[0], w[1]) {
             if !region.near_boundary(m, tol) {
                 sides.push(region.contains(m));
             }
