@@ -78,28 +78,6 @@ fn triangle_polygon(c: &[Point3; 3]) -> ExPolygon {
     }
 }
 
-/// Whether (x, y) lies in `ex` (even-odd over its rings).
-pub fn contains(ex: &ExPolygon, x: f64, y: f64) -> bool {
-    std::iter::once(&ex.contour)
-        .chain(&ex.holes)
-        .filter(|ring| ring_contains(ring, x, y))
-        .count()
-        % 2
-        == 1
-}
-
-fn ring_contains(ring: &Polygon, x: f64, y: f64) -> bool {
-    let pts: Vec<(f64, f64)> = ring.points.iter().map(|p| p.to_mm()).collect();
-    let mut inside = false;
-    for i in 0..pts.len() {
-        let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
-        if (a.1 > y) != (b.1 > y) && x < a.0 + (y - a.1) * (b.0 - a.0) / (b.1 - a.1) {
-            inside = !inside;
-        }
-    }
-    inside
-}
-
 /// The gently sloped top regions of `hf` (every visible upward-facing triangle no steeper than
 /// `max_angle_deg`, grouped into connected areas; flat and tiny ones left out) and the parts
 /// steeper than that, in a deterministic order.
@@ -136,7 +114,7 @@ pub fn find_top_regions(hf: &HeightField, max_angle_deg: f64) -> (Vec<TopRegion>
                     .copied()
                     .filter(|&i| {
                         let c = tris[i].centroid();
-                        contains(&a, c.x, c.y)
+                        a.contains(Point2::from_mm(c.x, c.y))
                     })
                     .collect();
                 (a, members)

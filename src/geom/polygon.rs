@@ -36,6 +36,24 @@ impl Polygon {
     pub fn is_counter_clockwise(&self) -> bool {
         self.signed_area2() > 0
     }
+
+    /// Whether `p` is inside (even-odd crossing test, exact in `i128`; points on the boundary
+    /// may go either way).
+    pub fn contains(&self, p: Point2) -> bool {
+        let pts = &self.points;
+        let mut result = false;
+        for i in 0..pts.len() {
+            let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+            if (a.y > p.y) != (b.y > p.y) {
+                let lhs = (p.x - a.x) as i128 * (b.y - a.y) as i128;
+                let rhs = (b.x - a.x) as i128 * (p.y - a.y) as i128;
+                if (lhs < rhs) == (b.y > a.y) {
+                    result = !result;
+                }
+            }
+        }
+        result
+    }
 }
 
 /// An outer contour (counter-clockwise) with holes (clockwise).
@@ -51,6 +69,12 @@ impl ExPolygon {
     /// Net area in mm²: the contour minus the holes.
     pub fn area_mm2(&self) -> f64 {
         self.contour.area_mm2().abs() - self.holes.iter().map(|h| h.area_mm2().abs()).sum::<f64>()
+    }
+
+    /// Whether `p` is inside the contour and outside every hole (points on a boundary may go
+    /// either way).
+    pub fn contains(&self, p: Point2) -> bool {
+        self.contour.contains(p) && !self.holes.iter().any(|h| h.contains(p))
     }
 }
 
@@ -86,5 +110,10 @@ mod tests {
             holes: vec![hole],
         };
         assert_eq!(ex.area_mm2(), 96.0);
+        // Inside the contour, in the hole, outside.
+        assert!(ex.contains(Point2::from_mm(5.0, 5.0)));
+        assert!(!ex.contains(Point2::from_mm(1.0, 1.0)));
+        assert!(!ex.contains(Point2::from_mm(11.0, 5.0)));
+        assert!(ex.contour.contains(Point2::from_mm(1.0, 1.0)));
     }
 }

@@ -291,24 +291,6 @@ impl ProgramParams {
     }
 }
 
-/// Whether `p` is inside `polygon` (even-odd crossing test, exact in `i128`; points on the
-/// boundary may go either way).
-fn inside(polygon: &Polygon, p: Point2) -> bool {
-    let pts = &polygon.points;
-    let mut result = false;
-    for i in 0..pts.len() {
-        let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
-        if (a.y > p.y) != (b.y > p.y) {
-            let lhs = (p.x - a.x) as i128 * (b.y - a.y) as i128;
-            let rhs = (b.x - a.x) as i128 * (p.y - a.y) as i128;
-            if (lhs < rhs) == (b.y > a.y) {
-                result = !result;
-            }
-        }
-    }
-    result
-}
-
 fn point3(p: Point2, z: f64) -> Point3 {
     Point3::new(unscaled(p.x), unscaled(p.y), z)
 }
@@ -408,7 +390,7 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
         };
         let owner = outer
             .iter()
-            .filter(|(_, poly, _)| inside(poly, pts[0]))
+            .filter(|(_, poly, _)| poly.contains(pts[0]))
             .min_by_key(|(island, _, area)| (*area, *island))
             .map(|(island, _, _)| *island);
         match owner {
