@@ -490,31 +490,14 @@ fn openlog_config() -> Config {
 }
 
 #[test]
-fn openlog_accounts_for_every_wire_and_routes_most() {
-    let Some(board) = Board::load("OpenLog") else {
-        return;
-    };
-    let e = board.slice(&openlog_config());
-    let failed = board.check_accounted(&e);
-    println!("OpenLog: unrouted nets {failed:?}");
-    // A regression guard until every net routes (the ignored test below): at least 80 %.
-    let routed = e["routed"].as_u64().expect("routed") as usize;
-    assert!(
-        10 * routed >= 8 * board.expected,
-        "{routed} of {}",
-        board.expected
-    );
-    // No pitch warning at this width.
-    assert_eq!(e["warnings"], Value::Array(Vec::new()));
-}
-
-#[test]
-#[ignore = "bug: 8 of OpenLog's 46 wires (nets 3.3V, GND, MISO, N$2, N$4, all at the TQFP U1) are not routed: its own GND and 3.3V pins connect across and around the chip, which needs layer changes where its pad rows leave no room for a staircase overlap; sequential routing with rip-up and reroute does not find them"]
 fn openlog_routes_completely() {
     let Some(board) = Board::load("OpenLog") else {
         return;
     };
-    board.check_complete(&board.slice(&openlog_config()));
+    let e = board.slice(&openlog_config());
+    board.check_complete(&e);
+    // No pitch warning at this width.
+    assert_eq!(e["warnings"], Value::Array(Vec::new()));
 }
 
 #[test]

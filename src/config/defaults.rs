@@ -458,6 +458,11 @@ const KEYS: &[KeyDoc] = &[
     ),
     k(
         "route",
+        "squeeze_weight",
+        "Cost per mm of trace through gaps the deflated perimeter traces do not reach.",
+    ),
+    k(
+        "route",
         "grid_step",
         "Step of the grid explored in the infill area, mm.",
     ),

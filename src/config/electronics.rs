@@ -30,6 +30,9 @@ pub struct RouteSettings {
     pub base_weight: f64,
     /// Cost per mm of a straight section outside material or across a hole. Default 100.
     pub outside_weight: f64,
+    /// Cost per mm of trace squeezed through a gap the deflated perimeter traces do not reach
+    /// (between pad rows, beside earlier traces), where a trace still fits. Default 4.
+    pub squeeze_weight: f64,
     /// Step of the grid explored inside the infill area, mm. Default 1.
     pub grid_step: f64,
     /// Overlap of a trace with the one of the next layer where a wire changes layer, mm (the
@@ -68,6 +71,7 @@ impl Default for RouteSettings {
             perimeter_weights: vec![3.0, 2.0, 1.0],
             base_weight: 1.0,
             outside_weight: 100.0,
+            squeeze_weight: 4.0,
             grid_step: 1.0,
             interlayer_overlap: 2.0,
             layer_change_penalty: 5.0,
@@ -91,6 +95,7 @@ impl RouteSettings {
             ("base_weight", self.base_weight),
             ("max_detour", self.max_detour),
             ("outside_weight", self.outside_weight),
+            ("squeeze_weight", self.squeeze_weight),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 out.push(format!("route.{key} must be > 0, got {v}"));

@@ -39,12 +39,17 @@ pub struct NetRoute {
     pub routed: bool,
     /// Length of the route, mm (0 when not routed).
     pub length: f64,
-    /// Straight 3D distance between the ends, mm: no route is shorter.
+    /// Straight 3D distance between the route's ends (the two pins, or the pin and the point
+    /// where it [`joins`](NetRoute::joins) another trace), mm: no route is shorter.
     pub lower_bound: f64,
     /// Number of layer changes.
     pub layer_changes: usize,
     /// Crossings of the route with the layers' outer perimeters.
     pub perimeter_crossings: usize,
+    /// Where the route ends when not on a pad: on the trace of this other wire of its net
+    /// (`FROM-TO` pins), as a T joint, since that trace already reaches the pin. `None` when
+    /// it runs pin to pin.
+    pub joins: Option<String>,
 }
 
 /// What the electronics stage did, for the report.
@@ -227,6 +232,7 @@ pub fn route_params(cfg: &Config) -> RouteParams {
         perimeter_weights: r.perimeter_weights.clone(),
         base_weight: r.base_weight,
         outside_weight: r.outside_weight,
+        squeeze_weight: r.squeeze_weight,
         grid_step: r.grid_step,
         interlayer_overlap: r.interlayer_overlap,
         layer_change_penalty: r.layer_change_penalty,
@@ -304,6 +310,7 @@ pub fn object_stage(
             lower_bound: (w.wire.to - w.wire.from).norm(),
             layer_changes: 0,
             perimeter_crossings: 0,
+            joins: None,
         });
     }
     let wires: Vec<Wire> = mine_wires.iter().map(|w| w.wire.clone()).collect();
@@ -352,6 +359,10 @@ pub fn object_stage(
             lower_bound: w.lower_bound,
             layer_changes: w.layer_changes,
             perimeter_crossings: w.perimeter_crossings,
+            joins: w
+                .ends_on_wire
+                .and_then(|k| mine_wires.get(k))
+                .map(|j| format!("{}-{}", j.from, j.to)),
         });
         if !w.routed {
             continue;

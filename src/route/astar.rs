@@ -4,21 +4,27 @@
 //! assembled trace (`trace.rs`). [`route`](super::route) runs one [`Search`] per wire;
 //! [`route_wire`] runs one on layers as given.
 //!
-//! - **Heuristic**: the 3D straight distance to the target pad times the smallest weight, plus,
-//!   per layer between the vertex and the target, the least a layer change can cost
-//!   (`layer_change_penalty + interlayer_overlap × base_weight`). Every edge costs at least the
-//!   heuristic's drop along it (layer changes are floored to make sure), so the heuristic is
-//!   consistent and the first path to reach the target is the cheapest in the graph explored.
+//! - **Targets**: the target pad, and the traces of the target's net already connected to it
+//!   ([`Tap`]s, given by the board): a route may end on its net's copper anywhere, as a T joint,
+//!   instead of running beside that copper to the pad. A vertex within one grid step of a tap,
+//!   joined to it by a straight link inside the material, reaches the target through that link.
+//! - **Heuristic**: the 3D straight distance to the nearest target (pad or tap segment) times
+//!   the smallest weight, plus, per layer between the vertex and that target, the least a layer
+//!   change can cost (`layer_change_penalty + interlayer_overlap × base_weight`). Every edge
+//!   costs at least the heuristic's drop along it (layer changes are floored to make sure), so
+//!   the heuristic is consistent (a minimum of consistent ones) and the first path to reach a
+//!   target is the cheapest in the graph explored. It is computed once per vertex.
 //! - **Lazy growth**: expanding a vertex inside the infill region adds grid vertices one
 //!   `grid_step` away in the eight 45° directions (reusing a vertex within a third of a step) and
-//!   edges to every vertex within one step, at `base_weight`; it also tries the layer changes of
-//!   `interlayer.rs`.
+//!   edges to every vertex within one step, at `base_weight`; in the squeeze region (see
+//!   `graph.rs`) the same grid grows at `squeeze_weight`; it also tries the layer changes of
+//!   `interlayer.rs` and the taps.
 //! - **Determinism**: the open list is a binary heap ordered by (f, larger g, vertex id) with
 //!   total float order; vertex ids follow creation order, which depends only on the input; hash
 //!   maps are only looked up, never iterated.
 
-use super::graph::{self, Ends, Graph, LayerInput, PENALTY_FACTOR, PreparedLayer, VertexId};
-use super::index::{dist, lerp};
+use super::graph::{self, Ends, Graph, LayerInput, PENALTY_FACTOR, PreparedLayer, VertexId, Zone};
+use super::index::{dist, lerp, point_segment_distance, project_param};
 use super::interlayer::{Parent, piece_fits, polyline_length, walk_back};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, layer_of, trace};
 use crate::geom::{Point2, scaled, unscaled};
@@ -102,7 +108,11 @@ pub(crate) fn min_weight(params: &RouteParams) -> f64 {
     params
         .perimeter_weights
         .iter()
-        .chain([&params.base_weight, &params.outside_weight])
+        .chain([
+            &params.base_weight,
+            &params.outside_weight,
+            &params.squeeze_weight,
+        ])
         .copied()
         .fold(f64::INFINITY, f64::min)
         .max(0.0)
@@ -134,6 +144,20 @@ pub(crate) fn cost_limit(
     limit
 }
 
+/// A piece of an already routed trace of the wire's net, connected to its target pad: the
+/// route may end anywhere on it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Tap {
+    /// Layer of the trace piece.
+    pub layer: usize,
+    /// Start of the piece (a segment of the trace's centreline).
+    pub a: Point2,
+    /// End of the piece.
+    pub b: Point2,
+    /// Index of the routed wire the piece belongs to.
+    pub wire: usize,
+}
+
 /// The A* search of one wire's route, one expansion per [`Search::step`].
 #[derive(Debug, Clone)]
 pub struct Search {
@@ -142,6 +166,13 @@ pub struct Search {
     layers: Vec<PreparedLayer>,
     graph: Graph,
     target: VertexId,
+    /// Trace pieces the route may end on besides the target pad.
+    taps: Vec<Tap>,
+    /// How the target was last reached through a tap: the point on the trace and the tap's
+    /// wire (`None` when it was reached at the pad).
+    arrival: Option<(Point2, usize)>,
+    /// Heuristic per vertex, computed once (NaN until then).
+    h: Vec<f64>,
     overlaps: Vec<Vec<Point2>>,
     g: Vec<f64>,
     parents: Vec<Parent>,
@@ -174,16 +205,18 @@ impl Search {
                 })
                 .collect()
         });
-        Self::with_layers(inputs, layers, wire, params)
+        Self::with_layers(inputs, layers, wire, params, Vec::new())
     }
 
     /// A search over prepared inputs (consecutive layers, ascending); `all` gives the pads'
-    /// layers.
+    /// layers; `taps` are trace pieces the route may end on besides the target pad (those on
+    /// layers outside the inputs are dropped).
     pub(crate) fn with_layers(
         inputs: Vec<LayerInput>,
         all: &[RouteLayer],
         wire: &Wire,
         params: &RouteParams,
+        taps: Vec<Tap>,
     ) -> Self {
         let layers: Vec<PreparedLayer> = inputs
             .iter()
@@ -213,6 +246,9 @@ impl Search {
             layers,
             graph,
             target,
+            taps: Vec::new(),
+            arrival: None,
+            h: Vec::new(),
             overlaps: Vec::new(),
             g: Vec::new(),
             parents: Vec::new(),
@@ -225,6 +261,10 @@ impl Search {
             cost_limit: f64::INFINITY,
         };
         if search.state == SearchState::Running {
+            search.taps = taps
+                .into_iter()
+                .filter(|t| search.in_range(t.layer))
+                .collect();
             let (a, b) = (search.graph.pos(source), search.graph.pos(target));
             let (la, lb) = (search.graph.layer(source), search.graph.layer(target));
             let dz = search.layer(la).z - search.layer(lb).z;
@@ -289,6 +329,7 @@ impl Search {
         }
         self.explore_grid(u);
         self.explore_layers(u);
+        self.explore_taps(u);
         let penalised = !self.layer(self.graph.layer(u)).penalty.is_empty();
         for k in 0..self.graph.adj[u as usize].len() {
             let e = self.graph.adj[u as usize][k];
@@ -310,7 +351,12 @@ impl Search {
             return trace::unrouted(&self.wire);
         }
         let mut path = Vec::new();
-        let mut v = self.target;
+        // A route that ends on a trace stops at the point of the trace, on the layer of the
+        // vertex that reached it; the target pad is not part of it.
+        let (mut v, end) = match (self.arrival, self.parents[self.target as usize]) {
+            (Some((q, wire)), Some((p, _))) => (p, Some((q, wire))),
+            _ => (self.target, None),
+        };
         loop {
             let parent = self.parents[v as usize];
             path.push((v, parent.and_then(|p| p.1)));
@@ -328,6 +374,7 @@ impl Search {
             &path,
             &self.overlaps,
             tol,
+            end,
         )
     }
 
@@ -337,6 +384,7 @@ impl Search {
         self.g.resize(n, f64::INFINITY);
         self.parents.resize(n, None);
         self.closed.resize(n, false);
+        self.h.resize(n, f64::NAN);
     }
 
     fn layer(&self, l: usize) -> &PreparedLayer {
@@ -348,12 +396,70 @@ impl Search {
         l >= lo && l < lo + self.layers.len()
     }
 
-    fn heuristic(&self, v: VertexId) -> f64 {
-        let (a, b) = (self.graph.pos(v), self.graph.pos(self.target));
-        let (la, lb) = (self.graph.layer(v), self.graph.layer(self.target));
+    /// The least cost from a point on layer `la` to one `dxy` scaled units away (in xy) on
+    /// layer `lb`.
+    fn bound(&self, la: usize, lb: usize, dxy: f64) -> f64 {
         let dz = self.layer(la).z - self.layer(lb).z;
-        let dxy = unscaled(1) * dist(a, b);
+        let dxy = unscaled(1) * dxy;
         self.min_weight * (dxy * dxy + dz * dz).sqrt() + self.change_cost * la.abs_diff(lb) as f64
+    }
+
+    fn heuristic(&mut self, v: VertexId) -> f64 {
+        let known = self.h[v as usize];
+        if !known.is_nan() {
+            return known;
+        }
+        let (p, l) = (self.graph.pos(v), self.graph.layer(v));
+        let to_pad = self.bound(
+            l,
+            self.graph.layer(self.target),
+            dist(p, self.graph.pos(self.target)),
+        );
+        let h = self.taps.iter().fold(to_pad, |h, t| {
+            h.min(self.bound(l, t.layer, point_segment_distance(p, t.a, t.b)))
+        });
+        self.h[v as usize] = h;
+        h
+    }
+
+    /// Offers the target to `u` through the nearest tap on its layer within one grid step, if
+    /// the straight link to it stays inside the material and clear of keep-outs.
+    fn explore_taps(&mut self, u: VertexId) {
+        if self.taps.is_empty() || u == self.target {
+            return;
+        }
+        let (l, p) = (self.graph.layer(u), self.graph.pos(u));
+        let reach = scaled(self.params.grid_step).max(1) as f64;
+        let Some((d, q, wire)) = self
+            .taps
+            .iter()
+            .filter(|t| t.layer == l)
+            .map(|t| {
+                let q = lerp(t.a, t.b, project_param(p, t.a, t.b));
+                (dist(p, q), q, t.wire)
+            })
+            .filter(|(d, _, _)| *d <= reach)
+            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)))
+        else {
+            return;
+        };
+        let tol = scaled(self.params.align_tolerance).max(1);
+        let base = self.params.base_weight;
+        if self.layer(l).link_weight(p, q, &self.params, tol) != Some(base) {
+            return;
+        }
+        let g = self.g[u as usize] + unscaled(1) * d * base;
+        let t = self.target as usize;
+        if !self.closed[t] && g < self.g[t] {
+            self.g[t] = g;
+            self.parents[t] = Some((u, None));
+            self.arrival = Some((q, wire));
+            self.open.push(Open {
+                f: g,
+                g,
+                v: self.target,
+            });
+        }
     }
 
     fn relax(&mut self, u: VertexId, v: VertexId, cost: f64, piece: Option<u32>) -> bool {
@@ -365,6 +471,9 @@ impl Search {
         if g < self.g[v as usize] {
             self.g[v as usize] = g;
             self.parents[v as usize] = Some((u, piece));
+            if v == self.target {
+                self.arrival = None;
+            }
             let f = g + self.heuristic(v);
             self.open.push(Open { f, g, v });
             return true;
@@ -372,24 +481,59 @@ impl Search {
         false
     }
 
-    /// Whether a planar grid edge `a`–`b` stays in the infill region of `layer`, given that `b`
-    /// is in it.
-    fn grid_edge_ok(&self, layer: &PreparedLayer, a: Point2, b: Point2, tol: i64) -> bool {
-        !layer.infill.crosses(a, b) && layer.infill.inside_or_on(lerp(a, b, 0.5), tol)
+    /// The grid zone of point `p` on `layer`.
+    fn zone_at(&self, layer: &PreparedLayer, p: Point2, tol: i64) -> Zone {
+        if layer.infill.inside_or_on(p, tol) {
+            Zone::Infill
+        } else if !layer.squeeze.is_empty()
+            && layer.squeeze.inside_or_on(p, tol)
+            && !layer.blocked.contains(p)
+        {
+            Zone::Squeeze
+        } else {
+            Zone::Out
+        }
     }
 
-    /// Whether vertex `v` lies in its layer's infill region (asked once per vertex).
-    fn in_infill(&mut self, v: VertexId, tol: i64) -> bool {
-        if let Some(known) = self.graph.verts[v as usize].infill {
+    /// The grid zone of vertex `v` (worked out once per vertex).
+    fn zone(&mut self, v: VertexId, tol: i64) -> Zone {
+        if let Some(known) = self.graph.verts[v as usize].zone {
             return known;
         }
         let (l, p) = (self.graph.layer(v), self.graph.pos(v));
-        let inside = self.layer(l).infill.inside_or_on(p, tol);
-        self.graph.verts[v as usize].infill = Some(inside);
-        inside
+        let zone = self.zone_at(self.layer(l), p, tol);
+        self.graph.verts[v as usize].zone = Some(zone);
+        zone
     }
 
-    /// Grows the infill grid around `u` (once per vertex), if `u` is in the infill region.
+    /// Weight per mm of a planar grid edge `a`–`b` between points of zones `za` and `zb`:
+    /// `base_weight` inside the infill region, `squeeze_weight` inside the squeeze region and
+    /// clear of keep-outs, else no edge.
+    fn grid_weight(
+        &self,
+        layer: &PreparedLayer,
+        (a, za): (Point2, Zone),
+        (b, zb): (Point2, Zone),
+        tol: i64,
+    ) -> Option<f64> {
+        if za == Zone::Out || zb == Zone::Out {
+            return None;
+        }
+        let mid = lerp(a, b, 0.5);
+        if za == Zone::Infill
+            && zb == Zone::Infill
+            && !layer.infill.crosses(a, b)
+            && layer.infill.inside_or_on(mid, tol)
+        {
+            return Some(self.params.base_weight);
+        }
+        (!layer.squeeze.crosses(a, b)
+            && layer.squeeze.inside_or_on(mid, tol)
+            && !layer.blocked_segment(a, b))
+        .then_some(self.params.squeeze_weight)
+    }
+
+    /// Grows the grid around `u` (once per vertex), if `u` is in the infill or squeeze region.
     fn explore_grid(&mut self, u: VertexId) {
         let ui = u as usize;
         if self.graph.verts[ui].explored {
@@ -399,12 +543,12 @@ impl Search {
         let l = self.graph.layer(u);
         let p = self.graph.pos(u);
         let tol = scaled(self.params.align_tolerance).max(1);
-        if !self.in_infill(u, tol) {
+        let zu = self.zone(u, tol);
+        if zu == Zone::Out {
             return;
         }
         let step = scaled(self.params.grid_step).max(1);
         let reuse = (step as f64 * GRID_REUSE) as i64;
-        let base = self.params.base_weight;
         // Grid points lie on one lattice of `grid_step` for every layer: steps from a lattice
         // point are exact 45° steps, steps from a ring or pad vertex land on the nearest
         // lattice point, and the same points recur on neighbouring layers (exact inter-layer
@@ -416,34 +560,37 @@ impl Search {
                 continue;
             }
             if let Some(v) = self.graph.nearest(l, q, reuse) {
-                if self.in_infill(v, tol)
-                    && self.grid_edge_ok(self.layer(l), p, self.graph.pos(v), tol)
-                {
-                    self.graph.link(u, v, base);
+                let zv = self.zone(v, tol);
+                let pv = self.graph.pos(v);
+                if let Some(w) = self.grid_weight(self.layer(l), (p, zu), (pv, zv), tol) {
+                    self.graph.link(u, v, w);
                 }
                 continue;
             }
             let layer = self.layer(l);
-            if !layer.infill.inside_or_on(q, tol) || !self.grid_edge_ok(layer, p, q, tol) {
+            let zq = self.zone_at(layer, q, tol);
+            let Some(w) = self.grid_weight(layer, (p, zu), (q, zq), tol) else {
                 continue;
-            }
+            };
             let (v, created) = self.graph.add_vertex(l, q);
-            self.graph.link(u, v, base);
+            self.graph.link(u, v, w);
             if created {
                 self.grow();
                 self.link_neighbours(v, |s, w| {
-                    (s.in_infill(w, tol)
-                        && s.grid_edge_ok(s.layer(l), s.graph.pos(w), s.graph.pos(v), tol))
-                    .then_some(base)
+                    let (zw, zv) = (s.zone(w, tol), s.zone(v, tol));
+                    let (pw, pv) = (s.graph.pos(w), s.graph.pos(v));
+                    s.grid_weight(s.layer(l), (pw, zw), (pv, zv), tol)
                 });
             }
         }
         for v in self.graph.within(l, p, step) {
-            if v != u
-                && self.in_infill(v, tol)
-                && self.grid_edge_ok(self.layer(l), p, self.graph.pos(v), tol)
-            {
-                self.graph.link(u, v, base);
+            if v == u {
+                continue;
+            }
+            let zv = self.zone(v, tol);
+            let pv = self.graph.pos(v);
+            if let Some(w) = self.grid_weight(self.layer(l), (p, zu), (pv, zv), tol) {
+                self.graph.link(u, v, w);
             }
         }
     }

@@ -7,21 +7,31 @@
 //!
 //! Sequential routing fails when an early wire walls off a later one, for example by passing
 //! round a connector whose pins still have to be reached. A failed wire then gets a **rip-up
-//! and reroute** round: it is searched again with other nets' traces as no obstacle but a cost
+//! and reroute** attempt: it is searched again with other nets' traces as no obstacle but a cost
 //! (each mm inside one costs 25 times more, so the probe runs into as few as it can; pads still
 //! count), the routed wires whose channels that probe route runs into (on its layer or an
-//! adjacent one) are ripped up, the failed wire is routed first, and the ripped wires are routed again after
-//! it. A round that leaves fewer wires routed than before it is undone, and rounds stop at the
-//! first one that routes nothing more or after `rip_up_rounds`.
+//! adjacent one) are ripped up, with the wires that end on their traces, the failed wire is
+//! routed first, and the ripped wires are routed again after it; the wires this leaves failing
+//! get an attempt of their own, `RIP_UP_DEPTH` levels deep. An attempt that does not leave more
+//! wires routed than before it is undone. Rounds stop at the first one that keeps no attempt,
+//! or after `rip_up_rounds`.
+//!
+//! Each search may end on the traces already connected to the wire's far pad ([`Tap`]s): the
+//! board follows the routed wires of the net from each pad and starts the search at the pad
+//! whose side has less copper, so the target has the most.
 
-use super::astar::{Search, SearchState, cost_limit, layer_range, min_weight};
+use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
 use super::graph::LayerInput;
 use super::{PadCopper, wire_order};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
-use crate::geom::{ExPolygon, Point2, difference, intersection, union};
+use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, union};
 
 /// A channel area (mm²) below which two channels count as not touching: polygon noise.
 const TOUCH_MM2: f64 = 1e-6;
+
+/// How deep a rip-up and reroute attempt may go: the wires an attempt leaves failing get an
+/// attempt of their own, down to this many levels.
+const RIP_UP_DEPTH: usize = 2;
 
 /// Extra margin of a wire's routing window beyond the farthest its route may go, mm.
 const WINDOW_MARGIN_MM: f64 = 2.0;
@@ -118,17 +128,7 @@ impl<'a> Board<'a> {
             self.route_one(i);
         }
         for _ in 0..self.params.rip_up_rounds {
-            let before = self.routed_count();
-            if before == self.wires.len() {
-                break;
-            }
-            let saved = self.clone();
-            self.rip_up_round();
-            let after = self.routed_count();
-            if after < before {
-                *self = saved;
-            }
-            if after <= before {
+            if self.routed_count() == self.wires.len() || !self.rip_up_round() {
                 break;
             }
         }
@@ -162,31 +162,61 @@ impl<'a> Board<'a> {
         (routes, channels)
     }
 
-    /// One rip-up and reroute round over the wires that failed, in wire order.
-    fn rip_up_round(&mut self) {
-        let failed: Vec<usize> = wire_order(self.wires, self.params)
+    /// One rip-up and reroute round over the wires that failed, in wire order (see
+    /// [`Board::attempt`]); returns whether any attempt was kept.
+    fn rip_up_round(&mut self) -> bool {
+        let mut improved = false;
+        for f in self.failed() {
+            improved |= self.attempt(f, RIP_UP_DEPTH);
+        }
+        improved
+    }
+
+    /// The wires without a route, in wire order.
+    fn failed(&self) -> Vec<usize> {
+        wire_order(self.wires, self.params)
             .into_iter()
             .filter(|&i| !self.routes[i].as_ref().is_some_and(|r| r.routed))
-            .collect();
-        for f in failed {
-            if self.routes[f].as_ref().is_some_and(|r| r.routed) {
-                continue;
+            .collect()
+    }
+
+    /// One rip-up and reroute of failed wire `f`: probe, rip up the blockers, route `f`, reroute
+    /// the blockers; with `depth` left, the wires that this leaves failing get an attempt of
+    /// their own. Kept only if more wires are routed than before (a failed wire routed at the
+    /// cost of another is undone); returns whether it was kept.
+    fn attempt(&mut self, f: usize, depth: usize) -> bool {
+        if depth == 0 || self.routes[f].as_ref().is_some_and(|r| r.routed) {
+            return false;
+        }
+        let probe = self.search(f, false);
+        if !probe.routed {
+            return false; // unroutable even on an empty board
+        }
+        let blockers = self.blockers(f, &probe);
+        if blockers.is_empty() {
+            return false;
+        }
+        let before = self.routed_count();
+        let failed_before = self.failed();
+        let saved = self.clone();
+        let mut ripped = Vec::new();
+        for &b in &blockers {
+            self.rip_up(b, &mut ripped);
+        }
+        self.route_one(f);
+        for b in ripped {
+            self.route_one(b);
+        }
+        for g in self.failed() {
+            if !failed_before.contains(&g) {
+                self.attempt(g, depth - 1);
             }
-            let probe = self.search(f, false);
-            if !probe.routed {
-                continue; // unroutable even on an empty board
-            }
-            let blockers = self.blockers(f, &probe);
-            if blockers.is_empty() {
-                continue;
-            }
-            for &b in &blockers {
-                self.rip_up(b);
-            }
-            self.route_one(f);
-            for b in blockers {
-                self.route_one(b);
-            }
+        }
+        if self.routed_count() > before {
+            true
+        } else {
+            *self = saved;
+            false
         }
     }
 
@@ -209,12 +239,79 @@ impl<'a> Board<'a> {
         self.routes[i] = Some(result);
     }
 
-    /// Removes wire `i`'s route and channels.
-    fn rip_up(&mut self, i: usize) {
+    /// Removes wire `i`'s route and channels, and those of the wires that end on its trace (and
+    /// so on): without it they would join nothing. Appends the wires removed to `ripped`.
+    fn rip_up(&mut self, i: usize, ripped: &mut Vec<usize>) {
+        if self.routes[i].is_none() {
+            return;
+        }
         for layer in &mut self.placed {
             layer.retain(|p| p.wire != i);
         }
         self.routes[i] = None;
+        ripped.push(i);
+        let dependants: Vec<usize> = (0..self.routes.len())
+            .filter(|&w| {
+                self.routes[w]
+                    .as_ref()
+                    .is_some_and(|r| r.ends_on_wire == Some(i))
+            })
+            .collect();
+        for w in dependants {
+            self.rip_up(w, ripped);
+        }
+    }
+
+    /// The pads connected to `pad` by the routed wires of `net` (`pad` included), and those
+    /// wires, by increasing index.
+    fn connected(&self, net: &str, pad: Point3) -> (Vec<Point3>, Vec<usize>) {
+        let mut pads = vec![pad];
+        let mut wires: Vec<usize> = Vec::new();
+        loop {
+            let before = wires.len();
+            for (i, w) in self.wires.iter().enumerate() {
+                let routed = self.routes[i].as_ref().is_some_and(|r| r.routed);
+                if !routed || w.net != net || wires.contains(&i) {
+                    continue;
+                }
+                let (a, b) = (pads.contains(&w.from), pads.contains(&w.to));
+                if a || b {
+                    wires.push(i);
+                    for p in [w.from, w.to] {
+                        if !pads.contains(&p) {
+                            pads.push(p);
+                        }
+                    }
+                }
+            }
+            if wires.len() == before {
+                break;
+            }
+        }
+        wires.sort_unstable();
+        (pads, wires)
+    }
+
+    /// The trace pieces of `wires`, as [`Tap`]s.
+    fn taps(&self, wires: &[usize]) -> Vec<Tap> {
+        let mut out = Vec::new();
+        for &w in wires {
+            let Some(route) = &self.routes[w] else {
+                continue;
+            };
+            for (layer, points) in &route.segments {
+                let xy: Vec<Point2> = points.iter().map(|p| Point2::from_mm(p.x, p.y)).collect();
+                for s in xy.windows(2) {
+                    out.push(Tap {
+                        layer: *layer,
+                        a: s[0],
+                        b: s[1],
+                        wire: w,
+                    });
+                }
+            }
+        }
+        out
     }
 
     /// The routed wires of other nets whose channels the route `probe` of wire `i` runs into,
@@ -250,16 +347,38 @@ impl<'a> Board<'a> {
 
     /// Runs the A* search of wire `i`; with `traces` the channels of other nets' wires are in
     /// the way, without only the pads are.
+    ///
+    /// The route may end on the traces already connected to either pad (see [`Tap`]): it starts
+    /// at the pad whose side has less trace and ends on the other side's pad or traces, so it
+    /// has the most copper to aim at.
     fn search(&self, i: usize, traces: bool) -> WireRoute {
         let wire = &self.wires[i];
         let Some(range) = layer_range(self.layers, wire, self.params) else {
             return trace::unrouted(wire);
         };
+        let (from_pads, from_wires) = self.connected(&wire.net, wire.from);
+        let (_, to_wires) = self.connected(&wire.net, wire.to);
+        let (start, taps) = if from_pads.contains(&wire.to) {
+            // Already connected: a plain pad-to-pad route.
+            (wire.clone(), Vec::new())
+        } else {
+            let (from_taps, to_taps) = (self.taps(&from_wires), self.taps(&to_wires));
+            if from_taps.len() > to_taps.len() {
+                let reversed = Wire {
+                    net: wire.net.clone(),
+                    from: wire.to,
+                    to: wire.from,
+                };
+                (reversed, from_taps)
+            } else {
+                (wire.clone(), to_taps)
+            }
+        };
         let window = self.window(wire, traces);
         let inputs: Vec<LayerInput> = range
             .map(|l| self.input(l, wire, traces, &window))
             .collect();
-        let mut search = Search::with_layers(inputs, self.layers, wire, self.params);
+        let mut search = Search::with_layers(inputs, self.layers, &start, self.params, taps);
         while search.step() == SearchState::Running {}
         search.result()
     }

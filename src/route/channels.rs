@@ -28,7 +28,7 @@ const SIMPLIFY_NM: f64 = 1_000.0;
 const KEEP_OUT_MARGIN_MM: f64 = 0.005;
 
 /// Farthest a channel of half-width `half` reaches from its centreline, mm.
-fn circumscribed(half: f64) -> f64 {
+pub(crate) fn circumscribed(half: f64) -> f64 {
     half / (PI / JOINT_SIDES as f64).cos()
 }
 

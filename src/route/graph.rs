@@ -8,6 +8,10 @@
 //!   by `i·perimeter_width + (conductive_width + channel_extra)/2` for `i = 1..=perimeters`; every
 //!   ring of each result is a closed chain of vertices whose edges cost `length ×
 //!   perimeter_weights[i-1]`.
+//! - **Squeeze rings**: the boundary of the squeeze region (the islands shrunk just past other
+//!   nets' keep-outs, within the first deflated area of the original islands), where it is not
+//!   a first deflated trace already, at `squeeze_weight` per mm: the only way through gaps too
+//!   narrow for two perimeter traces, such as between a fine-pitch part's pad rows.
 //! - **Direct connections**: the wire's rubberband projected into the layer, split where it meets
 //!   the rings, the island boundaries and the keep-outs of other nets' traces. Sections inside
 //!   the material cost `base_weight` per mm, sections across holes and notches of one island
@@ -25,7 +29,7 @@
 
 use super::RouteParams;
 use super::index::{Hit, RegionIndex, dist, lerp, point_segment_distance, project_param};
-use crate::geom::{ExPolygon, Join, Point2, offset, scaled, unscaled};
+use crate::geom::{ExPolygon, Join, Point2, intersection, offset, scaled, unscaled};
 use std::collections::{BTreeMap, HashMap};
 use std::hash::{BuildHasherDefault, Hasher};
 
@@ -118,6 +122,11 @@ pub(crate) struct PreparedLayer {
     pub clearance: RegionIndex,
     /// The innermost deflated area, explored on the grid.
     pub infill: RegionIndex,
+    /// Where a channel fits at all: clear of other nets' channels and pads (the islands shrunk by
+    /// half a channel) and one perimeter inside the layer's own walls (the original islands
+    /// shrunk by `perimeter_width` + half a channel). The grid reaches the gaps the deflated
+    /// traces leave out here, at `squeeze_weight`.
+    pub squeeze: RegionIndex,
     /// The original islands (inside/outside decisions, perimeter crossings).
     pub material: RegionIndex,
     /// Outer contours of the original islands, grouped by island.
@@ -161,6 +170,49 @@ impl PreparedLayer {
                 Join::Round(ROUND_DEVIATION_MM),
             ));
         }
+        let squeeze = if params.squeeze_weight.is_finite() {
+            // Just outside the keep-outs of other nets' channels and pads (which reach a
+            // polygonal channel's circumscribed half-width past their holes), so the squeeze
+            // rings are themselves usable.
+            let clear = offset(
+                &input.islands,
+                -(super::channels::keep_out_radius(params) - super::channels::circumscribed(half)
+                    + ROUND_DEVIATION_MM),
+                Join::Round(ROUND_DEVIATION_MM),
+            );
+            let walls = offset(
+                &input.original,
+                -(params.perimeter_width + half),
+                Join::Round(ROUND_DEVIATION_MM),
+            );
+            decimate(intersection(&clear, &walls))
+        } else {
+            Vec::new()
+        };
+        // Away from other nets' channels and pads the squeeze region ends where the first
+        // deflated area does: those rings are there already.
+        let sorted = |pts: &[Point2]| {
+            let mut v = pts.to_vec();
+            v.sort_unstable();
+            v
+        };
+        let first: Vec<Vec<Point2>> = areas
+            .first()
+            .into_iter()
+            .flatten()
+            .flat_map(|ex| std::iter::once(&ex.contour).chain(&ex.holes))
+            .map(|r| sorted(&r.points))
+            .collect();
+        for ex in &squeeze {
+            for ring in std::iter::once(&ex.contour).chain(&ex.holes) {
+                if ring.points.len() >= 3 && !first.contains(&sorted(&ring.points)) {
+                    rings.push(Ring {
+                        points: ring.points.clone(),
+                        weight: params.squeeze_weight,
+                    });
+                }
+            }
+        }
         let ring_refs: Vec<(u32, &[Point2])> = rings
             .iter()
             .enumerate()
@@ -175,6 +227,7 @@ impl PreparedLayer {
         Self {
             index: input.index,
             z: input.z,
+            squeeze: RegionIndex::of_regions(&squeeze),
             ring_edges: RegionIndex::new(&ring_refs),
             clearance: RegionIndex::of_regions(areas.first().map_or(&[], Vec::as_slice)),
             infill: RegionIndex::of_regions(areas.last().map_or(&[], Vec::as_slice)),
@@ -260,6 +313,17 @@ fn decimate(mut regions: Vec<ExPolygon>) -> Vec<ExPolygon> {
 }
 
 /// One vertex of the routing graph.
+/// Where a vertex lies for the lazily explored grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Zone {
+    /// Where no trace centre may run, or off every region.
+    Out,
+    /// In the squeeze region but not the infill region.
+    Squeeze,
+    /// In the infill region (the innermost deflated area).
+    Infill,
+}
+
 #[derive(Debug, Clone)]
 pub(crate) struct Vertex {
     /// Position, scaled units.
@@ -268,8 +332,8 @@ pub(crate) struct Vertex {
     pub layer: usize,
     /// Whether the infill grid has been explored around it.
     pub explored: bool,
-    /// Whether it lies in the infill region, once asked.
-    pub infill: Option<bool>,
+    /// Which grid zone it lies in, once asked.
+    pub zone: Option<Zone>,
 }
 
 /// One directed edge.
@@ -370,7 +434,7 @@ impl Graph {
             p: q,
             layer,
             explored: false,
-            infill: None,
+            zone: None,
         });
         self.adj.push(Vec::new());
         self.by_pos.insert((layer, q.x, q.y), id);
@@ -584,7 +648,11 @@ pub(crate) fn build(
             }
             for &(_, q) in pad_links.iter().filter(|(p, _)| *p == pad) {
                 if let Some(w) = layer.link_weight(pad, q, params, tol) {
-                    let (u, _) = graph.add_vertex(l, q);
+                    // The ring's own sample of `q`, which may have been snapped to a vertex of
+                    // the layer below.
+                    let u = graph
+                        .nearest(l, q, tol)
+                        .unwrap_or_else(|| graph.add_vertex(l, q).0);
                     graph.link(v, u, w);
                 }
             }

@@ -15,13 +15,21 @@
 //!    walls); the wire's own rubberband projected into the layer (the *direct connection*) is
 //!    split where it meets those rings and weighted `base_weight` inside the material and
 //!    `outside_weight` across holes and notches; the innermost deflated area (the *infill
-//!    region*) is explored lazily on a grid of 45° steps during the search.
+//!    region*) is explored lazily on a grid of 45° steps during the search. Gaps narrower than
+//!    two perimeter traces (between the pad rows of a fine-pitch part, beside earlier channels)
+//!    hold no deflated trace; the *squeeze region*, where a channel still fits clear of other
+//!    nets' keep-outs and one perimeter inside the walls, adds its own rings and grid there at
+//!    `squeeze_weight` (above every perimeter weight, so it is used only where nothing else
+//!    gets through).
 //! 2. **Inter-layer connections** (`interlayer.rs`): a route may change layer where its last
 //!    `interlayer_overlap + grid_step` millimetres can be printed on the neighbour layer too; that
 //!    piece is printed on both layers (the staircase overlap), so the traces of consecutive layers
 //!    touch over at least `interlayer_overlap` mm.
 //! 3. **A\*** (`astar.rs`) per wire, steppable ([`Search::step`]), deterministic; the path found
-//!    is pulled taut layer by layer (`smooth.rs`) before it becomes the trace (`trace.rs`).
+//!    is pulled taut layer by layer (`smooth.rs`) before it becomes the trace (`trace.rs`). A
+//!    wire's target is its far pad or any trace of its net already connected to that pad: the
+//!    route may end on that copper as a T joint ([`WireRoute::ends_on_wire`]), so a net is
+//!    built as a tree on its copper, not only pad to pad.
 //! 4. **Collisions and order** (`order.rs`, `channels.rs`, `board.rs`): wires are routed one
 //!    after another, fewest rubberband collisions first, then shortest; each routed wire's
 //!    channel becomes a hole in the islands of the following wires of other nets (new perimeter
@@ -30,7 +38,8 @@
 //!    of adjacent layers would touch, and one route passes over another only with a layer of
 //!    plastic between them. Other nets' pads are holes and keep-outs on their layer and the two
 //!    next to it (where the start of their own trace would be touched). Wires that fail get
-//!    rounds of rip-up and reroute: the wires in their way are routed again after them.
+//!    rounds of rip-up and reroute: the wires in their way are routed again after them, and an
+//!    attempt is kept only if it leaves more wires routed.
 //!
 //! Units: millimetres in the public types, nanometre integers ([`Point2`]) inside.
 
@@ -125,6 +134,12 @@ pub struct RouteParams {
     /// of one island (default 100, so a route crosses a hole only when going around costs more
     /// than 100 times the crossing). Gaps between separate islands are never bridged.
     pub outside_weight: f64,
+    /// Cost multiplier per mm of grid edges outside the infill region, through gaps the
+    /// deflated perimeter traces do not reach (between pad rows, beside earlier channels),
+    /// where a channel still fits one perimeter inside the walls (default 4.0: above every
+    /// perimeter weight, so such gaps are used only where the graph has no other way;
+    /// infinity turns them off).
+    pub squeeze_weight: f64,
     /// Step of the lazily explored infill grid, mm (default 1.0).
     pub grid_step: f64,
     /// Minimum xy overlap of the traces of two consecutive layers at a layer change, mm
@@ -166,6 +181,7 @@ impl Default for RouteParams {
             perimeter_weights: vec![3.0, 2.0, 1.0],
             base_weight: 1.0,
             outside_weight: 100.0,
+            squeeze_weight: 4.0,
             grid_step: 1.0,
             interlayer_overlap: 2.0,
             layer_change_penalty: 5.0,
@@ -209,13 +225,19 @@ pub struct WireRoute {
     /// Length of the conductor's centreline from pad to pad, mm, in 3D: layer changes add their
     /// z step, staircase overlaps are counted once.
     pub length: f64,
-    /// Straight 3D distance between the pads, mm: no route is shorter.
+    /// Straight 3D distance between the route's ends, mm: no route is shorter. That is the
+    /// pads, or, for a route that ends on a trace of its net ([`WireRoute::ends_on_wire`]), the
+    /// start pad and the point of that trace.
     pub lower_bound: f64,
     /// Number of layer changes.
     pub layer_changes: usize,
     /// Crossings of the route with the layers' original island boundaries (outer perimeters and
     /// hole walls): each outside section of a route adds two.
     pub perimeter_crossings: usize,
+    /// The wire (index in the input) whose trace this route ends on, as a T joint, instead of
+    /// running to its `to` pad: that trace is already connected to the pad. `None` when the
+    /// route ends at the pad.
+    pub ends_on_wire: Option<usize>,
 }
 
 /// Routes of all wires and the channels to carve.

@@ -473,3 +473,78 @@ fn routes_are_pulled_taut() {
         }
     }
 }
+
+#[test]
+fn a_wire_may_end_on_its_nets_trace_as_a_t_joint() {
+    // Net "n": C–A (12.8 mm) is routed first; B is 30 mm from A but only 21.5 mm from C, the
+    // far end of A's trace: B's wire ends on that trace instead of running beside it to A.
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 30.0))], 3);
+    let z = top(&layers);
+    let (a, b, c) = ((5.0, 5.0, z), (35.0, 5.0, z), (15.0, 13.0, z));
+    let wires = [wire("n", a, b), wire("n", c, a)];
+    let result = route(&layers, &wires, &end_pads(&wires), &RouteParams::default());
+    let (ab, ca) = (&result.wires[0], &result.wires[1]);
+    assert!(ab.routed && ca.routed, "{result:?}");
+    assert_eq!((ab.ends_on_wire, ca.ends_on_wire), (Some(1), None));
+    let trace: Vec<Point3> = ca.segments.iter().flat_map(|(_, p)| p.clone()).collect();
+    let (_, last) = ab.segments.last().expect("a segment");
+    let end = last.last().expect("a point");
+    assert!(
+        distance_to_polyline(end, &trace) < 1e-3,
+        "{end:?} off {trace:?}"
+    );
+    // It starts at B (the pad with no copper yet) and is far shorter than B to A.
+    let (_, first) = &ab.segments[0];
+    assert!((first[0].x - b.0).abs() < 1e-6 && (first[0].y - b.1).abs() < 1e-6);
+    let straight = ((end.x - b.0).powi(2) + (end.y - b.1).powi(2)).sqrt();
+    assert!((ab.lower_bound - straight).abs() < 1e-6, "{ab:?}");
+    assert!(ab.length >= ab.lower_bound - 1e-9);
+    assert!(ab.length < 24.0, "{ab:?}");
+}
+
+#[test]
+fn a_gap_too_narrow_for_perimeter_traces_is_squeezed_through() {
+    // Two wide pads of net "x" close a 40 mm plate but for a 1.4 mm gap at x = 20: too narrow
+    // for a deflated trace on each side (2 × (0.1 + 0.75) mm), wide enough for one channel clear
+    // of both keep-outs. One layer, so the wire cannot pass over them.
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 30.0))], 1);
+    let z = top(&layers);
+    let w = wire("s", (10.0, 4.0, z), (30.0, 26.0, z));
+    let mut pads = end_pads(std::slice::from_ref(&w));
+    for (x0, x1) in [(-1.0, 19.3), (20.7, 41.0)] {
+        pads.push(PadCopper {
+            net: Some("x".into()),
+            z,
+            outline: rect(x0, 10.0, x1, 18.0),
+        });
+    }
+    let squeezed = route(
+        &layers,
+        std::slice::from_ref(&w),
+        &pads,
+        &RouteParams::default(),
+    );
+    let r = &squeezed.wires[0];
+    assert!(r.routed, "{r:?}");
+    // Where the trace crosses the middle of the pads (y = 14), it is in the gap, a keep-out
+    // (0.41 mm) clear of both pads.
+    let crossings: Vec<f64> = r
+        .segments
+        .iter()
+        .flat_map(|(_, p)| p.windows(2))
+        .filter(|s| (s[0].y - 14.0) * (s[1].y - 14.0) <= 0.0 && s[0].y != s[1].y)
+        .map(|s| s[0].x + (14.0 - s[0].y) / (s[1].y - s[0].y) * (s[1].x - s[0].x))
+        .collect();
+    assert_eq!(crossings.len(), 1, "{r:?}");
+    assert!(
+        crossings[0] > 19.3 + 0.4 && crossings[0] < 20.7 - 0.4,
+        "{crossings:?}"
+    );
+    // Without the squeeze region the gap is closed.
+    let params = RouteParams {
+        squeeze_weight: f64::INFINITY,
+        ..RouteParams::default()
+    };
+    let closed = route(&layers, std::slice::from_ref(&w), &pads, &params);
+    assert!(!closed.wires[0].routed, "{:?}", closed.wires[0]);
+}

@@ -20,6 +20,7 @@ pub(crate) fn unrouted(wire: &Wire) -> WireRoute {
         lower_bound: (wire.to - wire.from).norm(),
         layer_changes: 0,
         perimeter_crossings: 0,
+        ends_on_wire: None,
     }
 }
 
@@ -54,7 +55,9 @@ struct Run {
 
 /// The route of `wire` along `path` (vertices from source to target, each with the staircase
 /// piece of the layer change into it, if any), each layer's run pulled taut (`smooth.rs`);
-/// `tol` (scaled units) is the boundary tolerance.
+/// `tol` (scaled units) is the boundary tolerance. With `end` (a point on the trace of another
+/// wire of the net, and that wire) the route ends there, on the layer of the path's last
+/// vertex, instead of at the `to` pad.
 pub(crate) fn assemble(
     wire: &Wire,
     layers: &[PreparedLayer],
@@ -62,6 +65,7 @@ pub(crate) fn assemble(
     path: &[(VertexId, Option<u32>)],
     overlaps: &[Vec<Point2>],
     tol: i64,
+    end: Option<(Point2, usize)>,
 ) -> WireRoute {
     let lo = layers.first().map_or(0, |l| l.index);
     let z_of = |l: usize| layers[l - lo].z;
@@ -82,6 +86,11 @@ pub(crate) fn assemble(
                 },
                 own: vec![p],
             }),
+        }
+    }
+    if let (Some((q, _)), Some(run)) = (end, runs.last_mut()) {
+        if run.own.last() != Some(&q) {
+            run.own.push(q);
         }
     }
     // Pull each run taut, keeping its ends and the points the next layer's piece repeats.
@@ -106,7 +115,11 @@ pub(crate) fn assemble(
             prev = here;
         }
     }
-    length += (wire.to - prev).norm();
+    let finish = match (end, runs.last()) {
+        (Some((q, _)), Some(run)) => at(q, z_of(run.layer)),
+        _ => wire.to,
+    };
+    length += (finish - prev).norm();
     let layer_changes = runs.len().saturating_sub(1);
     let segments: Vec<(usize, Vec<Point2>)> = runs
         .into_iter()
@@ -135,8 +148,9 @@ pub(crate) fn assemble(
             })
             .collect(),
         length,
-        lower_bound: (wire.to - wire.from).norm(),
+        lower_bound: (finish - wire.from).norm(),
         layer_changes,
         perimeter_crossings,
+        ends_on_wire: end.map(|(_, w)| w),
     }
 }
