@@ -138,7 +138,8 @@ harness_path, gcode_path, binary, circuit, placement = sys.argv[1:6]
 spec = importlib.util.spec_from_file_location("harness", harness_path)
 harness = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(harness)
-module = harness.load_script_class(tempfile.mkdtemp(prefix="conduit-cura-e2e-"))
+scratch = tempfile.TemporaryDirectory(prefix="conduit-cura-e2e-")
+module = harness.load_script_class(scratch.name)
 text = open(gcode_path).read()
 pieces, current = [], ""
 for line in text.splitlines(keepends=True):
@@ -152,6 +153,7 @@ script.values = {"conduit_path": binary, "circuit": circuit, "placement": placem
 result = script.execute(pieces)
 assert isinstance(result, list) and len(result) == len(pieces), (len(result), len(pieces))
 sys.stdout.write("".join(result))
+scratch.cleanup()
 "#;
 
 #[test]
