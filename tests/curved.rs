@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use conduit::config::Config;
+use conduit::curved::collision::{Bead, Head, ReplayHit, ReplayTolerances, replay};
 use conduit::curved::{HeightField, LAYER_COMMENT};
+use conduit::geom::Point3;
 use conduit::pipeline::place_on_bed;
 use conduit::scene::{LoadOptions, load_scene};
 use serde_json::Value;
@@ -18,7 +20,7 @@ type Tri = [[f64; 3]; 3];
 
 /// A closed block over `[x0, x1] × [y0, y1]`, bottom at z = 0, top z = f(x, y) triangulated on
 /// an `n × n` grid (walls split to match, so every edge is shared by two triangles).
-fn block_with_top(
+pub(crate) fn block_with_top(
     x0: f64,
     y0: f64,
     x1: f64,
@@ -60,7 +62,7 @@ fn block_with_top(
     t
 }
 
-fn write_stl(path: &Path, tris: &[Tri]) {
+pub(crate) fn write_stl(path: &Path, tris: &[Tri]) {
     let mut out = vec![0u8; 80];
     out.extend((tris.len() as u32).to_le_bytes());
     for t in tris {
@@ -152,6 +154,104 @@ fn curved_points(gcode: &str) -> Vec<([f64; 3], f64)> {
     out
 }
 
+/// Every extruding move of `gcode` as a bead (nozzle path, `;WIDTH:`/`;HEIGHT:` in effect),
+/// and the index of the first bead of the first curved layer.
+fn beads(gcode: &str) -> (Vec<Bead>, Option<usize>) {
+    let (mut pos, mut e) = ([0.0f64; 3], 0.0f64);
+    let (mut width, mut height) = (0.45, 0.2);
+    let mut relative_e = false;
+    let mut out = Vec::new();
+    let mut first_curved = None;
+    // Beads of curved layers lie on the surface, no steeper than curved.max_angle.
+    let mut lean_deg = 0.0;
+    let max_angle = Config::default().curved.max_angle;
+    for line in gcode.lines() {
+        if line.starts_with(&format!("; {LAYER_COMMENT} layer ")) {
+            first_curved.get_or_insert(out.len());
+            lean_deg = max_angle;
+        }
+        if line.starts_with(";LAYER_CHANGE") {
+            lean_deg = 0.0;
+        }
+        if let Some(v) = line.strip_prefix(";WIDTH:") {
+            width = v.trim().parse().unwrap_or(width);
+        }
+        if let Some(v) = line.strip_prefix(";HEIGHT:") {
+            height = v.trim().parse().unwrap_or(height);
+        }
+        let code = line.split(';').next().unwrap_or("").trim();
+        let mut words = code.split_whitespace();
+        let Some(cmd) = words.next() else { continue };
+        match cmd {
+            "M82" => relative_e = false,
+            "M83" => relative_e = true,
+            _ => {}
+        }
+        let from = pos;
+        let mut new_e = None;
+        for w in words {
+            let (k, v) = w.split_at(1);
+            let Ok(v) = v.parse::<f64>() else { continue };
+            match (cmd, k) {
+                ("G0" | "G1", "X") => pos[0] = v,
+                ("G0" | "G1", "Y") => pos[1] = v,
+                ("G0" | "G1", "Z") => pos[2] = v,
+                ("G0" | "G1", "E") => new_e = Some(v),
+                ("G92", "E") => e = v,
+                _ => {}
+            }
+        }
+        if let Some(ne) = new_e {
+            let de = if relative_e { ne } else { ne - e };
+            if !relative_e {
+                e = ne;
+            }
+            if de > 0.0 && (from[0] != pos[0] || from[1] != pos[1]) {
+                out.push(Bead {
+                    from: Point3::new(from[0], from[1], from[2]),
+                    to: Point3::new(pos[0], pos[1], pos[2]),
+                    width,
+                    height,
+                    lean_deg,
+                });
+            }
+        }
+    }
+    (out, first_curved)
+}
+
+/// Replays every extrusion from the first curved layer on against the default head and all
+/// material printed before it: the hits and the number of beads replayed.
+fn head_hits(name: &str, gcode: &str) -> (Vec<ReplayHit>, Vec<Bead>, usize) {
+    let (beads, first) = beads(gcode);
+    let Some(first) = first else {
+        panic!("{name}: no curved layer")
+    };
+    let c = Config::default().curved;
+    let head = Head {
+        angle_deg: c.head_angle,
+        height: c.head_height,
+        carriage_radius: c.carriage_radius,
+        carriage_clearance: c.carriage_clearance,
+    };
+    let hits = replay(&beads, first, &head, &ReplayTolerances::default());
+    (hits, beads, first)
+}
+
+/// [`head_hits`] finds nothing; returns the number of beads replayed.
+fn assert_no_head_hits(name: &str, gcode: &str) -> usize {
+    let (hits, beads, first) = head_hits(name, gcode);
+    assert!(
+        hits.is_empty(),
+        "{name}: {} of {} beads hit, first {:?} against {:?}",
+        hits.len(),
+        beads.len() - first,
+        hits[0],
+        beads[hits[0].earlier]
+    );
+    beads.len() - first
+}
+
 /// The placed mesh's height field (the slice centres the footprint on the bed).
 fn placed_surface(model: &Path) -> HeightField {
     let (scene, _) = load_scene(model, &LoadOptions::default()).expect("the model loads");
@@ -159,7 +259,7 @@ fn placed_surface(model: &Path) -> HeightField {
     HeightField::from_mesh(&meshes[0])
 }
 
-fn dome(x: f64, y: f64) -> f64 {
+pub(crate) fn dome(x: f64, y: f64) -> f64 {
     8.0 + 2.5 * (1.0 - ((x - 15.0).powi(2) + (y - 15.0).powi(2)) / 450.0)
 }
 
@@ -181,6 +281,7 @@ fn curved_gentle_dome_follows_the_surface_at_each_depth() {
         worst = worst.max((p[2] - (s - depth)).abs());
     }
     assert!(worst < 0.01, "worst {worst}");
+    assert_no_head_hits("dome", &run.gcode);
     let c = &run.report["curved"];
     assert_eq!(c["regions"].as_array().map(Vec::len), Some(1), "{c}");
     for layer in c["regions"][0]["layers"].as_array().into_iter().flatten() {
@@ -229,11 +330,12 @@ fn curved_steep_roof_is_rejected_with_position_and_setting() {
 }
 
 #[test]
-fn curved_slope_beside_a_tall_wall_is_rejected_for_the_head() {
+fn curved_slope_beside_a_tall_wall_is_trimmed_where_the_head_would_hit() {
     let dir = temp_dir();
     let model = dir.path().join("wall.stl");
     // A roof falling from 10 mm to 5.5 mm towards a 20 mm wall 1 mm away: when the roof's
-    // curved layers are printed the wall already stands 10 mm tall beside its low end.
+    // curved layers are printed the wall stands as tall as the roof's top planar layer
+    // (z = 9.8 over the slicing plane 9.7) beside its low end.
     let mut tris = block_with_top(0.0, 0.0, 30.0, 20.0, 10, &|x, _| 10.0 - 0.15 * x);
     tris.extend(block_with_top(31.0, 0.0, 34.0, 20.0, 1, &|_, _| 20.0));
     write_stl(&model, &tris);
@@ -245,41 +347,337 @@ fn curved_slope_beside_a_tall_wall_is_rejected_for_the_head() {
         .flatten()
         .filter(|r| r["kind"] == "head_collision")
         .collect();
-    assert_eq!(hits.len(), 1, "{c}");
-    assert!(
-        hits[0]["reason"]
-            .as_str()
-            .is_some_and(|s| s.contains("cone")),
-        "{}",
-        hits[0]
+    assert!(!hits.is_empty(), "{c}");
+    for hit in &hits {
+        assert!(
+            hit["reason"]
+                .as_str()
+                .is_some_and(|s| s.contains("cone") && s.contains("rim")),
+            "{hit}"
+        );
+        assert!(
+            hit["setting"]
+                .as_str()
+                .is_some_and(|s| s.contains("curved.head_angle")),
+            "{hit}"
+        );
+        // Reported at the roof's low end, beside the wall.
+        let x = hit["position"][0].as_f64().unwrap_or(0.0) - bed_offset(&model)[0];
+        assert!(x > 20.0 && x < 30.0, "{hit}");
+    }
+    // The rest of the roof is curved. The cone (60°) with its tip at the top layer,
+    // z = 10 − 0.15·x, meets the wall's top (x = 31, z = 9.8) where 31 − x = tan 60°·(9.8 − z),
+    // i.e. x = 24.87: nothing curved may lie beyond.
+    let region = &c["regions"][0];
+    let (area, curved) = (
+        region["area_mm2"].as_f64().unwrap_or(0.0),
+        region["curved_area_mm2"].as_f64().unwrap_or(0.0),
     );
+    assert!((area - 600.0).abs() < 1.0, "{region}");
     assert!(
-        hits[0]["setting"]
-            .as_str()
-            .is_some_and(|s| s.contains("curved.head_angle"))
+        curved > 0.6 * area && curved < area - 20.0 * 5.0,
+        "{region}"
     );
-    // With a narrow head the same roof is curved.
+    let off = bed_offset(&model);
+    let max_x = curved_segments(&run.gcode)
+        .iter()
+        .flat_map(|(a, b, _)| [a[0], b[0]])
+        .fold(f64::MIN, f64::max)
+        - off[0];
+    let limit = 31.0 - 60f64.to_radians().tan() * (9.8 - (10.0 - 0.15 * 24.87));
+    assert!(max_x > 20.0 && max_x < limit + 1e-6, "{max_x} vs {limit}");
+    assert_no_head_hits("wall", &run.gcode);
+    // With a narrow head the whole roof is curved.
     let run = slice(
         dir.path(),
         &model,
         "narrow",
         &["--set", "curved.head_angle=5"],
     );
-    assert_eq!(
-        run.report["curved"]["regions"].as_array().map(Vec::len),
-        Some(1),
-        "{}",
-        run.report["curved"]
-    );
+    let region = &run.report["curved"]["regions"][0];
+    let curved = region["curved_area_mm2"].as_f64().unwrap_or(0.0);
+    assert!((curved - 600.0).abs() < 1.0, "{}", run.report["curved"]);
+    // ... and the replay with the real (60°) head finds it running into the wall.
+    let (hits, beads, _) = head_hits("narrow", &run.gcode);
+    assert!(!hits.is_empty());
+    for h in &hits {
+        let wall = &beads[h.earlier];
+        assert!(wall.from.x - off[0] > 30.5 && h.hit.rise() > 0.2, "{h:?}");
+    }
+}
+
+/// Where the slice moved the model: placed minus original xy of the first vertex.
+fn bed_offset(model: &Path) -> [f64; 2] {
+    let (scene, _) = load_scene(model, &LoadOptions::default()).expect("the model loads");
+    let placed = place_on_bed(&scene, &Config::default());
+    let (a, b) = (scene.objects[0].mesh.vertices[0], placed[0].vertices[0]);
+    [b.x - a.x, b.y - a.y]
+}
+
+/// Every extruding move inside the curved blocks as (start, end, depth of its block).
+pub(crate) fn curved_segments(gcode: &str) -> Vec<([f64; 3], [f64; 3], f64)> {
+    let mut out = Vec::new();
+    let mut depth: Option<f64> = None;
+    let mut pos = [0.0f64; 3];
+    let (beads, _) = beads(gcode);
+    // Pair each bead with the block it is in by replaying the comments in step.
+    let mut it = beads.iter();
+    let (mut e, mut relative_e) = (0.0f64, false);
+    for line in gcode.lines() {
+        if let Some(rest) = line.strip_prefix(&format!("; {LAYER_COMMENT} layer ")) {
+            depth = rest.split_whitespace().nth(2).and_then(|d| d.parse().ok());
+            continue;
+        }
+        if line.starts_with(";LAYER_CHANGE") {
+            depth = None;
+        }
+        let code = line.split(';').next().unwrap_or("").trim();
+        let mut words = code.split_whitespace();
+        let Some(cmd) = words.next() else { continue };
+        match cmd {
+            "M82" => relative_e = false,
+            "M83" => relative_e = true,
+            _ => {}
+        }
+        let from = pos;
+        let mut new_e = None;
+        for w in words {
+            let (k, v) = w.split_at(1);
+            let Ok(v) = v.parse::<f64>() else { continue };
+            match (cmd, k) {
+                ("G0" | "G1", "X") => pos[0] = v,
+                ("G0" | "G1", "Y") => pos[1] = v,
+                ("G0" | "G1", "Z") => pos[2] = v,
+                ("G0" | "G1", "E") => new_e = Some(v),
+                ("G92", "E") => e = v,
+                _ => {}
+            }
+        }
+        if let Some(ne) = new_e {
+            let de = if relative_e { ne } else { ne - e };
+            if !relative_e {
+                e = ne;
+            }
+            if de > 0.0 && (from[0] != pos[0] || from[1] != pos[1]) {
+                let b = it.next();
+                assert!(b.is_some_and(|b| b.to.x == pos[0] && b.to.y == pos[1]));
+                if let Some(d) = depth {
+                    out.push((from, pos, d));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Largest error of the curved points (segment ends) and of the segments' midpoints from
+/// surface − depth, with the number of segments, for segments whose `depth` passes `keep`.
+fn surface_errors(hf: &HeightField, gcode: &str, keep: impl Fn(f64) -> bool) -> (usize, f64, f64) {
+    let (mut n, mut worst_point, mut worst_mid) = (0, 0.0f64, 0.0f64);
+    for (a, b, depth) in curved_segments(gcode) {
+        if !keep(depth) {
+            continue;
+        }
+        n += 1;
+        let off = |p: [f64; 3]| match hf.at(p[0], p[1]) {
+            Some(s) => (p[2] - (s.z - depth)).abs(),
+            None => panic!("no surface under {p:?}"),
+        };
+        worst_point = worst_point.max(off(a)).max(off(b));
+        let mid = [
+            (a[0] + b[0]) / 2.0,
+            (a[1] + b[1]) / 2.0,
+            (a[2] + b[2]) / 2.0,
+        ];
+        worst_mid = worst_mid.max(off(mid));
+    }
+    (n, worst_point, worst_mid)
 }
 
 #[test]
-fn curved_corpus_wing_and_car_slice_and_check() {
+fn curved_corpus_wing_and_car_print_curved_tops_on_the_surface_without_head_hits() {
     let Some(corpus) = corpus() else { return };
     let dir = temp_dir();
-    for name in ["wing", "car_med"] {
+    // The gently sloped top of the wing is curved whole; on the car the rims beside steeper
+    // panels are trimmed (and reported) where the head would hit.
+    for (name, min_share) in [("wing", 0.95), ("car_med", 0.6)] {
         let model: PathBuf = corpus.join(format!("curved/curvislicer/{name}.stl"));
         let run = slice(dir.path(), &model, name, &[]);
-        assert!(run.report["curved"].is_object(), "{name}");
+        let c = &run.report["curved"];
+        let regions = c["regions"].as_array().cloned().unwrap_or_default();
+        assert!(!regions.is_empty(), "{name}: {c}");
+        let sum = |key: &str| -> f64 { regions.iter().filter_map(|r| r[key].as_f64()).sum() };
+        let (gentle, curved) = (sum("area_mm2"), sum("curved_area_mm2"));
+        assert!(
+            curved >= min_share * gentle && curved > 100.0,
+            "{name}: {curved} of {gentle} mm² curved"
+        );
+        for r in c["rejections"].as_array().into_iter().flatten() {
+            let pos = r["position"].as_array().map(Vec::len);
+            let reason = r["reason"].as_str().unwrap_or("");
+            assert!(pos == Some(3) && !reason.is_empty(), "{r}");
+        }
+        // Every curved point on surface − k·h; the top layer's segments within 0.05 mm of the
+        // mesh, where the planar print's cusp at this layer height is ≥ 0.1 mm.
+        let hf = placed_surface(&model);
+        let (n, worst_point, _) = surface_errors(&hf, &run.gcode, |_| true);
+        assert!(n > 1000, "{name}: {n} curved segments");
+        assert!(worst_point < 0.01, "{name}: point {worst_point} mm off");
+        let (_, _, worst_top) = surface_errors(&hf, &run.gcode, |d| d == 0.0);
+        for r in &regions {
+            for layer in r["layers"].as_array().into_iter().flatten() {
+                let cusp = layer["planar_cusp"].as_f64().unwrap_or(0.0);
+                let dev = layer["max_deviation"].as_f64().unwrap_or(1.0);
+                assert!(cusp >= 0.1 && dev < 0.05, "{name}: {layer}");
+            }
+        }
+        assert!(
+            worst_top < 0.05,
+            "{name}: top layer {worst_top} mm off the mesh"
+        );
+        let replayed = assert_no_head_hits(name, &run.gcode);
+        assert!(replayed > 1000, "{name}: {replayed}");
+    }
+}
+
+/// Extruding moves of the planar layers (outside the curved blocks): (layer, role, from, to).
+fn planar_segments(gcode: &str) -> Vec<(usize, String, [f64; 3], [f64; 3])> {
+    let (mut pos, mut e) = ([0.0f64; 3], 0.0f64);
+    let (mut layer, mut curved, mut role) = (0usize, false, String::new());
+    let mut out = Vec::new();
+    for line in gcode.lines() {
+        if line.starts_with(";LAYER_CHANGE") {
+            layer += 1;
+            curved = false;
+        }
+        if line.starts_with(&format!("; {LAYER_COMMENT} layer ")) {
+            curved = true;
+        }
+        if let Some(r) = line.strip_prefix(";TYPE:") {
+            role = r.trim().to_owned();
+        }
+        let code = line.split(';').next().unwrap_or("").trim();
+        let mut words = code.split_whitespace();
+        let Some(cmd) = words.next() else { continue };
+        let from = pos;
+        let mut new_e = None;
+        for w in words {
+            let (k, v) = w.split_at(1);
+            let Ok(v) = v.parse::<f64>() else { continue };
+            match (cmd, k) {
+                ("G0" | "G1", "X") => pos[0] = v,
+                ("G0" | "G1", "Y") => pos[1] = v,
+                ("G0" | "G1", "Z") => pos[2] = v,
+                ("G0" | "G1", "E") => new_e = Some(v),
+                ("G92", "E") => e = v,
+                _ => {}
+            }
+        }
+        if let Some(ne) = new_e {
+            if ne > e && !curved && (from[0] != pos[0] || from[1] != pos[1]) {
+                out.push((layer, role.clone(), from, pos));
+            }
+            e = ne;
+        }
+    }
+    out
+}
+
+fn distance_to_segment(p: [f64; 2], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a[0] + t * dx - p[0]).hypot(a[1] + t * dy - p[1])
+}
+
+#[test]
+fn curved_dome_stands_on_solid_planar_layers_and_reports_deviation_beside_the_cusp() {
+    let dir = temp_dir();
+    let model = dir.path().join("dome.stl");
+    write_stl(&model, &block_with_top(0.0, 0.0, 30.0, 30.0, 24, &dome));
+    let run = slice(dir.path(), &model, "dome", &[]);
+    let off = bed_offset(&model);
+    // Under every point of the curved shell, the planar core's top layers are solid: the top
+    // three planar layers at a point are printed there, with solid infill or the perimeters
+    // where the core steps down, never sparse infill.
+    let planar = planar_segments(&run.gcode);
+    let mut checked = 0;
+    for i in 0..12 {
+        for j in 0..12 {
+            let p = [
+                off[0] + 4.0 + i as f64 * 2.0 + 0.3,
+                off[1] + 4.0 + j as f64 * 2.0 + 0.7,
+            ];
+            let mut covering: Vec<(usize, &str)> = planar
+                .iter()
+                .filter(|(_, role, a, b)| role != "Custom" && distance_to_segment(p, *a, *b) < 0.3)
+                .map(|(l, role, ..)| (*l, role.as_str()))
+                .collect();
+            covering.sort_unstable();
+            covering.dedup();
+            // The core's top at p and the two layers under it: solid there, nothing sparse.
+            let Some(&(top, _)) = covering.last() else {
+                panic!("nothing planar under {p:?}")
+            };
+            for l in [top, top - 1, top - 2] {
+                let roles: Vec<&str> = covering
+                    .iter()
+                    .filter(|(k, _)| *k == l)
+                    .map(|(_, r)| *r)
+                    .collect();
+                // Where the core's top steps down a layer its layers end in their perimeters.
+                let solid = |r: &&str| {
+                    matches!(
+                        *r,
+                        "Solid infill" | "Top solid infill" | "Perimeter" | "External perimeter"
+                    )
+                };
+                assert!(
+                    !roles.is_empty() && roles.iter().all(solid),
+                    "{p:?}, layer {l}: {roles:?}"
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 144);
+    // The report: per curved layer its deviation from the target surface (as measured on the
+    // G-code, to its rounding) beside the planar cusp h·cos α of the region's steepest slope;
+    // the dome's steepest slope is at its corners, atan(5·15√2/450) = 13.26°, less the chords.
+    let hf = placed_surface(&model);
+    let region = &run.report["curved"]["regions"][0];
+    let slope = region["max_slope_deg"].as_f64().unwrap_or(0.0);
+    let analytic = (5.0 * 15.0 * 2f64.sqrt() / 450.0).atan().to_degrees();
+    assert!(
+        slope < analytic && slope > analytic - 1.0,
+        "{slope} vs {analytic}"
+    );
+    let layers = region["layers"].as_array().cloned().unwrap_or_default();
+    assert_eq!(layers.len(), 3);
+    for (k, layer) in layers.iter().enumerate() {
+        assert_eq!(layer["k"].as_u64(), Some(k as u64));
+        let depth = k as f64 * 0.2;
+        assert!((layer["depth"].as_f64().unwrap_or(-1.0) - depth).abs() < 1e-9);
+        let cusp = layer["planar_cusp"].as_f64().unwrap_or(0.0);
+        assert!(
+            (cusp - 0.2 * slope.to_radians().cos()).abs() < 1e-9,
+            "{layer}"
+        );
+        let dev = layer["max_deviation"].as_f64().unwrap_or(1.0);
+        let (n, _, measured) = surface_errors(&hf, &run.gcode, |d| (d - depth).abs() < 1e-6);
+        assert!(n > 300, "layer {k}: {n} segments");
+        // The G-code rounds XYZ to 0.001 mm.
+        assert!(
+            dev <= measured + 1e-3 && measured <= dev + 2e-3,
+            "{layer}: {measured}"
+        );
+        assert!(dev < 0.05 && cusp >= 0.1, "{layer}");
+        // The dome has no planar material beside it: every layer covers the whole top.
+        let area = layer["area_mm2"].as_f64().unwrap_or(0.0);
+        assert!((area - 900.0).abs() < 0.5, "{layer}");
     }
 }

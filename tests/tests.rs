@@ -3,11 +3,14 @@
 //! Tests that need the shared corpus (`../shared/corpus` beside the checkout) print
 //! `skipped: corpus not found` and pass when it is absent.
 
+mod clfff;
 mod cli;
+mod conform;
 mod conformance;
 mod curved;
 mod electronics;
 mod electronics_corpus;
+mod jet;
 mod postprocess;
 mod postprocess_e2e;
 mod preview;

@@ -35,6 +35,14 @@ pub enum Command {
     /// Cura, Slic3r...) with its settings (unless `-c` is given) and edit it in place; without a
     /// circuit it only reports what it finds.
     Postprocess(PostprocessArgs),
+    /// Conformal printing: lay a 2D design (SVG) onto a scanned surface (mesh or point cloud),
+    /// register it to the machine, correct the path for the nozzle and write G-code with a
+    /// deposit report.
+    Conform(ConformArgs),
+    /// Aerosol-jet toolpaths for micro-walls from an SVG or DXF design: corner fillets by angle,
+    /// a shutter gap in closed contours that moves every layer, direction reversed every block
+    /// of layers. `conduit jet model ...` evaluates the corner accumulation model.
+    Jet(JetArgs),
 }
 
 /// Where settings come from: a config file plus `--set` overrides.
@@ -73,10 +81,16 @@ pub struct SliceArgs {
     #[arg(long, value_name = "P.toml|P.3de", requires = "circuit")]
     pub placement: Option<PathBuf>,
     /// Curved layers: `tops` prints the top solid layers of gently sloped top surfaces along
-    /// the surface (the `[curved]` settings apply); `off` keeps every layer planar. Overrides
-    /// `curved.mode`.
-    #[arg(long, value_name = "MODE", value_parser = ["tops", "off"])]
+    /// the surface; `clfff` prints a thin shell in curved layers following its bottom surface
+    /// over a planar scaffold (curved-layer FFF); `off` keeps every layer planar. The
+    /// `[curved]` settings apply. Overrides `curved.mode`.
+    #[arg(long, value_name = "MODE", value_parser = ["tops", "clfff", "off"])]
     pub curved: Option<String>,
+    /// With `--curved clfff`: write the scaffold, buffer and model to OUT.scaffold.gcode,
+    /// OUT.buffer.gcode and OUT.model.gcode (for a material change between them) instead of
+    /// one file with a tool per section. Sets `curved.split_sections`.
+    #[arg(long)]
+    pub split_sections: bool,
 }
 
 /// Arguments of `conduit route`.
@@ -133,6 +147,124 @@ pub struct PostprocessArgs {
     /// stays in the output folder).
     #[arg(long, value_name = "NAME")]
     pub output_name: Option<String>,
+}
+
+/// Arguments of `conduit conform`.
+#[derive(Debug, Args)]
+pub struct ConformArgs {
+    /// The scanned surface: a mesh (STL, OBJ, 3MF, PLY with faces) or a point cloud (XYZ, PLY
+    /// without faces), in mm.
+    #[arg(long, value_name = "SCAN")]
+    pub surface: PathBuf,
+    /// Read a PLY with faces as a point cloud (its faces ignored; 2.5D Delaunay of the points).
+    #[arg(long)]
+    pub as_cloud: bool,
+    /// The design: an SVG of paths (centre lines).
+    #[arg(long, value_name = "DESIGN.svg")]
+    pub design: PathBuf,
+    /// Where the design goes on the surface's top view (machine frame): its bounding-box
+    /// centre at x,y (mm), rotated by rot degrees and scaled by scale. Default: the centre of
+    /// the surface, 0, 1.
+    #[arg(long, value_name = "x,y,rot,scale", allow_hyphen_values = true)]
+    pub place: Option<String>,
+    /// Reference points in the scan frame, `x,y,z;x,y,z;x,y,z` (three or more).
+    #[arg(
+        long,
+        value_name = "POINTS",
+        requires = "refs_machine",
+        conflicts_with = "refs_auto",
+        allow_hyphen_values = true
+    )]
+    pub refs_scan: Option<String>,
+    /// The same reference points measured on the machine, in the same order.
+    #[arg(long, value_name = "POINTS", allow_hyphen_values = true)]
+    pub refs_machine: Option<String>,
+    /// Find the reference points in the scan: small holes (markers) up to
+    /// `conform.marker_max_size`, matched to `--refs-machine` in the order that fits best.
+    #[arg(long, requires = "refs_machine")]
+    pub refs_auto: bool,
+    /// `projection` (drop along −z) or `geodesic` (keep arc length). Overrides
+    /// `conform.mapping`.
+    #[arg(long, value_name = "MAPPING", value_parser = ["projection", "geodesic"])]
+    pub mapping: Option<String>,
+    /// Settings (`[conform]`, tools, printer).
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// The G-code file to write.
+    #[arg(short, long, value_name = "OUT.gcode")]
+    pub output: PathBuf,
+    /// Also write the JSON report (geometry, corrections, deposit thickness against the
+    /// controls, contacts, replay).
+    #[arg(long, value_name = "R.json")]
+    pub report: Option<PathBuf>,
+}
+
+/// Arguments of `conduit jet`.
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct JetArgs {
+    /// `model`: evaluate the accumulation model instead of making toolpaths.
+    #[command(subcommand)]
+    pub command: Option<JetCommand>,
+    /// Designs (.svg, .dxf: LINE, LWPOLYLINE, POLYLINE, ARC, CIRCLE); every path is one
+    /// structure, printed layer by layer in turn with the others.
+    #[arg(required = true, value_name = "DESIGN")]
+    pub designs: Vec<PathBuf>,
+    /// Line width, µm.
+    #[arg(long, value_name = "UM", required = true)]
+    pub width: Option<f64>,
+    /// Number of layers.
+    #[arg(long, value_name = "N", required = true, value_parser = clap::value_parser!(u32).range(1..))]
+    pub layers: Option<u32>,
+    /// Layer height, µm.
+    #[arg(long = "layer-height", value_name = "UM", required = true)]
+    pub layer_height: Option<f64>,
+    /// Settings (the `[jet]` section and the jet tool).
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// The G-code file to write.
+    #[arg(short, long, value_name = "OUT.gcode", required = true)]
+    pub output: Option<PathBuf>,
+    /// Also write a JSON report: every corner (angle, rule, fillet, model), gap places, the
+    /// layer plan, totals.
+    #[arg(long, value_name = "R.json")]
+    pub report: Option<PathBuf>,
+}
+
+/// Subcommands of `conduit jet`.
+#[derive(Debug, Subcommand)]
+pub enum JetCommand {
+    /// The corner accumulation model: inside minus outside height of a line at a bend.
+    Model(JetModelArgs),
+}
+
+/// Arguments of `conduit jet model`.
+#[derive(Debug, Args)]
+pub struct JetModelArgs {
+    /// Corner angle between the two segments, degrees (180 = straight).
+    #[arg(long, value_name = "DEG")]
+    pub angle: f64,
+    /// Fillet radius of the line's centre, µm.
+    #[arg(long, value_name = "UM", default_value_t = 0.0)]
+    pub radius: f64,
+    /// Line width, µm.
+    #[arg(long, value_name = "UM")]
+    pub width: f64,
+    /// Line (wall) height, µm.
+    #[arg(long, value_name = "UM")]
+    pub height: f64,
+    /// Region of interest along the centreline, µm; `A..B` for a sweep.
+    #[arg(long, value_name = "UM[..UM]")]
+    pub roi: String,
+    /// Rows of a sweep.
+    #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(2..=1000))]
+    pub steps: u32,
+    /// Settings (for `jet.leveling_factor`).
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `conduit check`.

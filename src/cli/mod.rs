@@ -4,8 +4,10 @@
 mod args;
 mod check;
 mod config;
+mod conform;
 mod convert;
 mod info;
+mod jet;
 mod postprocess;
 mod preview;
 mod progress;
@@ -56,6 +58,8 @@ pub fn run() -> ExitCode {
         args::Command::Preview(a) => preview::run(a),
         args::Command::Route(a) => route::run(a),
         args::Command::Postprocess(a) => postprocess::run(a),
+        args::Command::Conform(a) => conform::run(a),
+        args::Command::Jet(a) => jet::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,7 +4,7 @@ use super::{Failure, args::SliceArgs, config::resolve};
 use anyhow::Context;
 use conduit::circuit::{Circuit, Placement};
 use conduit::pipeline::electronics::pnp_records;
-use conduit::pipeline::{Electronics, Stage, slice_scene_with};
+use conduit::pipeline::{Electronics, Stage, slice_clfff, slice_scene_with};
 use conduit::scene::{LoadOptions, Scene, load_scene, write_atomically};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{IsTerminal, Write};
@@ -13,8 +13,21 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     let mut cfg = resolve(&args.config)?;
     match args.curved.as_deref() {
         Some("tops") => cfg.curved.mode = conduit::config::CurvedMode::Tops,
+        Some("clfff") => cfg.curved.mode = conduit::config::CurvedMode::Clfff,
         Some(_) => cfg.curved.mode = conduit::config::CurvedMode::Off,
         None => {}
+    }
+    if args.split_sections {
+        cfg.curved.split_sections = true;
+    }
+    if cfg.curved.mode == conduit::config::CurvedMode::Clfff {
+        if args.circuit.is_some() {
+            return Err(anyhow::anyhow!(
+                "--curved clfff prints a shell without a circuit; leave out --circuit"
+            )
+            .into());
+        }
+        return run_clfff(&args, &cfg);
     }
     let scene = load_models(&args.models)?;
     let electronics = match (&args.circuit, &args.placement) {
@@ -82,6 +95,74 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         for r in &c.rejections {
             eprintln!("warning: {r}");
         }
+    }
+    Ok(())
+}
+
+/// `conduit slice --curved clfff`: one G-code file, or one per section with
+/// `--split-sections` (`OUT.scaffold.gcode`, `OUT.buffer.gcode`, `OUT.model.gcode`).
+fn run_clfff(args: &SliceArgs, cfg: &conduit::config::Config) -> Result<(), Failure> {
+    let scene = load_models(&args.models)?;
+    let bar = stage_bar();
+    let (files, summary) = slice_clfff(&scene, cfg, |stage| {
+        bar.set_position(stage as u64);
+        bar.set_message(stage.name());
+    })
+    .with_context(|| format!("slicing {}", args.models[0].display()))?;
+    bar.finish_and_clear();
+    let split = cfg.curved.split_sections;
+    for file in &files {
+        let path = match (split, file.sections.first()) {
+            (true, Some(s)) => s.file_name(&args.output),
+            _ => args.output.clone(),
+        };
+        write_atomically(&path, |f| f.write_all(&file.gcode))
+            .with_context(|| format!("{}: cannot write G-code", path.display()))?;
+        let total: f64 = file.stats.tools.iter().map(|t| t.filament_mm).sum();
+        let names: Vec<&str> = file.sections.iter().map(|s| s.name()).collect();
+        eprintln!(
+            "{}: {} ({} program layers), {:.0} mm filament, estimated {:.0} min",
+            path.display(),
+            names.join(" + "),
+            file.program.layers.len(),
+            total,
+            file.stats.estimated_time_s / 60.0
+        );
+    }
+    let mut summary = summary;
+    if split {
+        for s in &mut summary.clfff.sections {
+            s.file = Some(s.section.file_name(&args.output).display().to_string());
+        }
+    }
+    if let Some(report) = &args.report {
+        let json = serde_json::to_vec_pretty(&summary).context("serialising the report")?;
+        write_atomically(report, |f| f.write_all(&json))
+            .with_context(|| format!("{}: cannot write report", report.display()))?;
+    }
+    let r = &summary.clfff;
+    let model_layers = r
+        .layers
+        .iter()
+        .filter(|l| l.section == conduit::curved::clfff::Section::Model)
+        .count();
+    let slowed = if r.z_speed_limited > 0 {
+        format!(
+            ", {} moves slowed for curved.max_z_speed",
+            r.z_speed_limited
+        )
+    } else {
+        String::new()
+    };
+    eprintln!(
+        "clfff: {} scaffold layers, {} buffer layer(s), {} curved layers, {} collision(s){slowed}",
+        r.scaffold.layers,
+        r.layers.len() - model_layers,
+        model_layers,
+        r.collisions.count
+    );
+    for w in r.warnings() {
+        eprintln!("warning: {w}");
     }
     Ok(())
 }

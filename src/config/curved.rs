@@ -1,8 +1,10 @@
-//! The `[curved]` section of the configuration: non-planar top surfaces.
+//! The `[curved]` section of the configuration: non-planar top surfaces (`mode = "tops"`) and
+//! curved-layer FFF of thin shells (`mode = "clfff"`).
 //!
 //! Place in the pipeline: read with the rest of [`super::Config`]; the pipeline hands it to
 //! [`crate::curved`], which runs between slicing and the regions stage and adds the curved
-//! layers to the Program.
+//! layers to the Program (tops), or to [`crate::curved::clfff`], which replaces the planar
+//! pipeline with scaffold, buffer and curved layers (clfff).
 
 use serde::{Deserialize, Serialize};
 
@@ -15,6 +17,9 @@ pub enum CurvedMode {
     Off,
     /// Planar body; the top solid layers of gently sloped top surfaces follow the surface.
     Tops,
+    /// Curved-layer FFF of a thin shell: planar scaffold, optional buffer layer, then layers
+    /// that follow the shell's bottom surface offset along z.
+    Clfff,
 }
 
 /// Non-planar top surfaces (`[curved]`). Lengths in mm, angles in degrees from the horizontal
@@ -22,7 +27,8 @@ pub enum CurvedMode {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CurvedSettings {
-    /// `"off"` or `"tops"` (also set by `conduit slice --curved tops`). Default `"off"`.
+    /// `"off"`, `"tops"` or `"clfff"` (also set by `conduit slice --curved tops|clfff`).
+    /// Default `"off"`.
     pub mode: CurvedMode,
     /// Steepest surface slope printed curved, degrees from the horizontal; steeper top surfaces
     /// stay planar (the nozzle would plough its own bead). Default 15.
@@ -43,6 +49,53 @@ pub struct CurvedSettings {
     /// Fastest z motion while extruding, mm/s: moves that would rise or fall faster are
     /// slowed. Default 10.
     pub max_z_speed: f64,
+    /// clfff: height of the model's lowest point above the bed, room for scaffold under it, mm
+    /// (with a buffer layer, the buffer's lowest point sits there). Default 2.
+    pub raise: f64,
+    /// clfff: print a planar scaffold under the shell. Default true.
+    pub scaffold: bool,
+    /// clfff: how far the scaffold area (the convex hull of the shell's top-down outline)
+    /// is grown, mm. Default 3.
+    pub scaffold_margin: f64,
+    /// clfff: directions [x, y] of the scaffold's lines; scaffold layer `j` uses vector
+    /// `j mod n`, so two crossing vectors make a grid over two layers. Default
+    /// [[1, 0], [0, 1]].
+    pub scaffold_vectors: Vec<[f64; 2]>,
+    /// clfff: distance between neighbouring scaffold lines, mm. Default 1.
+    pub scaffold_spacing: f64,
+    /// clfff: tool printing the scaffold (e.g. PLA). Default 0.
+    pub scaffold_tool: usize,
+    /// clfff: gap between the scaffold's top and the bottom of the lowest curved layer (the
+    /// buffer, or the first model layer), mm: no scaffold point is higher than the shell's
+    /// bottom surface minus the buffer height minus this. Default 0.2.
+    pub scaffold_clearance: f64,
+    /// clfff: print one buffer layer (e.g. TPE) following the bottom surface between the
+    /// scaffold and the model. Default false.
+    pub buffer: bool,
+    /// clfff: tool printing the buffer layer. Default 0.
+    pub buffer_tool: usize,
+    /// clfff: number of curved model layers; 0 = the shell's median thickness divided by the
+    /// layer height. Default 3.
+    pub layers: usize,
+    /// clfff: raster angle of each curved layer, degrees from +X, cycled through the layers.
+    /// Default [0, 90].
+    pub angles: Vec<f64>,
+    /// clfff: how far above the highest material under a travel the nozzle passes, mm.
+    /// Default 1.
+    pub travel_clearance: f64,
+    /// clfff: write the scaffold, buffer and model as separate files (`OUT.scaffold.gcode`,
+    /// `OUT.buffer.gcode`, `OUT.model.gcode`) instead of one file with tool changes (also
+    /// `conduit slice --split-sections`). Default false.
+    pub split_sections: bool,
+    /// clfff: print a thick part as a sandwich: `curved.layers` bottom skin layers following
+    /// the bottom surface, a planar core (the `[slice]` perimeters and infill, no solid layers
+    /// of its own) between the skins, then `curved.top_layers` top skin layers following the
+    /// top surface, the last on it. `curved.layers = 0` gives the bottom skin as many layers as
+    /// the top. Default false.
+    pub sandwich: bool,
+    /// clfff sandwich: number of top skin layers (nozzle at top surface − (n − 1 − j)·h,
+    /// j = 0 … n − 1). Default 3.
+    pub top_layers: usize,
 }
 
 impl Default for CurvedSettings {
@@ -56,6 +109,21 @@ impl Default for CurvedSettings {
             carriage_radius: 0.0,
             carriage_clearance: 10.0,
             max_z_speed: 10.0,
+            raise: 2.0,
+            scaffold: true,
+            scaffold_margin: 3.0,
+            scaffold_vectors: vec![[1.0, 0.0], [0.0, 1.0]],
+            scaffold_spacing: 1.0,
+            scaffold_tool: 0,
+            scaffold_clearance: 0.2,
+            buffer: false,
+            buffer_tool: 0,
+            layers: 3,
+            angles: vec![0.0, 90.0],
+            travel_clearance: 1.0,
+            split_sections: false,
+            sandwich: false,
+            top_layers: 3,
         }
     }
 }
@@ -72,11 +140,42 @@ impl CurvedSettings {
             ("carriage_radius", self.carriage_radius, 0.0, 1000.0),
             ("carriage_clearance", self.carriage_clearance, 0.0, 1000.0),
             ("max_z_speed", self.max_z_speed, 0.01, 10000.0),
+            ("raise", self.raise, 0.0, 1000.0),
+            ("scaffold_margin", self.scaffold_margin, 0.0, 1000.0),
+            ("scaffold_spacing", self.scaffold_spacing, 0.1, 1000.0),
+            ("scaffold_clearance", self.scaffold_clearance, 0.0, 100.0),
+            ("travel_clearance", self.travel_clearance, 0.0, 100.0),
         ];
         for (key, v, lo, hi) in ranges {
             if !(v.is_finite() && v >= lo && v <= hi) {
                 out.push(format!("curved.{key} must be in {lo}..={hi}, got {v}"));
             }
+        }
+        if self.scaffold_vectors.is_empty() {
+            out.push("curved.scaffold_vectors must list at least one direction".to_owned());
+        }
+        for v in &self.scaffold_vectors {
+            let len = v[0].hypot(v[1]);
+            if !(len.is_finite() && len > 0.0) {
+                out.push(format!(
+                    "curved.scaffold_vectors: [{}, {}] is not a direction",
+                    v[0], v[1]
+                ));
+            }
+        }
+        if self.angles.is_empty() {
+            out.push("curved.angles must list at least one angle".to_owned());
+        }
+        for a in &self.angles {
+            if !a.is_finite() {
+                out.push(format!("curved.angles: {a} is not an angle"));
+            }
+        }
+        if !(1..=1000).contains(&self.top_layers) {
+            out.push(format!(
+                "curved.top_layers must be in 1..=1000, got {}",
+                self.top_layers
+            ));
         }
         out
     }

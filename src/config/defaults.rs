@@ -58,7 +58,18 @@ const SECTION_DOCS: &[(&str, &str)] = &[
     ),
     (
         "curved",
-        "Non-planar top surfaces: top solid layers of gentle top surfaces follow the surface.",
+        "Non-planar printing: top solid layers of gentle top surfaces follow the surface (\"tops\"), or\n\
+         a thin shell is printed as curved layers over a planar scaffold (\"clfff\").",
+    ),
+    (
+        "conform",
+        "Conformal printing (conduit conform): a 2D design laid onto a scanned surface and printed with\n\
+         a micro-extrusion nozzle: nozzle geometry, corrections, deposit thresholds, pressure snippets.",
+    ),
+    (
+        "jet",
+        "Aerosol jet (conduit jet): corner fillet rules, shutter gap, direction blocks, shutter G-code,\n\
+         fill and the corner accumulation model. Lengths mm (the command line takes µm).",
     ),
 ];
 
@@ -521,7 +532,8 @@ const KEYS: &[KeyDoc] = &[
     k(
         "curved",
         "mode",
-        "\"off\" or \"tops\" (curved top surfaces; also `conduit slice --curved tops`).",
+        "\"off\", \"tops\" (curved top surfaces) or \"clfff\" (curved-layer shells); also \
+         `conduit slice --curved MODE`.",
     ),
     k(
         "curved",
@@ -557,6 +569,271 @@ const KEYS: &[KeyDoc] = &[
         "curved",
         "max_z_speed",
         "Fastest z motion while extruding, mm/s; faster moves are slowed.",
+    ),
+    k(
+        "curved",
+        "raise",
+        "clfff: height of the shell's lowest point (or its buffer's) above the bed, room for \
+         scaffold, mm.",
+    ),
+    k(
+        "curved",
+        "scaffold",
+        "clfff: print a planar scaffold under the shell.",
+    ),
+    k(
+        "curved",
+        "scaffold_margin",
+        "clfff: growth of the scaffold area (convex hull of the shell's outline), mm.",
+    ),
+    k(
+        "curved",
+        "scaffold_vectors",
+        "clfff: directions [x, y] of the scaffold lines, one per layer, cycled (two make a grid).",
+    ),
+    k(
+        "curved",
+        "scaffold_spacing",
+        "clfff: distance between neighbouring scaffold lines, mm.",
+    ),
+    k(
+        "curved",
+        "scaffold_tool",
+        "clfff: tool printing the scaffold.",
+    ),
+    k(
+        "curved",
+        "scaffold_clearance",
+        "clfff: gap between the scaffold's top and the bottom of the lowest curved layer, mm.",
+    ),
+    k(
+        "curved",
+        "buffer",
+        "clfff: print one buffer layer following the bottom surface between scaffold and model.",
+    ),
+    k(
+        "curved",
+        "buffer_tool",
+        "clfff: tool printing the buffer layer.",
+    ),
+    k(
+        "curved",
+        "layers",
+        "clfff: number of curved model layers; 0 = the shell's median thickness / layer height.",
+    ),
+    k(
+        "curved",
+        "angles",
+        "clfff: raster angle of each curved layer, degrees from +X, cycled through the layers.",
+    ),
+    k(
+        "curved",
+        "travel_clearance",
+        "clfff: how far above the highest material under a travel the nozzle passes, mm.",
+    ),
+    k(
+        "curved",
+        "split_sections",
+        "clfff: write OUT.scaffold.gcode, OUT.buffer.gcode and OUT.model.gcode instead of one \
+         file (also --split-sections).",
+    ),
+    k(
+        "curved",
+        "sandwich",
+        "clfff: thick part as a curved bottom skin (curved.layers), a planar core and a curved \
+         top skin (curved.top_layers).",
+    ),
+    k(
+        "curved",
+        "top_layers",
+        "clfff sandwich: number of top skin layers, the last on the top surface.",
+    ),
+    k(
+        "conform",
+        "tool",
+        "Tool that dispenses (a paste tool: its snippets switch the pressure).",
+    ),
+    k(
+        "conform",
+        "inner_diameter",
+        "Nozzle inner diameter d, mm: standoff, bead width, point spacing (two points per d).",
+    ),
+    k(
+        "conform",
+        "outer_diameter",
+        "Nozzle outer diameter d_o, mm: the tip disk of the contact check.",
+    ),
+    k(
+        "conform",
+        "tolerance",
+        "Extra lateral clearance of every contact correction, mm.",
+    ),
+    k("conform", "feed", "Feed rate while dispensing, mm/s."),
+    k(
+        "conform",
+        "pressure_on_gcode",
+        "G-code that switches the pressure on; empty = the tool's paste_on_gcode.",
+    ),
+    k(
+        "conform",
+        "pressure_off_gcode",
+        "G-code that switches the pressure off; empty = the tool's paste_off_gcode.",
+    ),
+    k(
+        "conform",
+        "mapping",
+        "\"projection\" (drop along -z) or \"geodesic\" (keep arc length on the surface); also --mapping.",
+    ),
+    k(
+        "conform",
+        "corrections",
+        "\"full\" (contact + curvature-scaled downhill), \"slope\" (downhill without curvature) or \"none\".",
+    ),
+    k(
+        "conform",
+        "needle_length",
+        "Length of the straight needle above the tip, mm.",
+    ),
+    k(
+        "conform",
+        "cone_angle",
+        "Half-angle of the cone above the needle, degrees from the vertical; 0 = needle only.",
+    ),
+    k("conform", "cone_height", "Height of that cone, mm."),
+    k(
+        "conform",
+        "contact_thickness",
+        "Deposit thickness at or below which the nozzle touches the surface, mm.",
+    ),
+    k(
+        "conform",
+        "flattening_error",
+        "Thickness error below minus this counts as flattening, mm.",
+    ),
+    k(
+        "conform",
+        "floating_error",
+        "Thickness error above this counts as floating, mm.",
+    ),
+    k(
+        "conform",
+        "marker_max_size",
+        "--refs-auto: largest hole (longest bounding-box side) taken as a marker, mm.",
+    ),
+    k(
+        "conform",
+        "fold_gap",
+        "Point clouds: points this far below the top of their grid cell are a fold, not the surface, mm.",
+    ),
+    k(
+        "conform",
+        "travel_clearance",
+        "Height above the highest surface point that travels between paths clear, mm.",
+    ),
+    k(
+        "jet",
+        "tool",
+        "Tool that jets: a kind = \"paste\" tool (its own paste snippets are not used).",
+    ),
+    k(
+        "jet",
+        "corner_rules",
+        "Minimum fillet radius per corner angle (180 = straight): [min_angle_deg, radius / line \
+         width] rows; the row with the largest min_angle_deg <= the corner's angle applies.",
+    ),
+    k(
+        "jet",
+        "split_below",
+        "Corners sharper than this, degrees, are split: the shutter closes, the next segment starts \
+         fresh.",
+    ),
+    k(
+        "jet",
+        "arcs",
+        "Write fillets as G2/G3 arcs (Klipper needs [gcode_arcs]); false flattens them into G1.",
+    ),
+    k(
+        "jet",
+        "arc_tolerance",
+        "Largest distance between a flattened fillet and its chords, mm.",
+    ),
+    k(
+        "jet",
+        "gap",
+        "Gap between the end and the start of a closed contour, mm (where the shutter acts).",
+    ),
+    k(
+        "jet",
+        "gap_positions",
+        "Places the gap cycles through, one per layer, on straight segments away from corners.",
+    ),
+    k(
+        "jet",
+        "block_layers",
+        "The print direction reverses after every block of this many layers.",
+    ),
+    k(
+        "jet",
+        "fill",
+        "Closed outlines: \"wall\" (one line), \"contour\" (inward loops) or \"serpentine\".",
+    ),
+    k(
+        "jet",
+        "fill_spacing",
+        "Distance between fill lines, as a multiple of the line width.",
+    ),
+    k(
+        "jet",
+        "fill_angle",
+        "Direction of serpentine lines, degrees from +X.",
+    ),
+    k("jet", "speed", "Feed while jetting, mm/s."),
+    k(
+        "jet",
+        "travel_speed",
+        "Feed of travels (shutter closed), mm/s.",
+    ),
+    k(
+        "jet",
+        "shutter_open_gcode",
+        "G-code that opens the shutter.",
+    ),
+    k(
+        "jet",
+        "shutter_close_gcode",
+        "G-code that closes the shutter.",
+    ),
+    k(
+        "jet",
+        "shutter_lead_time",
+        "Shutter-on-the-fly: open/close commands this long (s, at the jetting speed) before a \
+         path's start and end; 0 = at the ends.",
+    ),
+    k(
+        "jet",
+        "start_gcode",
+        "Written once before the job (after G21, G90, M83).",
+    ),
+    k(
+        "jet",
+        "end_gcode",
+        "Written once after the job (after the shutter closes).",
+    ),
+    k(
+        "jet",
+        "e_words",
+        "Write E (deposited volume, mm³, relative) so conduit check and preview see the lines.",
+    ),
+    k(
+        "jet",
+        "leveling_factor",
+        "Factor on the accumulation model: the bare model over-predicts the inside/outside height \
+         difference about tenfold.",
+    ),
+    k(
+        "jet",
+        "model_roi",
+        "Region of interest around each corner for the accumulation model in the report, mm.",
     ),
 ];
 

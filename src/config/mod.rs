@@ -24,9 +24,9 @@
 //! Every key may be left out and takes its default; `conduit config --defaults` prints them all
 //! with their documentation ([`defaults_toml`]). Unknown keys are errors naming the key, so a
 //! typo never passes silently. `[route]` and `[pnp]` configure cavities, trace routing and part
-//! placement ([`RouteSettings`], [`PnpSettings`]), `[curved]` non-planar top surfaces
-//! ([`CurvedSettings`]); later sections (`[conform]`,
-//! `[jet]`) will be added as fields of [`Config`] next to them.
+//! placement ([`RouteSettings`], [`PnpSettings`]), `[curved]` curved layers (non-planar tops
+//! and curved-layer FFF, [`CurvedSettings`]), `[conform]` conformal printing on scanned
+//! surfaces ([`ConformSettings`]) and `[jet]` aerosol-jet toolpaths ([`JetSettings`]).
 //!
 //! A `[tools.N]` table, when present, defines the tools: the tool numbers must run `0, 1, …`
 //! without gaps, and every key a table leaves out takes the default *of its kind*
@@ -38,15 +38,19 @@
 //! Lengths in millimetres, speeds in mm/s, accelerations in mm/s², temperatures in °C,
 //! fan speeds in percent, densities in g/cm³, volumetric flows in mm³/s.
 
+mod conform;
 mod curved;
 mod defaults;
 mod electronics;
+mod jet;
 pub mod prusa_ini;
 mod template;
 
+pub use conform::{ConformSettings, Corrections, Mapping};
 pub use curved::{CurvedMode, CurvedSettings};
 pub use defaults::defaults_toml;
 pub use electronics::{PnpSettings, RouteSettings};
+pub use jet::{JetFill, JetSettings};
 pub use prusa_ini::from_prusa_pairs;
 
 use std::collections::BTreeMap;
@@ -75,6 +79,10 @@ pub struct Config {
     pub pnp: PnpSettings,
     /// Non-planar top surfaces (`[curved]`).
     pub curved: CurvedSettings,
+    /// Conformal printing onto scanned surfaces (`[conform]`).
+    pub conform: ConformSettings,
+    /// Aerosol-jet toolpaths (`[jet]`).
+    pub jet: JetSettings,
 }
 
 /// G-code dialect of the printer's firmware.
@@ -430,6 +438,8 @@ impl Default for Config {
             route: RouteSettings::default(),
             pnp: PnpSettings::default(),
             curved: CurvedSettings::default(),
+            conform: ConformSettings::default(),
+            jet: JetSettings::default(),
         }
     }
 }
@@ -631,6 +641,7 @@ impl Config {
         }
         problems.extend(self.route.problems());
         problems.extend(self.curved.problems());
+        problems.extend(self.jet.problems());
         if !(self.pnp.lift.is_finite() && self.pnp.lift >= 0.0) {
             problems.push(format!("pnp.lift must be ≥ 0, got {}", self.pnp.lift));
         }

@@ -108,10 +108,15 @@ impl Material {
 impl Head {
     /// The head's radius at `rise` mm above the tip (0 where it has no extent), and the part.
     pub fn radius_at(&self, rise: f64) -> Option<(f64, HeadPart)> {
+        self.radius_with(rise, self.angle_deg.to_radians().tan())
+    }
+
+    /// [`Head::radius_at`] with the cone's `tan(angle)` computed by the caller.
+    fn radius_with(&self, rise: f64, tan: f64) -> Option<(f64, HeadPart)> {
         if rise <= 0.0 {
             return None;
         }
-        let cone = (rise <= self.height).then(|| rise * self.angle_deg.to_radians().tan());
+        let cone = (rise <= self.height).then_some(rise * tan);
         let carriage = (self.carriage_radius > 0.0 && rise >= self.carriage_clearance)
             .then_some(self.carriage_radius);
         match (cone, carriage) {
@@ -129,9 +134,23 @@ impl Head {
 
     /// The first hit (in the order of `nozzles`) of the head against `material`.
     pub fn first_hit(&self, nozzles: &[Point3], material: &Material) -> Option<Hit> {
-        for &p in nozzles {
+        nozzles.iter().find_map(|&p| self.hit_at(p, material))
+    }
+
+    /// Every nozzle position of `nozzles` with a hit, each with its first hit, in order.
+    pub fn hits(&self, nozzles: &[Point3], material: &Material) -> Vec<Hit> {
+        nozzles
+            .iter()
+            .filter_map(|&p| self.hit_at(p, material))
+            .collect()
+    }
+
+    /// The first hit of the head against `material` with the nozzle at `p`.
+    pub fn hit_at(&self, p: Point3, material: &Material) -> Option<Hit> {
+        let tan = self.angle_deg.to_radians().tan();
+        {
             for slab in &material.slabs {
-                let Some((r, part)) = self.radius_at(slab.top - p.z) else {
+                let Some((r, part)) = self.radius_with(slab.top - p.z, tan) else {
                     continue;
                 };
                 for (rings, bb) in &slab.shapes {
@@ -148,7 +167,7 @@ impl Head {
                 }
             }
             for &q in &material.points {
-                let Some((r, part)) = self.radius_at(q.z - p.z) else {
+                let Some((r, part)) = self.radius_with(q.z - p.z, tan) else {
                     continue;
                 };
                 if (q.x - p.x).hypot(q.y - p.y) < r {
@@ -162,6 +181,384 @@ impl Head {
         }
         None
     }
+}
+
+/// One printed bead for [`replay`]: a straight extrusion whose nozzle tip ran from `from` to
+/// `to` (the tip is the bead's top), with a rounded-rectangle cross-section `width × height`
+/// (the extrusion model of [`crate::program::extrusion`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bead {
+    /// Start of the nozzle tip, mm.
+    pub from: Point3,
+    /// End of the nozzle tip, mm.
+    pub to: Point3,
+    /// Bead width, mm.
+    pub width: f64,
+    /// Bead height, mm.
+    pub height: f64,
+    /// How steeply the bead's top may lean across it, degrees: a bead of a curved layer lies
+    /// on the surface and is lower on its downhill side, the side a lower nozzle beside it
+    /// faces; 0 for a planar bead.
+    pub lean_deg: f64,
+}
+
+/// A bead whose nozzle ran into material printed before it, found by [`replay`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReplayHit {
+    /// Index of the bead being printed.
+    pub bead: usize,
+    /// Index of the earlier bead the head touched.
+    pub earlier: usize,
+    /// Nozzle position, the highest material point in the head and the part of the head.
+    pub hit: Hit,
+}
+
+/// Settings of [`replay`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReplayTolerances {
+    /// Material must stand more than this above the nozzle tip to count, mm: G-code rounds Z
+    /// to 0.001 mm, so two beads printed at "the same" height may differ by that much.
+    pub rise: f64,
+    /// The nozzle is tested every this many mm along each bead (and at both ends), mm.
+    pub sample: f64,
+}
+
+impl Default for ReplayTolerances {
+    fn default() -> Self {
+        Self {
+            rise: 0.002,
+            sample: 0.1,
+        }
+    }
+}
+
+/// Side of the grid cells [`replay`] sorts beads into, mm.
+const REPLAY_CELL_MM: f64 = 2.0;
+
+/// Replays `beads[start..]` in order: the nozzle runs along each bead (tested every
+/// `tol.sample` mm) and every bead printed before it is material. Returns, per bead with a
+/// hit, its first hit.
+///
+/// # Material model
+///
+/// A bead is the union, along its centre line, of round "buttons": at horizontal distance `u`
+/// from the centre point `c` (tip height `z`) its top is `z` for `u ≤ a = (w − h)/2` and
+/// `z − r + √(r² − (u − a)²)` for `a < u ≤ w/2`, `r = h/2` — the rounded rectangle swept
+/// along the bead with round ends. The head's cone (half-angle θ) with its apex at the nozzle
+/// tip `p` meets a button at horizontal distance `e = |p − c| > w/2` exactly when
+/// `e − a − r·cos θ < tan θ · (z − p.z − r·(1 − sin θ))`: the cone's surface is tangent to the
+/// rounded edge at `u = a + r·cos θ`. A bead with a `lean` is lower by `u·tan lean` at `u`
+/// on the nozzle's side. Within the footprint (`e ≤ w/2`) the bead's top right
+/// above the tip counts as well. The carriage takes the same candidate points. The distance to the centre line is convex along a bead and its height linear,
+/// so the worst button of a bead is found by a golden-section search.
+///
+/// The nozzle's own bead continues the bead(s) just before it when they join end to start; the
+/// part of that run within one bead width behind the nozzle is the material it is laying down,
+/// not an obstacle, and is skipped — as is, while the nozzle is within one bead width of the
+/// run's end, the run's first bead width (a loop closing over its own start: the seam).
+pub fn replay(beads: &[Bead], start: usize, head: &Head, tol: &ReplayTolerances) -> Vec<ReplayHit> {
+    let mut index = BeadIndex::new(beads);
+    for i in 0..start.min(beads.len()) {
+        index.insert(beads, i);
+    }
+    let mut out = Vec::new();
+    // Per bead: the first bead of its continuous run and the run's arc length up to the bead's
+    // start; per run (by first bead): its total length.
+    let joined = |i: usize| i > 0 && (beads[i].from - beads[i - 1].to).norm() < 1e-6;
+    let mut run_of = vec![0; beads.len()];
+    let mut run_len = vec![0.0; beads.len()];
+    let mut run_total = vec![0.0; beads.len()];
+    for i in 0..beads.len() {
+        if joined(i) {
+            run_of[i] = run_of[i - 1];
+            run_len[i] = run_len[i - 1] + beads[i - 1].length();
+        } else {
+            run_of[i] = i;
+        }
+        run_total[run_of[i]] = run_len[i] + beads[i].length();
+    }
+    for i in 0..beads.len() {
+        if i < start {
+            continue;
+        }
+        let b = &beads[i];
+        let len = b.length();
+        let steps = ((len / tol.sample.max(1e-3)).ceil() as usize).max(1);
+        'samples: for s in 0..=steps {
+            let f = s as f64 / steps as f64;
+            let p = Point3::from(b.from.coords + (b.to.coords - b.from.coords) * f);
+            let arc = run_len[i] + f * len;
+            let total = run_total[run_of[i]];
+            for j in index.candidates(beads, p, head, tol) {
+                // Within one bead width behind the nozzle on its own run: its own bead; and a
+                // loop's last bead width closing over the run's first one: its seam.
+                if run_of[j] == run_of[i]
+                    && (arc - (run_len[j] + beads[j].length()) < b.width
+                        || (run_len[j] < b.width && total - arc < b.width))
+                {
+                    continue;
+                }
+                if let Some(hit) = head.bead_hit(p, &beads[j], tol.rise) {
+                    out.push(ReplayHit {
+                        bead: i,
+                        earlier: j,
+                        hit,
+                    });
+                    break 'samples;
+                }
+            }
+        }
+        index.insert(beads, i);
+    }
+    out
+}
+
+impl Bead {
+    /// Length of the centre line, mm.
+    pub fn length(&self) -> f64 {
+        (self.to - self.from).norm()
+    }
+
+    fn top(&self) -> f64 {
+        self.from.z.max(self.to.z)
+    }
+}
+
+impl Head {
+    /// The hit of the head with its tip at `p` against `bead` (see [`replay`]): the bead's
+    /// highest point inside the head, if any rises more than `min_rise` above the tip.
+    pub fn bead_hit(&self, p: Point3, bead: &Bead, min_rise: f64) -> Option<Hit> {
+        if bead.top() - p.z <= min_rise {
+            return None;
+        }
+        let (w, h) = (bead.width, bead.height.min(bead.width));
+        let (r, a) = (h / 2.0, (w - h) / 2.0);
+        let theta = self.angle_deg.to_radians();
+        let (cos, tan) = (theta.cos(), theta.tan());
+        let lean = bead.lean_deg.to_radians().tan();
+        let at = |t: f64| Point3::from(bead.from.coords + (bead.to.coords - bead.from.coords) * t);
+        // Top of a button at horizontal distance u from its centre, relative to the centre.
+        let profile = |u: f64| {
+            if u <= a {
+                0.0
+            } else {
+                (r * r - (u - a) * (u - a)).max(0.0).sqrt() - r
+            }
+        };
+        // How far the head is from touching the button at t (negative: it touches). Along the
+        // line from the nozzle to the centre the head's measure |e − u| − radius(rise(u)) is
+        // convex in u towards the centre and grows away from it, so the flat top's edge, the
+        // cone's tangent point on the rounded edge (u = a + r·cos θ) and the point under the
+        // nozzle are the candidates.
+        let gap = |t: f64| {
+            let c = at(t);
+            let e = (c.x - p.x).hypot(c.y - p.y);
+            let mut g = f64::MAX;
+            if e > w / 2.0 + self.max_radius() {
+                return g;
+            }
+            for u in [a.min(e), (a + r * cos).min(e), e.min(w / 2.0)] {
+                let rise = c.z + profile(u) - u * lean - p.z;
+                if rise <= min_rise {
+                    continue;
+                }
+                let dist = e - u;
+                if dist <= 0.0 {
+                    // Material right above the tip.
+                    g = g.min(-rise);
+                } else if let Some((radius, _)) = self.radius_at(rise) {
+                    g = g.min(dist - radius);
+                }
+            }
+            g
+        };
+        // The cone's measure without its limits is convex along the bead (distance to a
+        // segment minus a linear height): its minimum, the point nearest to the nozzle and the
+        // ends cover the cone, the footprint and the carriage.
+        let cone = |t: f64| {
+            let c = at(t);
+            (c.x - p.x).hypot(c.y - p.y) - tan * (c.z - p.z)
+        };
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        let golden = 0.5 * (5f64.sqrt() - 1.0);
+        for _ in 0..60 {
+            if (hi - lo) * bead.length() < 1e-5 {
+                break;
+            }
+            let m1 = hi - golden * (hi - lo);
+            let m2 = lo + golden * (hi - lo);
+            if cone(m1) < cone(m2) {
+                hi = m2;
+            } else {
+                lo = m1;
+            }
+        }
+        let d = bead.to - bead.from;
+        let l2 = d.x * d.x + d.y * d.y;
+        let nearest = if l2 > 0.0 {
+            (((p.x - bead.from.x) * d.x + (p.y - bead.from.y) * d.y) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let t = [(lo + hi) / 2.0, nearest, 0.0, 1.0]
+            .into_iter()
+            .map(|t| (gap(t), t))
+            .fold((f64::MAX, 0.0), |b, c| if c.0 < b.0 { c } else { b })
+            .1;
+        (gap(t) < 0.0).then(|| {
+            let c = at(t);
+            let rise = c.z - p.z;
+            let part = self
+                .radius_at(rise)
+                .map_or(HeadPart::Cone, |(_, part)| part);
+            Hit {
+                nozzle: p,
+                material: c,
+                part,
+            }
+        })
+    }
+}
+
+/// Beads sorted into [`REPLAY_CELL_MM`] cells by the xy box of their footprint; each cell's
+/// list is kept highest first so a query stops at the first bead below the nozzle.
+struct BeadIndex {
+    origin: [f64; 2],
+    dims: [usize; 2],
+    /// Per cell: (top z, bead index), highest first.
+    cells: Vec<Vec<(f64, usize)>>,
+    /// Per cell: the highest top in it.
+    tops: Vec<f64>,
+    widest: f64,
+}
+
+impl BeadIndex {
+    fn new(beads: &[Bead]) -> Self {
+        let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+        let mut widest: f64 = 0.0;
+        for b in beads {
+            for q in [b.from, b.to] {
+                lo = [lo[0].min(q.x), lo[1].min(q.y)];
+                hi = [hi[0].max(q.x), hi[1].max(q.y)];
+            }
+            widest = widest.max(b.width);
+        }
+        if beads.is_empty() {
+            lo = [0.0; 2];
+            hi = [0.0; 2];
+        }
+        let dims = [
+            (((hi[0] - lo[0]) / REPLAY_CELL_MM).floor() as usize + 1).min(4096),
+            (((hi[1] - lo[1]) / REPLAY_CELL_MM).floor() as usize + 1).min(4096),
+        ];
+        Self {
+            origin: lo,
+            dims,
+            cells: vec![Vec::new(); dims[0] * dims[1]],
+            tops: vec![f64::MIN; dims[0] * dims[1]],
+            widest,
+        }
+    }
+
+    fn cell(&self, x: f64, y: f64) -> (usize, usize) {
+        let c = |v: f64, o: f64, n: usize| {
+            let f = ((v - o) / REPLAY_CELL_MM).floor();
+            if f.is_finite() {
+                (f.max(0.0) as usize).min(n - 1)
+            } else {
+                0
+            }
+        };
+        (
+            c(x, self.origin[0], self.dims[0]),
+            c(y, self.origin[1], self.dims[1]),
+        )
+    }
+
+    fn insert(&mut self, beads: &[Bead], i: usize) {
+        let b = &beads[i];
+        let half = b.width / 2.0;
+        let (x0, y0) = self.cell(b.from.x.min(b.to.x) - half, b.from.y.min(b.to.y) - half);
+        let (x1, y1) = self.cell(b.from.x.max(b.to.x) + half, b.from.y.max(b.to.y) + half);
+        let top = b.top();
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                let k = cy * self.dims[0] + cx;
+                let list = &mut self.cells[k];
+                let at = list.partition_point(|&(z, j)| z > top || (z == top && j < i));
+                list.insert(at, (top, i));
+                self.tops[k] = self.tops[k].max(top);
+            }
+        }
+    }
+
+    /// Beads that may reach into the head at `p`, in ascending index order without repeats.
+    fn candidates(
+        &self,
+        beads: &[Bead],
+        p: Point3,
+        head: &Head,
+        tol: &ReplayTolerances,
+    ) -> Vec<usize> {
+        let mut out = Vec::new();
+        let reach = |rise: f64| -> f64 {
+            let tan = head.angle_deg.to_radians().tan();
+            let cone = rise.min(head.height) * tan;
+            let carriage = if head.carriage_radius > 0.0 && rise >= head.carriage_clearance {
+                head.carriage_radius
+            } else {
+                0.0
+            };
+            cone.max(carriage) + self.widest / 2.0
+        };
+        let far = reach(f64::MAX / 4.0).min(1e4);
+        let (x0, y0) = self.cell(p.x - far, p.y - far);
+        let (x1, y1) = self.cell(p.x + far, p.y + far);
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                let k = cy * self.dims[0] + cx;
+                let rise = self.tops[k] - p.z;
+                if rise <= tol.rise {
+                    continue;
+                }
+                // Distance from p to the cell's square.
+                let (bx, by) = (
+                    self.origin[0] + cx as f64 * REPLAY_CELL_MM,
+                    self.origin[1] + cy as f64 * REPLAY_CELL_MM,
+                );
+                let dx = (bx - p.x).max(p.x - bx - REPLAY_CELL_MM).max(0.0);
+                let dy = (by - p.y).max(p.y - by - REPLAY_CELL_MM).max(0.0);
+                if dx.hypot(dy) > reach(rise) {
+                    continue;
+                }
+                for &(z, j) in &self.cells[k] {
+                    if z - p.z <= tol.rise {
+                        break;
+                    }
+                    let b = &beads[j];
+                    if segment_distance(p, b.from, b.to) - b.width / 2.0 > reach(z - p.z) {
+                        continue;
+                    }
+                    out.push(j);
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+}
+
+/// Horizontal distance from `p` to the segment from `a` to `b`, mm.
+fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
+    let (dx, dy) = (b.x - a.x, b.y - a.y);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 {
+        (((p.x - a.x) * dx + (p.y - a.y) * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a.x + t * dx - p.x).hypot(a.y + t * dy - p.y)
 }
 
 /// The point of the shape (rings, contour first, even-odd) nearest to (x, y) when it is closer
@@ -246,5 +643,58 @@ mod tests {
         };
         let hit = carriage.first_hit(&far, &m).map(|h| h.part);
         assert_eq!(hit, Some(HeadPart::Carriage));
+    }
+
+    #[test]
+    fn replay_finds_a_bead_exactly_where_the_cone_meets_its_rounded_edge() {
+        let head = Head {
+            angle_deg: 60.0,
+            height: 5.0,
+            carriage_radius: 0.0,
+            carriage_clearance: 10.0,
+        };
+        let wall = Bead {
+            from: Point3::new(0.0, 0.0, 1.3),
+            to: Point3::new(10.0, 0.0, 1.3),
+            width: 0.45,
+            height: 0.2,
+            lean_deg: 0.0,
+        };
+        // Tangent on the rounded edge (a = 0.125, r = 0.1): e < a + r·cos 60° + tan 60°·(0.3 −
+        // r·(1 − sin 60°)) = 0.67141.
+        let limit = 0.125 + 0.05 + 3f64.sqrt() * (0.3 - 0.1 * (1.0 - 3f64.sqrt() / 2.0));
+        let pass = |y: f64| Bead {
+            from: Point3::new(2.0, y, 1.0),
+            to: Point3::new(8.0, y, 1.0),
+            width: 0.45,
+            height: 0.2,
+            lean_deg: 0.0,
+        };
+        let tol = ReplayTolerances::default();
+        let near = replay(&[wall, pass(limit - 0.01)], 1, &head, &tol);
+        assert_eq!(near.len(), 1);
+        assert_eq!((near[0].bead, near[0].earlier), (1, 0));
+        assert_eq!(near[0].hit.part, HeadPart::Cone);
+        assert!((near[0].hit.material.z - 1.3).abs() < 1e-9);
+        assert!(replay(&[wall, pass(limit + 0.01)], 1, &head, &tol).is_empty());
+        // Before `start` nothing is tested; a bead at the same height never counts.
+        assert!(replay(&[wall, pass(limit - 0.01)], 2, &head, &tol).is_empty());
+        let level = Bead {
+            from: Point3::new(2.0, 0.2, 1.3),
+            to: Point3::new(8.0, 0.2, 1.3),
+            ..pass(0.0)
+        };
+        assert!(replay(&[wall, level], 1, &head, &tol).is_empty());
+        // Right under the wall's flat top: hit, whatever the angle.
+        let under = Bead {
+            from: Point3::new(2.0, 0.05, 1.2),
+            to: Point3::new(8.0, 0.05, 1.2),
+            ..pass(0.0)
+        };
+        let narrow = Head {
+            angle_deg: 0.0,
+            ..head
+        };
+        assert_eq!(replay(&[wall, under], 1, &narrow, &tol).len(), 1);
     }
 }

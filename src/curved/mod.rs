@@ -8,10 +8,15 @@
 //! 2. [`tops`]: the top regions no steeper than `curved.max_angle` (steeper ones are reported
 //!    and stay planar), their curved layers (perimeters and solid infill over the region, made
 //!    flat by the regions stage's generators, then projected to `surface − k·h` with points at
-//!    every triangle edge and every `curved.step`), and what the planar layers give up;
-//! 3. [`collision`]: each region's nozzle positions against the head model and the material
-//!    printed before (the planar layers up to the region's top, its own surface); a region with
-//!    a hit stays planar and the hit is reported with the setting that would allow it;
+//!    every triangle edge and every `curved.step`), and what the planar layers give up. Where
+//!    planar material stands beside a region, each deeper layer steps in from it by
+//!    [`tops::rim_step`], so the planar columns left beside it rise a layer at most;
+//! 3. [`collision`]: every curved layer's nozzle positions against the head model and the
+//!    material printed before (the planar layers up to the region's top less what the curved
+//!    layers replace, the layer's own surface); where the head hits, that layer and those under
+//!    it are trimmed around the material it hits and the region is planned again, so only the
+//!    unreachable rim stays planar, reported with the setting that would allow it.
+//!    [`collision::replay`] checks written G-code the same way, bead by bead;
 //! 4. [`motion`]: flow from the local layer thickness, feed limited by `curved.max_z_speed`.
 //!
 //! The pipeline removes the planar areas ([`TopsPlan::removals`]) from the islands before the
@@ -19,6 +24,7 @@
 //! holding the region's highest point ([`insert_curved`]). Everything is sequential and
 //! ordered, so the output is deterministic.
 
+pub mod clfff;
 pub mod collision;
 pub mod motion;
 pub mod report;
@@ -29,14 +35,18 @@ pub use report::{CurvedLayerReport, CurvedReport, RegionReport, Rejection};
 pub use surface::{HeightField, SurfaceHit};
 
 use crate::config::Config;
-use crate::geom::{ExPolygon, Point3, difference, scaled, union};
+use crate::geom::{
+    ExPolygon, Join, Point2, Point3, Polygon, difference, intersection, offset, scaled, union,
+};
 use crate::mesh::Mesh;
 use crate::program::{Event, LayerItem, Program, ProgramParams, Role, Toolpath};
 use crate::region::infill::{InfillPattern, Rectilinear};
 use crate::region::make_perimeters;
 use crate::slice::LayerZ;
 use collision::{Head, HeadPart, Material};
-use tops::{Projector, TopRegion, find_top_regions, removal, top_layer_at};
+use tops::{
+    AreaIndex, Projector, TopRegion, find_top_regions, removal_stepped, rim_step, top_layer_at,
+};
 
 /// Nozzle positions tested for collisions are thinned to one per square of this side, mm.
 const COLLISION_SAMPLE_MM: f64 = 0.5;
@@ -99,6 +109,7 @@ pub fn plan_tops(objects: &[CurvedObject<'_>], cfg: &Config) -> TopsPlan {
     for (oi, obj) in objects.iter().enumerate() {
         let hf = HeightField::from_mesh(obj.mesh);
         let (regions, steep) = find_top_regions(&hf, c.max_angle);
+
         for s in steep {
             plan.report.rejections.push(Rejection {
                 object: oi,
@@ -122,7 +133,15 @@ pub fn plan_tops(objects: &[CurvedObject<'_>], cfg: &Config) -> TopsPlan {
                 });
                 continue;
             }
-            match plan_region(objects, oi, &region, &hf, &head, cfg) {
+            match plan_region(
+                objects,
+                oi,
+                &region,
+                &hf,
+                &head,
+                cfg,
+                &mut plan.report.rejections,
+            ) {
                 Ok((remove, insert, rep)) => {
                     for (acc, r) in plan.removals[oi].iter_mut().zip(remove) {
                         if !r.is_empty() {
@@ -144,10 +163,17 @@ pub fn plan_tops(objects: &[CurvedObject<'_>], cfg: &Config) -> TopsPlan {
 /// One region's flat paths of curved layer `k`: (xy points, closed, role, width).
 type FlatPath = (Vec<(f64, f64)>, bool, Role, f64);
 
-fn flat_layer(area: &ExPolygon, k: usize, cfg: &Config) -> Vec<FlatPath> {
+/// Slivers of planar material beside a region thinner than twice this (mm) are left out of the
+/// material the deeper layers step away from: where a vertical outer wall bounds the region,
+/// the sliced footprint and the region's triangles meet up to rounding.
+const SLIVER_MM: f64 = 0.05;
+
+/// The flat paths of curved layer `k` over `area`: perimeter loops around it and solid infill
+/// inside them (top solid infill for the topmost), by the regions stage's generators.
+fn flat_layer(area: &[ExPolygon], k: usize, cfg: &Config) -> Vec<FlatPath> {
     let params = cfg.slice.region.for_layer(1);
     let h = params.layer_height;
-    let per = make_perimeters(std::slice::from_ref(area), &params, h);
+    let per = make_perimeters(area, &params, h);
     let mut out: Vec<FlatPath> = per
         .loops
         .iter()
@@ -197,6 +223,108 @@ type ProjectedLayer = (usize, Vec<tops::Projected>, Vec<(Role, f64)>, usize);
 
 type RegionPlan = (Vec<Vec<ExPolygon>>, CurvedInsert, RegionReport);
 
+/// Most rounds of trimming a region's rim where the head hits before the region is rejected.
+const MAX_TRIM_ROUNDS: usize = 12;
+
+/// Clearance kept around a material point the head hit, beyond the cone's radius there, mm.
+const TRIM_MARGIN_MM: f64 = 0.1;
+
+/// Hits closer than this (mm, on a grid) on one layer are trimmed as one.
+const HIT_GRID_MM: f64 = 0.5;
+
+/// The curved layers over `areas` (topmost first), projected, lowest first.
+fn project_layers(
+    areas: &[Vec<ExPolygon>],
+    region: &TopRegion,
+    obj: &CurvedObject<'_>,
+    hf: &HeightField,
+    cfg: &Config,
+) -> Vec<ProjectedLayer> {
+    let h = cfg.slice.region.layer_height;
+    let mut layers = Vec::new();
+    for k in (0..areas.len()).rev() {
+        let below = areas
+            .get(k + 1)
+            .map_or_else(AreaIndex::default, |a| AreaIndex::new(a));
+        let proj = Projector {
+            surface: hf,
+            layers: obj.layers,
+            depth: k as f64 * h,
+            count: k + 1,
+            below: &below,
+            height: h,
+            step: cfg.curved.step,
+            triangles: &region.triangles,
+        };
+        let mut pieces = Vec::new();
+        let mut meta = Vec::new();
+        let mut dropped = 0;
+        for (pts, closed, role, width) in flat_layer(&areas[k], k, cfg) {
+            let (ps, d) = proj.project(&pts, closed);
+            dropped += d;
+            for p in ps {
+                meta.push((role, width));
+                pieces.push(p);
+            }
+        }
+        layers.push((k, pieces, meta, dropped));
+    }
+    layers
+}
+
+fn area_of(areas: &[ExPolygon]) -> f64 {
+    areas
+        .iter()
+        .map(ExPolygon::area_mm2)
+        .fold(0.0, |a, b| a + b)
+}
+
+/// A regular 24-gon of radius `r` around (x, y), mm: the area a trimmed hit takes away.
+fn disc(x: f64, y: f64, r: f64) -> ExPolygon {
+    let points = (0..24)
+        .map(|i| {
+            let a = i as f64 * std::f64::consts::TAU / 24.0;
+            // Circumscribed, so the polygon contains the circle.
+            let rr = r / (std::f64::consts::PI / 24.0).cos();
+            Point2::from_mm(x + rr * a.cos(), y + rr * a.sin())
+        })
+        .collect();
+    ExPolygon {
+        contour: Polygon::new(points),
+        holes: Vec::new(),
+    }
+}
+
+/// The rejection for a head hit: what part of the head, where, and the setting that allows it.
+fn collision_rejection(oi: usize, hit: &collision::Hit, what: String) -> Rejection {
+    let (r, rise) = (hit.radius(), hit.rise());
+    let (part, setting) = match hit.part {
+        HeadPart::Cone => (
+            "cone",
+            format!(
+                "curved.head_angle < {:.1} or curved.head_height < {:.2}",
+                r.atan2(rise).to_degrees(),
+                rise
+            ),
+        ),
+        HeadPart::Carriage => (
+            "carriage",
+            format!("curved.carriage_radius < {r:.2} or curved.carriage_clearance > {rise:.2}"),
+        ),
+    };
+    Rejection {
+        object: oi,
+        kind: "head_collision",
+        reason: format!(
+            "{what}: the head's {part} would touch printed material at ({:.2}, {:.2}, {:.2}), \
+             {rise:.2} mm above and {r:.2} mm beside the nozzle",
+            hit.material.x, hit.material.y, hit.material.z
+        ),
+        position: [hit.nozzle.x, hit.nozzle.y, hit.nozzle.z],
+        setting,
+    }
+}
+
 fn plan_region(
     objects: &[CurvedObject<'_>],
     oi: usize,
@@ -204,6 +332,7 @@ fn plan_region(
     hf: &HeightField,
     head: &Head,
     cfg: &Config,
+    rejections: &mut Vec<Rejection>,
 ) -> Result<RegionPlan, Rejection> {
     let obj = &objects[oi];
     let c = &cfg.curved;
@@ -224,115 +353,231 @@ fn plan_region(
         .get(obj.tool)
         .map(|t| t.speeds)
         .unwrap_or_default();
-    // Curved layers, lowest first.
-    let mut layers: Vec<ProjectedLayer> = Vec::new();
-    for k in (0..n).rev() {
-        let proj = Projector {
-            surface: hf,
-            layers: obj.layers,
-            depth: k as f64 * h,
-            count: n,
-            lowest: k + 1 == n,
-            height: h,
-            step: c.step,
-        };
-        let mut pieces = Vec::new();
-        let mut meta = Vec::new();
-        let mut dropped = 0;
-        for (pts, closed, role, width) in flat_layer(&region.area, k, cfg) {
-            let (ps, d) = proj.project(&pts, closed);
-            dropped += d;
-            for p in ps {
-                meta.push((role, width));
-                pieces.push(p);
+    // Each deeper layer steps in from the one above so the head clears the planar columns
+    // beside it ([`tops::rim_step`]); where the head still hits, the layer and those under it
+    // are trimmed around the material it hits, and the stack is planned again.
+    let top_area = vec![region.area.clone()];
+    let step = rim_step(c.head_angle, h, region.max_slope_deg);
+    // The object's islands near the region (within the head's and the loops' reach) and at
+    // its height (from `n + 1` layers under its lowest point up to the layers over its top):
+    // all that the removals, the material beside it and the collision test look at. The rest
+    // of each island is far away, and clipping it off keeps the polygon operations small.
+    let params = cfg.slice.region.for_layer(1);
+    let reach = (params.perimeters + 2) as f64 * params.perimeter_width
+        + n as f64 * step.unwrap_or(0.0)
+        + 1.0;
+    let bb = ring_bbox(&region.area);
+    let grow = head.max_radius().max(reach) + 1.0;
+    let window = [bb[0] - grow, bb[1] - grow, bb[2] + grow, bb[3] + grow];
+    let window_area = [ExPolygon {
+        contour: Polygon::new(vec![
+            Point2::from_mm(window[0], window[1]),
+            Point2::from_mm(window[2], window[1]),
+            Point2::from_mm(window[2], window[3]),
+            Point2::from_mm(window[0], window[3]),
+        ]),
+        holes: Vec::new(),
+    }];
+    let z_from = region.z_min - (n + 1) as f64 * h;
+    let islands: Vec<Vec<ExPolygon>> = obj
+        .layers
+        .iter()
+        .zip(obj.islands)
+        .enumerate()
+        .map(|(j, (lz, isl))| {
+            if lz.top >= z_from && j <= after + n + 1 {
+                intersection(isl, &window_area)
+            } else {
+                Vec::new()
+            }
+        })
+        .collect();
+    // The footprint at the region's height: where planar material stands beside the region
+    // when its curved layers are printed. Elsewhere the region's rim is an outer wall.
+    // Layer by layer: stacked layers repeat the same edges, which one overlay of all of them
+    // handles very slowly.
+    let footprint = islands[..=after].iter().filter(|isl| !isl.is_empty()).fold(
+        Vec::new(),
+        |acc: Vec<ExPolygon>, isl| {
+            if acc.is_empty() {
+                isl.clone()
+            } else {
+                union(&[acc.as_slice(), isl.as_slice()].concat())
+            }
+        },
+    );
+    let footprint = footprint.as_slice();
+    // Planar material beside the region (slivers along outer walls left out).
+    let material = offset(
+        &offset(
+            &difference(footprint, &top_area),
+            -SLIVER_MM,
+            Join::Miter(2.0),
+        ),
+        SLIVER_MM,
+        Join::Miter(2.0),
+    );
+    let mut areas: Vec<Vec<ExPolygon>> = (0..n)
+        .map(|k| match (k, step) {
+            (0, _) => top_area.clone(),
+            _ if material.is_empty() => top_area.clone(),
+            (_, Some(s)) => difference(
+                &top_area,
+                &offset(&material, k as f64 * s, Join::Miter(2.0)),
+            ),
+            (_, None) => Vec::new(),
+        })
+        .collect();
+    let after_top = obj.layers[after].top;
+    let mut trims: Vec<(usize, collision::Hit)> = Vec::new();
+    let mut rounds = 0;
+    let (layers, remove) = loop {
+        let layers = project_layers(&areas, region, obj, hf, cfg);
+        if layers.iter().all(|(_, pieces, ..)| pieces.is_empty()) {
+            return Err(match trims.first() {
+                Some((_, hit)) => collision_rejection(
+                    oi,
+                    hit,
+                    format!(
+                        "trimming the rim where the head hits leaves nothing of the region \
+                         ({:.1} mm²)",
+                        region.area.area_mm2()
+                    ),
+                ),
+                None => Rejection {
+                    object: oi,
+                    kind: "too_small",
+                    reason: format!(
+                        "the region ({:.1} mm²) is too small for a perimeter or infill line",
+                        region.area.area_mm2()
+                    ),
+                    position: peak,
+                    setting: "narrower extrusion widths in [slice]".to_owned(),
+                },
+            });
+        }
+        let remove = removal_stepped(&areas, &islands);
+        let z_low = layers
+            .iter()
+            .flat_map(|(_, pieces, ..)| pieces.iter().flat_map(|p| p.points.iter()))
+            .map(|p| p.z)
+            .fold(f64::MAX, f64::min);
+        let mut material = Material::default();
+        for (o, other) in objects.iter().enumerate() {
+            for (j, lz) in other.layers.iter().enumerate() {
+                if lz.top <= z_low || lz.top > after_top + 1e-9 {
+                    continue;
+                }
+                let isl = if o == oi {
+                    islands.get(j)
+                } else {
+                    other.islands.get(j)
+                };
+                let Some(isl) = isl else {
+                    continue;
+                };
+                if o == oi && !remove[j].is_empty() {
+                    material.add_layer(lz.top, &difference(isl, &remove[j]), window);
+                } else {
+                    material.add_layer(lz.top, isl, window);
+                }
             }
         }
-        layers.push((k, pieces, meta, dropped));
-    }
-    if layers.iter().all(|(_, pieces, ..)| pieces.is_empty()) {
-        return Err(Rejection {
-            object: oi,
-            kind: "too_small",
-            reason: format!(
-                "the region ({:.1} mm²) is too small for a perimeter or infill line",
-                region.area.area_mm2()
-            ),
-            position: peak,
-            setting: "narrower extrusion widths in [slice]".to_owned(),
-        });
-    }
-    // Collision: the lowest layer's nozzle positions against the planar material, the
-    // topmost layer's also against its own surface (what the layers below it leave is
-    // the same surface lower down, so this covers them).
-    let layer_nozzles = |want: usize| {
-        sample_nozzles(
-            layers
-                .iter()
-                .filter(|(k, ..)| *k == want)
-                .flat_map(|(_, pieces, ..)| pieces.iter().flat_map(|p| p.points.iter().copied())),
-        )
-    };
-    let nozzles = layer_nozzles(n - 1);
-    let top_nozzles = layer_nozzles(0);
-    let remove = removal(&region.area, obj.islands, n);
-    let after_top = obj.layers[after].top;
-    let z_low = nozzles.iter().map(|p| p.z).fold(f64::MAX, f64::min);
-    let bb = ring_bbox(&region.area);
-    let grow = head.max_radius();
-    let window = [bb[0] - grow, bb[1] - grow, bb[2] + grow, bb[3] + grow];
-    let mut material = Material::default();
-    for (o, other) in objects.iter().enumerate() {
-        for (j, lz) in other.layers.iter().enumerate() {
-            if lz.top <= z_low || lz.top > after_top + 1e-9 {
-                continue;
+        // Every layer's nozzles against the planar material and the layer's own points (a
+        // concave surface may rise into the head beside the nozzle).
+        let mut found: Vec<(usize, collision::Hit)> = Vec::new();
+        let mut seen = std::collections::BTreeSet::new();
+        for (k, pieces, ..) in &layers {
+            let nozzles = sample_nozzles(pieces.iter().flat_map(|p| p.points.iter().copied()));
+            let mut with_own = material.clone();
+            with_own.add_points(nozzles.iter().copied());
+            for hit in head.hits(&nozzles, &with_own) {
+                let key = (
+                    *k,
+                    (hit.material.x / HIT_GRID_MM).floor() as i64,
+                    (hit.material.y / HIT_GRID_MM).floor() as i64,
+                );
+                if seen.insert(key) {
+                    found.push((*k, hit));
+                }
             }
-            let Some(isl) = other.islands.get(j) else {
+        }
+        if found.is_empty() {
+            break (layers, remove);
+        }
+        rounds += 1;
+        if rounds > MAX_TRIM_ROUNDS {
+            let (k, hit) = found[0];
+            return Err(collision_rejection(
+                oi,
+                &hit,
+                format!("curved layer {k} still collides after {MAX_TRIM_ROUNDS} trims"),
+            ));
+        }
+        // A hit on layer k trims it and every deeper layer, each deeper one a rim step more
+        // (what it trims becomes planar material beside the deeper layers).
+        let discs_of = |k: usize| -> Vec<ExPolygon> {
+            found
+                .iter()
+                .filter(|(hk, _)| *hk <= k)
+                .map(|(hk, hit)| {
+                    let r = head.radius_at(hit.rise()).map_or(0.0, |(r, _)| r);
+                    let steps = (k - hk) as f64 * step.unwrap_or(0.0);
+                    disc(hit.material.x, hit.material.y, r + TRIM_MARGIN_MM + steps)
+                })
+                .collect()
+        };
+        for (k, area) in areas.iter_mut().enumerate() {
+            let discs = discs_of(k);
+            if !discs.is_empty() && !area.is_empty() {
+                *area = difference(area, &union(&discs));
+            }
+        }
+        trims.extend(found);
+    };
+    // Report every trimmed piece: per layer, each connected group of trimmed hits.
+    for k in 0..n {
+        let hits: Vec<&collision::Hit> = trims
+            .iter()
+            .filter(|(hk, _)| *hk == k)
+            .map(|(_, h)| h)
+            .collect();
+        if hits.is_empty() {
+            continue;
+        }
+        let discs: Vec<ExPolygon> = hits
+            .iter()
+            .map(|hit| {
+                let r = head.radius_at(hit.rise()).map_or(0.0, |(r, _)| r);
+                disc(hit.material.x, hit.material.y, r + TRIM_MARGIN_MM)
+            })
+            .collect();
+        for group in union(&discs) {
+            let Some(hit) = hits
+                .iter()
+                .find(|hit| group.contains(Point2::from_mm(hit.material.x, hit.material.y)))
+            else {
                 continue;
             };
-            if o == oi && !remove[j].is_empty() {
-                material.add_layer(lz.top, &difference(isl, &remove[j]), window);
-            } else {
-                material.add_layer(lz.top, isl, window);
-            }
-        }
-    }
-    let mut hit = head.first_hit(&nozzles, &material);
-    if hit.is_none() {
-        material.add_points(top_nozzles.iter().copied());
-        hit = head.first_hit(&top_nozzles, &material);
-    }
-    if let Some(hit) = hit {
-        let (r, rise) = (hit.radius(), hit.rise());
-        let (part, setting) = match hit.part {
-            HeadPart::Cone => (
-                "cone",
+            let lost = area_of(&intersection(std::slice::from_ref(&group), &top_area));
+            rejections.push(collision_rejection(
+                oi,
+                hit,
                 format!(
-                    "curved.head_angle < {:.1} or curved.head_height < {:.2}",
-                    r.atan2(rise).to_degrees(),
-                    rise
+                    "curved layer {k} (depth {:.2} mm) leaves out {lost:.1} mm² of the region's \
+                     rim here, printed planar",
+                    k as f64 * h
                 ),
-            ),
-            HeadPart::Carriage => (
-                "carriage",
-                format!("curved.carriage_radius < {r:.2} or curved.carriage_clearance > {rise:.2}"),
-            ),
-        };
-        return Err(Rejection {
-            object: oi,
-            kind: "head_collision",
-            reason: format!(
-                "the head's {part} would touch printed material at ({:.2}, {:.2}, {:.2}), \
-                 {rise:.2} mm above and {r:.2} mm beside the nozzle",
-                hit.material.x, hit.material.y, hit.material.z
-            ),
-            position: [hit.nozzle.x, hit.nozzle.y, hit.nozzle.z],
-            setting,
-        });
+            ));
+        }
     }
     let mut items = Vec::new();
     let mut rep = RegionReport {
         object: oi,
         area_mm2: region.area.area_mm2(),
+        curved_area_mm2: area_of(&areas[0]),
+        rim_step_mm: step,
+        trim_rounds: rounds,
         min_slope_deg: region.min_slope_deg,
         max_slope_deg: region.max_slope_deg,
         after_layer: after,
@@ -349,6 +594,7 @@ fn plan_region(
         let mut lr = CurvedLayerReport {
             k,
             depth,
+            area_mm2: area_of(&areas[k]),
             points: 0,
             max_deviation: 0.0,
             planar_cusp: cusp,

@@ -21,9 +21,17 @@ pub struct CurvedReport {
 pub struct RegionReport {
     /// Object index.
     pub object: usize,
-    /// Area, mm².
+    /// Area of the gently sloped top surface, mm².
     pub area_mm2: f64,
-    /// Slope range, degrees.
+    /// Area printed curved (the topmost curved layer's, after trimming the rim where the head
+    /// would hit), mm².
+    pub curved_area_mm2: f64,
+    /// How far each deeper curved layer steps in from the one above, mm (`None`: the head's
+    /// cone is too flat for the slope and only the topmost layer is curved).
+    pub rim_step_mm: Option<f64>,
+    /// Rounds of trimming the rim where the head hit (0: none needed).
+    pub trim_rounds: usize,
+    /// Flattest slope, degrees.
     pub min_slope_deg: f64,
     /// Steepest slope, degrees.
     pub max_slope_deg: f64,
@@ -44,6 +52,8 @@ pub struct CurvedLayerReport {
     pub k: usize,
     /// Depth below the surface, mm.
     pub depth: f64,
+    /// Area of the layer, mm² (deeper layers step in from the region's rim).
+    pub area_mm2: f64,
     /// Points written.
     pub points: usize,
     /// Largest distance of a point or segment midpoint from its target (surface − depth), mm.

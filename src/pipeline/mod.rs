@@ -105,6 +105,9 @@ pub enum PipelineError {
     /// The circuit's placement does not fit.
     #[error("{0}")]
     Electronics(#[from] electronics::ElectronicsError),
+    /// A curved-layer (clfff) print cannot be planned.
+    #[error("{0}")]
+    Clfff(#[from] crate::curved::clfff::ClfffError),
 }
 
 /// What slicing one object found.
@@ -536,4 +539,122 @@ fn check_fits(meshes: &[Mesh], cfg: &Config) -> Result<(), PipelineError> {
         }
     }
     Ok(())
+}
+
+/// One G-code file of a curved-layer print ([`slice_clfff`]).
+#[derive(Debug, Clone)]
+pub struct ClfffFile {
+    /// The sections in it, in print order.
+    pub sections: Vec<crate::curved::clfff::Section>,
+    /// The G-code.
+    pub gcode: Vec<u8>,
+    /// The Program it was written from.
+    pub program: Program,
+    /// Filament, time and per-tool figures from the writer.
+    pub stats: GcodeStats,
+}
+
+/// One object of a curved-layer print, for the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct ClfffObject {
+    /// The object's name.
+    pub name: String,
+    /// Where it ended up on the bed (raised).
+    pub bbox: Option<BoundingBox>,
+}
+
+/// What a curved-layer run produced, for the JSON report.
+#[derive(Debug, Clone, Serialize)]
+pub struct ClfffSummary {
+    /// The objects (printed together as one shell).
+    pub objects: Vec<ClfffObject>,
+    /// Program layers per file (planar scaffold layers and curved travel groups).
+    pub layers: Vec<usize>,
+    /// Writer figures per file.
+    pub gcode: Vec<GcodeStats>,
+    /// Wall time per stage in seconds, in stage order.
+    pub stage_seconds: Vec<(Stage, f64)>,
+    /// Scaffold, curved layers, collisions, sections.
+    pub clfff: crate::curved::clfff::ClfffReport,
+}
+
+/// The curved-layer FFF pipeline (`curved.mode = "clfff"`): the scene centred and raised on the
+/// bed, planned by [`crate::curved::clfff::plan`] (every object together as one shell, the
+/// model on object 0's tool), and written as one G-code file, or one per section with
+/// `curved.split_sections` (in print order: scaffold, buffer, model; with `curved.sandwich`
+/// the model section holds the bottom skin, the planar core and the top skin). See
+/// [`crate::curved::clfff`].
+pub fn slice_clfff(
+    scene: &Scene,
+    cfg: &Config,
+    mut progress: impl FnMut(Stage),
+) -> Result<(Vec<ClfffFile>, ClfffSummary), PipelineError> {
+    use crate::curved::clfff;
+    let mut laps = Laps::new();
+    if scene.triangle_count() == 0 {
+        return Err(PipelineError::EmptyScene);
+    }
+    progress(Stage::Place);
+    let mut meshes = place_on_bed(scene, cfg);
+    let raised = clfff::place::raise(&mut meshes, cfg);
+    check_fits(&meshes, cfg)?;
+    for m in &meshes {
+        if let Some(bb) = m.bounding_box()
+            && bb.max[2] > cfg.printer.max_height
+        {
+            return Err(PipelineError::TooLarge {
+                object: m.name.clone(),
+                axis: "z",
+                size: bb.max[2],
+                limit: cfg.printer.max_height,
+            });
+        }
+    }
+    let tool = cfg.tool_for_object(0);
+    if tool >= cfg.tools.len() {
+        return Err(PipelineError::UnknownTool {
+            object: meshes.first().map(|m| m.name.clone()).unwrap_or_default(),
+            tool,
+            tools: cfg.tools.len(),
+        });
+    }
+    laps.lap(Stage::Place);
+
+    progress(Stage::Slice);
+    let plan = clfff::plan(&meshes, tool, raised, cfg)?;
+    laps.lap(Stage::Slice);
+
+    progress(Stage::Program);
+    let programs = clfff::sections::programs(&plan.sections, cfg.curved.split_sections);
+    laps.lap(Stage::Program);
+
+    progress(Stage::Emit);
+    let wcfg = clfff::sections::writer_config(cfg);
+    let mut files = Vec::with_capacity(programs.len());
+    for (sections, program) in programs {
+        let mut gcode = Vec::new();
+        let stats = write_gcode(&program, &wcfg, &mut gcode)?;
+        files.push(ClfffFile {
+            sections,
+            gcode,
+            program,
+            stats,
+        });
+    }
+    laps.lap(Stage::Emit);
+
+    let summary = ClfffSummary {
+        objects: meshes
+            .iter()
+            .map(|m| ClfffObject {
+                name: m.name.clone(),
+                bbox: m.bounding_box(),
+            })
+            .collect(),
+        layers: files.iter().map(|f| f.program.layers.len()).collect(),
+        gcode: files.iter().map(|f| f.stats.clone()).collect(),
+        stage_seconds: laps.times,
+        clfff: plan.report,
+    };
+    Ok((files, summary))
 }

@@ -12,8 +12,13 @@
 //!   lighter tint per tool), travels as [`TRAVEL_WIDTH`] grey lines, with a legend below.
 //! - [`png`] rasterises every Nth layer into a grid of square tiles with `tiny-skia`
 //!   (extrusions only; a bar under each tile shows how far up the print the layer is).
-//! - [`write()`] writes `layer_0001.svg`… and [`CONTACT_SHEET`] into a folder, each file
-//!   atomically.
+//! - Side views ([`SIDE_VIEWS`]): every extrusion of the print projected onto the XZ and YZ
+//!   planes, planar layers in grey and non-planar (curved) extrusions highlighted, as SVG
+//!   ([`svg::side`]) and PNG ([`png::side`]). An extrusion is curved when a point of it lies off
+//!   its layer's Z; [`layered_by_markers`] keeps curved extrusions in the layer they are printed
+//!   in (by the `;LAYER_CHANGE` markers) instead of making a layer of every height.
+//! - [`write()`] writes `layer_0001.svg`…, [`CONTACT_SHEET`] and the side views into a folder,
+//!   each file atomically.
 //!
 //! Output bytes depend only on the input: SVG numbers have a fixed 3 decimals and the PNG
 //! encoder writes no timestamp.
@@ -35,6 +40,8 @@ pub const TRAVEL_COLOUR: [u8; 3] = [0x99, 0x99, 0x99];
 pub const MAX_DEFAULT_TILES: usize = 36;
 /// File name of the contact sheet.
 pub const CONTACT_SHEET: &str = "contact_sheet.png";
+/// Role of the start and end G-code's extrusions (PrusaSlicer's and conduit's `;TYPE:Custom`).
+const CUSTOM_ROLE: &str = "Custom";
 /// Role name of extrusions before any role comment.
 pub const UNNAMED_ROLE: &str = "Extrusion";
 
@@ -114,6 +121,10 @@ pub struct Stroke {
     pub kind: StrokeKind,
     /// Points [X, Y], mm; at least two.
     pub points: Vec<[f64; 2]>,
+    /// Z of each point, mm (the layer's Z where the file leaves it unknown).
+    pub z: Vec<f64>,
+    /// A non-planar extrusion: some point lies off its layer's Z (curved top or curved layer).
+    pub curved: bool,
 }
 
 /// The strokes of one printed layer, in file order.
@@ -151,7 +162,6 @@ impl Preview {
                 strokes: Vec::new(),
             })
             .collect();
-        const CUSTOM_ROLE: &str = "Custom";
         let mut roles: Vec<String> = Vec::new();
         let mut styles = Vec::new();
         // The view frames the part: extrusions of the start/end G-code (role `Custom`, e.g. a
@@ -173,6 +183,9 @@ impl Preview {
             let Some(layer) = layers.get_mut(m.layer) else {
                 continue;
             };
+            let z: Vec<f64> = m.path.iter().map(|p| p[2].unwrap_or(layer.z)).collect();
+            // Off the layer's Z by more than the G-code's rounding.
+            let curved = m.extruding && z.iter().any(|&v| (v - layer.z).abs() > 5e-4);
             let kind = if m.extruding {
                 let name = m.role.as_deref().unwrap_or(UNNAMED_ROLE);
                 let role = match roles.iter().position(|r| r == name) {
@@ -208,10 +221,21 @@ impl Preview {
                 StrokeKind::Travel
             };
             match layer.strokes.last_mut() {
-                Some(s) if s.kind == kind && s.points.last() == points.first() => {
+                Some(s)
+                    if s.kind == kind
+                        && s.curved == curved
+                        && s.points.last() == points.first()
+                        && (kind == StrokeKind::Travel || s.z.last() == z.first()) =>
+                {
                     s.points.extend_from_slice(&points[1..]);
+                    s.z.extend_from_slice(&z[1..]);
                 }
-                _ => layer.strokes.push(Stroke { kind, points }),
+                _ => layer.strokes.push(Stroke {
+                    kind,
+                    points,
+                    z,
+                    curved,
+                }),
             }
         }
         let bounds = bounds.or(custom_bounds).ok_or(PreviewError::NoExtrusion)?;
@@ -301,6 +325,134 @@ pub fn tint(rgb: [u8; 3], tool: usize) -> [u8; 3] {
     })
 }
 
+/// `moves` with printed layers numbered by the file's `;LAYER_CHANGE` markers (conduit's and
+/// PrusaSlicer's) instead of by distinct extrusion heights, when the heights would give more
+/// layers than the markers: non-planar extrusions (curved tops inside a layer, curved layers,
+/// spiral vases) then stay in the layer they are printed in instead of each height becoming a
+/// layer. A layer's Z is the `;Z:` value after its marker (else its first extrusion's Z);
+/// markers without extrusions give no layer. Other files are returned unchanged.
+pub fn layered_by_markers(gcode: &conduit_gcode::Gcode, moves: Moves) -> Moves {
+    // (line number of the marker, its Z).
+    let mut marks: Vec<(usize, Option<f64>)> = Vec::new();
+    for line in &gcode.lines {
+        let text = String::from_utf8_lossy(&line.text);
+        let text = text.trim();
+        if text.starts_with(";LAYER_CHANGE") {
+            marks.push((line.number, None));
+        } else if let (Some(z), Some(last)) = (text.strip_prefix(";Z:"), marks.last_mut()) {
+            if last.1.is_none() {
+                last.1 = z.trim().parse().ok();
+            }
+        }
+    }
+    if marks.is_empty() || moves.layer_z.len() <= marks.len() {
+        return moves;
+    }
+    // Marker index of each move (moves before the first marker go with the first).
+    let section = |line: usize| marks.partition_point(|&(l, _)| l <= line).saturating_sub(1);
+    let mut used = vec![false; marks.len()];
+    let mut first_z: Vec<Option<f64>> = vec![None; marks.len()];
+    for m in moves.moves.iter().filter(|m| m.extruding) {
+        let k = section(m.line);
+        used[k] = true;
+        if first_z[k].is_none() {
+            first_z[k] = m.to[2];
+        }
+    }
+    let mut index = vec![0; marks.len()];
+    let mut layer_z = Vec::new();
+    for k in 0..marks.len() {
+        index[k] = layer_z.len().saturating_sub(1);
+        if used[k] {
+            index[k] = layer_z.len();
+            layer_z.push(marks[k].1.or(first_z[k]).unwrap_or(0.0));
+        }
+    }
+    let Moves { mut moves, .. } = moves;
+    // Travels lead to the next extruding move's layer, as in `check::moves`.
+    let mut next = layer_z.len().saturating_sub(1);
+    for m in moves.iter_mut().rev() {
+        if m.extruding {
+            next = index[section(m.line)];
+        }
+        m.layer = next;
+    }
+    Moves { moves, layer_z }
+}
+
+/// File names of the side views: projections onto the XZ and YZ planes.
+pub const SIDE_VIEWS: [&str; 4] = ["side_xz.svg", "side_yz.svg", "side_xz.png", "side_yz.png"];
+
+/// Which vertical plane a side view projects onto.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SideAxis {
+    /// X across, Z up (looking along +Y).
+    X,
+    /// Y across, Z up (looking along −X).
+    Y,
+}
+
+impl SideAxis {
+    /// The horizontal coordinate of a point [X, Y].
+    pub fn across(self, p: [f64; 2]) -> f64 {
+        match self {
+            SideAxis::X => p[0],
+            SideAxis::Y => p[1],
+        }
+    }
+
+    /// The file name part: `xz` or `yz`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SideAxis::X => "xz",
+            SideAxis::Y => "yz",
+        }
+    }
+}
+
+/// Colour of planar extrusions in the side views, RGB.
+pub const SIDE_PLANAR_COLOUR: [u8; 3] = [0xb0, 0xb0, 0xb0];
+/// Colour of non-planar (curved) extrusions in the side views, RGB.
+pub const SIDE_CURVED_COLOUR: [u8; 3] = [0xd6, 0x27, 0x28];
+
+impl Preview {
+    /// Extent of the extrusions in a side view: [min across, min Z, max across, max Z], mm
+    /// (`None` when nothing extrudes).
+    /// As in the layer views, extrusions of the start and end G-code (role `Custom`) only frame
+    /// the view when nothing else does.
+    pub fn side_bounds(&self, axis: SideAxis) -> Option<[f64; 4]> {
+        let mut part: Option<[f64; 4]> = None;
+        let mut custom: Option<[f64; 4]> = None;
+        for layer in &self.layers {
+            for s in &layer.strokes {
+                let StrokeKind::Extrusion { role, .. } = s.kind else {
+                    continue;
+                };
+                let b = if self.roles.get(role).is_some_and(|r| r == CUSTOM_ROLE) {
+                    &mut custom
+                } else {
+                    &mut part
+                };
+                for (p, &z) in s.points.iter().zip(&s.z) {
+                    let a = axis.across(*p);
+                    let v = b.get_or_insert([a, z, a, z]);
+                    *v = [v[0].min(a), v[1].min(z), v[2].max(a), v[3].max(z)];
+                }
+            }
+        }
+        part.or(custom)
+    }
+
+    /// Number of curved (non-planar) extrusion strokes.
+    pub fn curved_strokes(&self) -> usize {
+        self.layers
+            .iter()
+            .flat_map(|l| &l.strokes)
+            .filter(|s| s.curved)
+            .count()
+    }
+}
+
 /// File name of layer `index` (0-based): `layer_0001.svg` for index 0.
 pub fn layer_file_name(index: usize) -> String {
     format!("layer_{:04}.svg", index + 1)
@@ -317,6 +469,8 @@ pub struct PreviewFiles {
     pub every: usize,
     /// Tiles on the contact sheet.
     pub tiles: usize,
+    /// The side views ([`SIDE_VIEWS`]).
+    pub side_views: Vec<PathBuf>,
 }
 
 /// Writes the preview of `moves` into `dir` (created if missing): one SVG per layer and
@@ -350,11 +504,23 @@ pub fn write(
     }
     let contact_sheet = dir.join(CONTACT_SHEET);
     write_file(&contact_sheet, &sheet)?;
+    let mut side_views = Vec::with_capacity(SIDE_VIEWS.len());
+    for axis in [SideAxis::X, SideAxis::Y] {
+        let path = dir.join(format!("side_{}.svg", axis.name()));
+        write_file(&path, svg::side(&preview, axis).as_bytes())?;
+        side_views.push(path);
+    }
+    for axis in [SideAxis::X, SideAxis::Y] {
+        let path = dir.join(format!("side_{}.png", axis.name()));
+        write_file(&path, &png::side(&preview, axis, params.tile_px * 4)?)?;
+        side_views.push(path);
+    }
     Ok(PreviewFiles {
         svgs,
         contact_sheet,
         every,
         tiles: preview.layers.len().div_ceil(every),
+        side_views,
     })
 }
 
@@ -540,7 +706,15 @@ mod tests {
             names.sort();
             assert_eq!(
                 names,
-                ["contact_sheet.png", "layer_0001.svg", "layer_0002.svg"]
+                [
+                    "contact_sheet.png",
+                    "layer_0001.svg",
+                    "layer_0002.svg",
+                    "side_xz.png",
+                    "side_xz.svg",
+                    "side_yz.png",
+                    "side_yz.svg"
+                ]
             );
             let bytes: Vec<Vec<u8>> = names
                 .iter()
@@ -579,5 +753,48 @@ mod tests {
         assert_eq!(svg::num(-0.0001), "0.000");
         assert_eq!(svg::num(1.23456), "1.235");
         assert_eq!(svg::num(-20.0), "-20.000");
+    }
+
+    /// One planar layer at Z 0.2 with a curved block after it (a slope from Z 0.3 to 0.5), then
+    /// a planar layer at Z 0.6.
+    const CURVED: &str = ";LAYER_CHANGE\n;Z:0.2\nG1 Z0.2\nG1 X10 Y10\n;TYPE:Solid infill\n\
+        G1 X20 Y10 E1\n; curved top layer 0 depth 0.000 (object 0)\nG1 X10 Y12 Z0.3\n\
+        G1 X15 Y12 Z0.4 E2\nG1 X20 Y12 Z0.5 E3\n;LAYER_CHANGE\n;Z:0.6\nG1 Z0.6\n\
+        G1 X10 Y14\nG1 X20 Y14 E4\n";
+
+    #[test]
+    fn curved_extrusions_stay_in_their_layer_and_are_highlighted_in_the_side_view() {
+        let g = conduit_gcode::parse(CURVED.as_bytes()).expect("parses");
+        let plain = moves(&g, Flavor::Marlin);
+        // By heights: 0.2, 0.4, 0.5, 0.6.
+        assert_eq!(plain.layer_z, vec![0.2, 0.4, 0.5, 0.6]);
+        let m = layered_by_markers(&g, plain);
+        assert_eq!(m.layer_z, vec![0.2, 0.6]);
+        let p = Preview::from_moves(&m).expect("extrudes");
+        let curved: Vec<&Stroke> = p.layers[0].strokes.iter().filter(|s| s.curved).collect();
+        assert_eq!(curved.len(), 1);
+        assert_eq!(
+            curved[0].points,
+            vec![[10.0, 12.0], [15.0, 12.0], [20.0, 12.0]]
+        );
+        assert_eq!(curved[0].z, vec![0.3, 0.4, 0.5]);
+        assert_eq!(p.curved_strokes(), 1);
+        assert_eq!(p.side_bounds(SideAxis::X), Some([10.0, 0.2, 20.0, 0.6]));
+        let side = svg::side(&p, SideAxis::X);
+        let lines: Vec<&str> = polylines(&side);
+        assert_eq!(
+            lines,
+            vec![
+                r#"<polyline data-layer="1" data-curved="false" data-role="Solid infill" points="10.000,-0.200 20.000,-0.200"/>"#,
+                r#"<polyline data-layer="2" data-curved="false" data-role="Solid infill" points="10.000,-0.600 20.000,-0.600"/>"#,
+                r#"<polyline data-layer="1" data-curved="true" data-role="Solid infill" points="10.000,-0.300 15.000,-0.400 20.000,-0.500"/>"#,
+            ]
+        );
+        // A planar file keeps its layers.
+        let planar = two_layers();
+        let g = conduit_gcode::parse(TWO_LAYERS.as_bytes()).expect("parses");
+        assert_eq!(layered_by_markers(&g, planar.clone()), planar);
+        let png = png::side(&p, SideAxis::Y, 64).expect("renders");
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     }
 }

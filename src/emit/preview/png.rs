@@ -1,3 +1,5 @@
+//! The contact sheet, and the side views as images.
+//!
 //! The contact sheet: every Nth layer rasterised with `tiny-skia` into square tiles on a grid
 //! (as many columns as `⌈√tiles⌉`, filled row by row), encoded as RGBA PNG.
 //!
@@ -8,7 +10,7 @@
 
 use tiny_skia::{LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
-use super::{Preview, PreviewError, StrokeKind};
+use super::{Preview, PreviewError, SIDE_CURVED_COLOUR, SIDE_PLANAR_COLOUR, SideAxis, StrokeKind};
 
 /// Sheet background (the frame between tiles), RGB.
 const FRAME: [u8; 3] = [0xd0, 0xd0, 0xd0];
@@ -114,4 +116,65 @@ pub fn contact_sheet(preview: &Preview, every: usize, tile: u32) -> Result<Vec<u
 
 fn colour(rgb: [u8; 3]) -> tiny_skia::Color {
     tiny_skia::Color::from_rgba8(rgb[0], rgb[1], rgb[2], 255)
+}
+
+/// The PNG bytes of the side view of `preview` onto the plane of `axis` and Z, `width` pixels
+/// wide (the height follows the print's aspect, at least 16 and at most 4·`width` pixels):
+/// planar extrusions grey, curved ones highlighted and drawn last, each at least a pixel wide.
+pub fn side(preview: &Preview, axis: SideAxis, width: u32) -> Result<Vec<u8>, PreviewError> {
+    let [a0, z0, a1, z1] = preview.side_bounds(axis).unwrap_or([0.0, 0.0, 1.0, 1.0]);
+    let width = width.max(16);
+    let pad = padding(width);
+    let inner = width as f32 - 2.0 * pad;
+    let scale = inner / (a1 - a0).max(1e-3) as f32;
+    let height = (((z1 - z0) as f32 * scale + 2.0 * pad).ceil() as u32).clamp(16, width * 4);
+    let too_large = PreviewError::SheetTooLarge {
+        width: u64::from(width),
+        height: u64::from(height),
+    };
+    if u64::from(width) * u64::from(height) > 1 << 28 {
+        return Err(too_large);
+    }
+    let mut pixmap = Pixmap::new(width, height).ok_or(too_large)?;
+    pixmap.fill(colour(BACKGROUND));
+    let mut paint = Paint {
+        anti_alias: true,
+        ..Paint::default()
+    };
+    let stroke = Stroke {
+        width: 1.0,
+        line_cap: LineCap::Round,
+        line_join: LineJoin::Round,
+        ..Stroke::default()
+    };
+    for curved in [false, true] {
+        paint.set_color(colour(if curved {
+            SIDE_CURVED_COLOUR
+        } else {
+            SIDE_PLANAR_COLOUR
+        }));
+        for layer in &preview.layers {
+            for s in layer.strokes.iter().filter(|s| s.curved == curved) {
+                if s.kind == StrokeKind::Travel {
+                    continue;
+                }
+                let mut pb = PathBuilder::new();
+                for (i, (p, &z)) in s.points.iter().zip(&s.z).enumerate() {
+                    let x = pad + (axis.across(*p) - a0) as f32 * scale;
+                    let y = height as f32 - pad - (z - z0) as f32 * scale;
+                    if i == 0 {
+                        pb.move_to(x, y);
+                    } else {
+                        pb.line_to(x, y);
+                    }
+                }
+                if let Some(path) = pb.finish() {
+                    pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+                }
+            }
+        }
+    }
+    pixmap
+        .encode_png()
+        .map_err(|e| PreviewError::Png(Box::new(e)))
 }

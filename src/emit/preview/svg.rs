@@ -1,9 +1,13 @@
 //! One layer as SVG: millimetre user units, Y flipped (SVG `y` is −Y) so +Y is up, the view box
-//! over the extrusions of every layer plus a margin, and a legend below the drawing.
+//! over the extrusions of every layer plus a margin, and a legend below the drawing; and the
+//! side views, every extrusion projected onto a vertical plane (SVG `y` is −Z).
 
 use std::fmt::Write;
 
-use super::{Preview, StrokeKind, TRAVEL_COLOUR, TRAVEL_WIDTH};
+use super::{
+    Preview, SIDE_CURVED_COLOUR, SIDE_PLANAR_COLOUR, SideAxis, StrokeKind, TRAVEL_COLOUR,
+    TRAVEL_WIDTH,
+};
 
 /// Margin around the extrusions, mm.
 const MARGIN: f64 = 2.0;
@@ -179,6 +183,86 @@ pub fn layer(preview: &Preview, index: usize) -> String {
         &mut s,
     );
     let _ = writeln!(s, "</g>");
+    let _ = writeln!(s, "</svg>");
+    s
+}
+
+/// Stroke width of the side views' lines, mm.
+pub const SIDE_STROKE: f64 = 0.1;
+
+/// The side view of `preview` onto the plane of `axis` and Z: every extrusion as a polyline of
+/// (across, −Z) points, in file order. Planar extrusions are grey (`data-curved="false"`),
+/// non-planar ones highlighted (`data-curved="true"`); each carries its layer
+/// (`data-layer`, 1-based) and role.
+pub fn side(preview: &Preview, axis: SideAxis) -> String {
+    let [a0, z0, a1, z1] = preview.side_bounds(axis).unwrap_or([0.0, 0.0, 1.0, 1.0]);
+    let (w, h) = (a1 - a0 + 2.0 * MARGIN, z1 - z0 + 2.0 * MARGIN);
+    let (vx, vy) = (a0 - MARGIN, -z1 - MARGIN);
+    let mut s = String::new();
+    let _ = writeln!(s, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{}mm" height="{}mm" viewBox="{} {} {} {}">"#,
+        num(w),
+        num(h),
+        num(vx),
+        num(vy),
+        num(w),
+        num(h)
+    );
+    let _ = writeln!(
+        s,
+        "<title>side view {}: {} layers, {} curved extrusions</title>",
+        axis.name().to_uppercase(),
+        preview.layers.len(),
+        preview.curved_strokes()
+    );
+    let _ = writeln!(
+        s,
+        r##"<rect x="{}" y="{}" width="{}" height="{}" fill="#ffffff"/>"##,
+        num(vx),
+        num(vy),
+        num(w),
+        num(h)
+    );
+    // Planar first, curved on top.
+    for curved in [false, true] {
+        let colour = if curved {
+            SIDE_CURVED_COLOUR
+        } else {
+            SIDE_PLANAR_COLOUR
+        };
+        let _ = writeln!(
+            s,
+            r#"<g class="{}" fill="none" stroke="{}" stroke-width="{}" stroke-linecap="round" stroke-linejoin="round">"#,
+            if curved { "curved" } else { "planar" },
+            hex(colour),
+            num(SIDE_STROKE)
+        );
+        for (i, layer) in preview.layers.iter().enumerate() {
+            for stroke in layer.strokes.iter().filter(|st| st.curved == curved) {
+                let StrokeKind::Extrusion { role, .. } = stroke.kind else {
+                    continue;
+                };
+                let mut pts = String::with_capacity(stroke.points.len() * 16);
+                for (k, (p, &z)) in stroke.points.iter().zip(&stroke.z).enumerate() {
+                    if k > 0 {
+                        pts.push(' ');
+                    }
+                    pts.push_str(&num(axis.across(*p)));
+                    pts.push(',');
+                    pts.push_str(&num(-z));
+                }
+                let _ = writeln!(
+                    s,
+                    r#"<polyline data-layer="{}" data-curved="{curved}" data-role="{}" points="{pts}"/>"#,
+                    i + 1,
+                    escape(&preview.roles[role])
+                );
+            }
+        }
+        let _ = writeln!(s, "</g>");
+    }
     let _ = writeln!(s, "</svg>");
     s
 }

@@ -1,0 +1,340 @@
+//! Conformal printing: a 2D design (SVG) laid onto a one-of-a-kind scanned surface and printed
+//! with a micro-extrusion nozzle on a 3-axis machine, by point-cloud-based path planning (PCPP).
+//!
+//! Place in the pipeline: a command of its own (`conduit conform`) that ends in a
+//! [`Program`], so the G-code writer, `conduit check` and `conduit preview` work on it. Its
+//! stages, in order ([`Stage`]):
+//!
+//! 1. [`surface`]: the scan as a queryable surface (mesh, or 2.5D Delaunay of a point cloud).
+//! 2. [`register`] (and [`markers`] for `--refs-auto`): scan frame → machine frame.
+//! 3. [`design`]: SVG paths placed on the top view, two points per inner diameter.
+//! 4. [`project`] (or [`geodesic`]): the zero-standoff path T on the surface.
+//! 5. [`spline`]: tangent, signed curvature, inflections, direction of travel.
+//! 6. [`correct`]: standoff, tip-disk contact escape, curvature-scaled downhill shift; then a
+//!    clearance pass with the whole nozzle ([`nozzle`]) lifts what still touches.
+//! 7. [`deposit`]: expected deposit thickness and its errors, for the method and two controls.
+//! 8. [`report`]: the JSON report; [`replay`] re-checks the written G-code for contacts.
+
+pub mod correct;
+pub mod deposit;
+pub mod design;
+pub mod geodesic;
+pub mod markers;
+pub mod nozzle;
+pub mod project;
+pub mod register;
+pub mod replay;
+pub mod report;
+pub mod spline;
+pub mod surface;
+
+pub use design::Placement;
+pub use nozzle::Nozzle;
+pub use register::{Registration, register};
+pub use report::ConformReport;
+pub use surface::Surface;
+
+use crate::config::{Config, ConformSettings, Corrections, Mapping};
+use crate::geom::Point3;
+use crate::program::{Layer, LayerItem, Program, Role, Toolpath};
+use deposit::{DepositStats, Thresholds};
+
+/// The stages of a conform run, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Stage {
+    /// Building the surface.
+    Surface,
+    /// Registration.
+    Register,
+    /// Placing and discretising the design.
+    Design,
+    /// Projection or geodesic mapping.
+    Project,
+    /// Local geometry.
+    Geometry,
+    /// Corrections and clearance.
+    Correct,
+    /// Deposit model.
+    Deposit,
+}
+
+/// Why a conform run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ConformError {
+    /// A setting is out of range.
+    ///
+    /// How to fix: correct the named `[conform]` key.
+    #[error("conform.{key}: {message}")]
+    Setting {
+        /// The key.
+        key: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// No design point lies over the surface.
+    ///
+    /// How to fix: move the design with `--place` over the surface (see the report's surface
+    /// bounds), or check the registration.
+    #[error("no point of the design lies over the surface")]
+    OffSurface,
+    /// The design has no paths.
+    ///
+    /// How to fix: the SVG must hold paths or shapes (text is not read).
+    #[error("the design has no paths")]
+    EmptyDesign,
+}
+
+/// Validated parameters of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConformParams {
+    /// Nozzle shape.
+    pub nozzle: Nozzle,
+    /// Extra lateral clearance of contact corrections, mm.
+    pub tolerance: f64,
+    /// Corrections applied.
+    pub corrections: Corrections,
+    /// Mapping of the design onto the surface.
+    pub mapping: Mapping,
+    /// Defect thresholds of the deposit model.
+    pub thresholds: Thresholds,
+}
+
+impl ConformParams {
+    /// Parameters from the `[conform]` settings, checked.
+    pub fn from_settings(s: &ConformSettings) -> Result<Self, ConformError> {
+        let positive = |key, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(ConformError::Setting {
+                    key,
+                    message: format!("must be a positive number, got {v}"),
+                })
+            }
+        };
+        let inner = positive("inner_diameter", s.inner_diameter)?;
+        let outer = positive("outer_diameter", s.outer_diameter)?;
+        if outer < inner {
+            return Err(ConformError::Setting {
+                key: "outer_diameter",
+                message: format!("{outer} is smaller than inner_diameter {inner}"),
+            });
+        }
+        positive("feed", s.feed)?;
+        for (key, v) in [
+            ("tolerance", s.tolerance),
+            ("needle_length", s.needle_length),
+            ("cone_height", s.cone_height),
+            ("flattening_error", s.flattening_error),
+            ("floating_error", s.floating_error),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(ConformError::Setting {
+                    key,
+                    message: format!("must be 0 or more, got {v}"),
+                });
+            }
+        }
+        if !(0.0..90.0).contains(&s.cone_angle) {
+            return Err(ConformError::Setting {
+                key: "cone_angle",
+                message: format!("must be in [0, 90), got {}", s.cone_angle),
+            });
+        }
+        Ok(Self {
+            nozzle: Nozzle {
+                inner,
+                outer,
+                needle_length: s.needle_length,
+                cone_angle_deg: s.cone_angle,
+                cone_height: s.cone_height,
+            },
+            tolerance: s.tolerance,
+            corrections: s.corrections,
+            mapping: s.mapping,
+            thresholds: Thresholds {
+                contact_thickness: s.contact_thickness,
+                flattening_error: s.flattening_error,
+                floating_error: s.floating_error,
+            },
+        })
+    }
+}
+
+/// The planned paths of a run.
+#[derive(Debug, Clone)]
+pub struct Planned {
+    /// Final tip positions per path (machine frame, mm).
+    pub paths: Vec<Vec<Point3>>,
+    /// The report (registration and replay are filled in by the caller).
+    pub report: ConformReport,
+}
+
+/// Tip paths of `t` (zero-standoff paths with their local geometry) under `mode`.
+fn corrected(
+    surface: &Surface,
+    params: &ConformParams,
+    mode: Corrections,
+    t: &[(Vec<Point3>, Vec<spline::Local>)],
+    counts: &mut correct::CorrectionCounts,
+) -> Vec<Vec<Point3>> {
+    t.iter()
+        .map(|(p, g)| {
+            correct::correct(
+                surface,
+                &params.nozzle,
+                params.tolerance,
+                mode,
+                p,
+                g,
+                counts,
+            )
+        })
+        .collect()
+}
+
+/// Plans the paths of `design` placed by `place` on `surface` (already in the machine frame):
+/// steps 3 to 7 of the module docs. `progress` is called at the start of each stage.
+pub fn plan(
+    surface: &Surface,
+    design: &conduit_svg::Design,
+    place: &Placement,
+    params: &ConformParams,
+    mut progress: impl FnMut(Stage),
+) -> Result<Planned, ConformError> {
+    let d = params.nozzle.inner;
+    progress(Stage::Design);
+    let placed = design::place(design, place);
+    if placed.is_empty() {
+        return Err(ConformError::EmptyDesign);
+    }
+    let planar: Vec<design::PlanarPath> = placed
+        .iter()
+        .map(|p| design::discretise(p, d / 2.0))
+        .collect();
+    progress(Stage::Project);
+    let projected = match params.mapping {
+        Mapping::Projection => project::project(surface, &planar),
+        Mapping::Geodesic => geodesic::map_geodesic(surface, &planar),
+    };
+    if projected.paths.is_empty() {
+        return Err(ConformError::OffSurface);
+    }
+    progress(Stage::Geometry);
+    let t: Vec<(Vec<Point3>, Vec<spline::Local>)> = projected
+        .paths
+        .iter()
+        .map(|p| (p.clone(), spline::local_geometry(p)))
+        .collect();
+    progress(Stage::Correct);
+    let mut counts = correct::CorrectionCounts::default();
+    let method = corrected(surface, params, params.corrections, &t, &mut counts);
+    let mut scratch = correct::CorrectionCounts::default();
+    let controls = [Corrections::None, Corrections::Slope, Corrections::Full].map(|mode| {
+        if mode == params.corrections {
+            (mode, method.clone())
+        } else {
+            (mode, corrected(surface, params, mode, &t, &mut scratch))
+        }
+    });
+    // The whole-nozzle check of the method's path, before anything is lifted.
+    let mut remaining = Vec::new();
+    for p in method.iter().flatten() {
+        let pen = params.nozzle.penetration(surface, p);
+        if pen > 0.0 {
+            remaining.push(report::Contact {
+                at: [p.x, p.y, p.z],
+                depth: pen,
+            });
+        }
+    }
+    let mut paths = method.clone();
+    // 5 µm over the G-code's 1 µm rounding.
+    let lifted: usize = paths
+        .iter_mut()
+        .map(|p| correct::clear(surface, &params.nozzle, p, 0.005))
+        .sum();
+    progress(Stage::Deposit);
+    let dep = |p: &[Vec<Point3>]| -> DepositStats {
+        deposit::deposit(surface, p, d, params.nozzle.outer, &params.thresholds)
+    };
+    let comparison = report::Comparison {
+        full: dep(&controls[2].1),
+        slope: dep(&controls[1].1),
+        none: dep(&controls[0].1),
+    };
+    let report = report::build(report::Inputs {
+        surface,
+        planar: &planar,
+        projected: &projected,
+        geometry: &t,
+        params,
+        counts,
+        remaining,
+        lifted,
+        deposit: dep(&paths),
+        comparison,
+    });
+    Ok(Planned { paths, report })
+}
+
+/// The planned paths as a one-layer Program for `cfg`'s writer: conductive traces of tool
+/// `settings.tool`, width and height d, at `settings.feed`. The layer's height `safe_z` is where
+/// the nozzle arrives before travelling to the first path (the surface's top plus clearance).
+pub fn program(paths: &[Vec<Point3>], settings: &ConformSettings, safe_z: f64) -> Program {
+    let items = paths
+        .iter()
+        .filter(|p| p.len() >= 2)
+        .map(|p| {
+            LayerItem::Path(Toolpath {
+                points: p.clone(),
+                closed: false,
+                role: Role::ConductiveTrace,
+                tool: settings.tool,
+                width: settings.inner_diameter,
+                height: settings.inner_diameter,
+                speed: settings.feed,
+                tool_axis: None,
+            })
+        })
+        .collect();
+    Program {
+        layers: vec![Layer {
+            index: 0,
+            z: safe_z,
+            height: settings.inner_diameter,
+            items,
+        }],
+    }
+}
+
+/// `cfg` adjusted for writing a conform program over `surface`: the pressure snippets of
+/// `[conform]` (when set) as the tool's paste snippets, and every travel lifted over the
+/// surface's top by `travel_clearance` (a hop on every travel, however short).
+pub fn machine_config(
+    cfg: &Config,
+    surface: &Surface,
+    lowest_tip: f64,
+) -> Result<Config, ConformError> {
+    let c = &cfg.conform;
+    let mut out = cfg.clone();
+    let Some(tool) = out.tools.get_mut(c.tool) else {
+        return Err(ConformError::Setting {
+            key: "tool",
+            message: format!(
+                "tool {} is not defined ({} tool(s))",
+                c.tool,
+                cfg.tools.len()
+            ),
+        });
+    };
+    if !c.pressure_on_gcode.is_empty() {
+        tool.paste_on_gcode = c.pressure_on_gcode.clone();
+    }
+    if !c.pressure_off_gcode.is_empty() {
+        tool.paste_off_gcode = c.pressure_off_gcode.clone();
+    }
+    tool.travel_lift = Some((surface.max().z - lowest_tip).max(0.0) + c.travel_clearance);
+    out.printer.retract_before_travel = 0.0;
+    Ok(out)
+}

@@ -1,0 +1,243 @@
+//! The head model replayed over a whole curved-layer print: does the head's cone (or carriage)
+//! touch anything printed before the nozzle gets there?
+//!
+//! Place in the pipeline: after the sections are Programs, before they are written; its
+//! findings go to the report and to stderr. It uses the head of [`crate::curved::collision`]
+//! (the `[curved]` head keys) but not its material model, which tests every nozzle position
+//! against every point: a whole print needs a spatial index.
+//!
+//! # Method
+//!
+//! Printed material is kept as a grid of [`CELL_MM`] squares over the bed, each holding the
+//! highest printed point that fell in it (a path's points, and points every [`CELL_MM`] along
+//! its segments). Each path is tested before it is added: every nozzle position (its points and
+//! points every [`CELL_MM`] between them) against the cells within the head's widest radius;
+//! a cell's point `q` hits when it is above the tip and closer horizontally than the head's
+//! radius at that height ([`Head::radius_at`]). Positions at or above everything printed so far
+//! are skipped (nothing can be above the tip). Keeping one point per cell is an approximation
+//! at the scale of a cell: a lower point beside the highest is not tested.
+
+use serde::Serialize;
+
+use crate::curved::collision::{Head, HeadPart};
+use crate::geom::Point3;
+use crate::program::{Program, Role};
+
+/// Side of the material grid's cells, mm.
+pub const CELL_MM: f64 = 0.25;
+
+/// Collisions listed in the report; the rest are counted.
+pub const MAX_LISTED: usize = 20;
+
+/// The head touching printed material.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Collision {
+    /// Program layer (index in the printed file) of the path.
+    pub layer: usize,
+    /// Role of the path being printed.
+    pub role: &'static str,
+    /// The nozzle tip, mm.
+    pub nozzle: [f64; 3],
+    /// The material inside the head, mm.
+    pub material: [f64; 3],
+    /// The part of the head.
+    pub part: HeadPart,
+}
+
+/// What the replay found.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct Collisions {
+    /// The first [`MAX_LISTED`] collisions.
+    pub listed: Vec<Collision>,
+    /// All collisions (one per path at most).
+    pub count: usize,
+}
+
+struct Grid {
+    origin: [f64; 2],
+    dims: [usize; 2],
+    cells: Vec<Option<Point3>>,
+    top: f64,
+}
+
+impl Grid {
+    fn new(program: &Program) -> Option<Self> {
+        let mut lo = [f64::MAX; 2];
+        let mut hi = [f64::MIN; 2];
+        for p in program.paths().flat_map(|p| p.points.iter()) {
+            lo = [lo[0].min(p.x), lo[1].min(p.y)];
+            hi = [hi[0].max(p.x), hi[1].max(p.y)];
+        }
+        if lo[0] > hi[0] {
+            return None;
+        }
+        let dims = [
+            ((hi[0] - lo[0]) / CELL_MM).ceil() as usize + 1,
+            ((hi[1] - lo[1]) / CELL_MM).ceil() as usize + 1,
+        ];
+        Some(Self {
+            origin: lo,
+            dims,
+            cells: vec![None; dims[0] * dims[1]],
+            top: f64::MIN,
+        })
+    }
+
+    fn cell(&self, x: f64, y: f64) -> Option<(usize, usize)> {
+        let cx = ((x - self.origin[0]) / CELL_MM).floor();
+        let cy = ((y - self.origin[1]) / CELL_MM).floor();
+        (cx >= 0.0 && cy >= 0.0 && (cx as usize) < self.dims[0] && (cy as usize) < self.dims[1])
+            .then_some((cx as usize, cy as usize))
+    }
+
+    fn add(&mut self, p: Point3) {
+        if let Some((cx, cy)) = self.cell(p.x, p.y) {
+            let slot = &mut self.cells[cy * self.dims[0] + cx];
+            if slot.is_none_or(|q| p.z > q.z) {
+                *slot = Some(p);
+            }
+            self.top = self.top.max(p.z);
+        }
+    }
+
+    /// The first material point inside the head with its tip at `p`.
+    fn hit(&self, head: &Head, p: Point3) -> Option<(Point3, HeadPart)> {
+        if p.z >= self.top {
+            return None;
+        }
+        let r = head.max_radius();
+        let (x0, y0) = (p.x - r, p.y - r);
+        let c0 = (
+            ((x0 - self.origin[0]) / CELL_MM).floor().max(0.0) as usize,
+            ((y0 - self.origin[1]) / CELL_MM).floor().max(0.0) as usize,
+        );
+        let c1 = (
+            (((p.x + r - self.origin[0]) / CELL_MM).floor().max(0.0) as usize)
+                .min(self.dims[0] - 1),
+            (((p.y + r - self.origin[1]) / CELL_MM).floor().max(0.0) as usize)
+                .min(self.dims[1] - 1),
+        );
+        for cy in c0.1..=c1.1 {
+            for cx in c0.0..=c1.0 {
+                let Some(q) = self.cells[cy * self.dims[0] + cx] else {
+                    continue;
+                };
+                let Some((radius, part)) = head.radius_at(q.z - p.z) else {
+                    continue;
+                };
+                if (q.x - p.x).hypot(q.y - p.y) < radius {
+                    return Some((q, part));
+                }
+            }
+        }
+        None
+    }
+}
+
+/// Points along `points` (closed: back to the first) at most [`CELL_MM`] apart.
+fn samples(points: &[Point3], closed: bool) -> Vec<Point3> {
+    let mut out = Vec::with_capacity(points.len() * 2);
+    let n = points.len();
+    let segs = if closed && n > 2 {
+        n
+    } else {
+        n.saturating_sub(1)
+    };
+    for i in 0..segs {
+        let (a, b) = (points[i], points[(i + 1) % n]);
+        let k = ((b - a).xy().norm() / CELL_MM).ceil().max(1.0) as usize;
+        for j in 0..k {
+            out.push(a + (b - a) * (j as f64 / k as f64));
+        }
+    }
+    if let (false, Some(&last)) = (closed && n > 2, points.last()) {
+        out.push(last);
+    }
+    out
+}
+
+/// Replays `program` with `head` (see the module docs).
+pub fn replay(program: &Program, head: &Head) -> Collisions {
+    let mut found = Collisions::default();
+    let Some(mut grid) = Grid::new(program) else {
+        return found;
+    };
+    for layer in &program.layers {
+        for path in layer.paths() {
+            let pts = samples(&path.points, path.closed);
+            if path.role != Role::Scaffold
+                && let Some((p, (q, part))) =
+                    pts.iter().find_map(|&p| grid.hit(head, p).map(|h| (p, h)))
+            {
+                found.count += 1;
+                if found.listed.len() < MAX_LISTED {
+                    found.listed.push(Collision {
+                        layer: layer.index,
+                        role: path.role.type_name(),
+                        nozzle: [p.x, p.y, p.z],
+                        material: [q.x, q.y, q.z],
+                        part,
+                    });
+                }
+            }
+            for p in pts {
+                grid.add(p);
+            }
+        }
+    }
+    found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::program::{Layer, LayerItem, Toolpath};
+
+    fn path(points: Vec<Point3>, role: Role) -> LayerItem {
+        LayerItem::Path(Toolpath {
+            points,
+            closed: false,
+            role,
+            tool: 0,
+            width: 0.45,
+            height: 0.2,
+            speed: 40.0,
+            tool_axis: None,
+        })
+    }
+
+    #[test]
+    fn a_wall_beside_a_low_path_is_hit_and_a_far_one_is_not() {
+        let head = Head {
+            angle_deg: 45.0,
+            height: 5.0,
+            carriage_radius: 0.0,
+            carriage_clearance: 10.0,
+        };
+        let wall = path(
+            vec![Point3::new(10.0, 0.0, 3.0), Point3::new(10.0, 5.0, 3.0)],
+            Role::ExternalPerimeter,
+        );
+        let near = path(
+            vec![Point3::new(8.5, 1.0, 1.0), Point3::new(8.5, 2.0, 1.0)],
+            Role::SolidInfill,
+        );
+        let far = path(
+            vec![Point3::new(7.5, 1.0, 1.0), Point3::new(7.5, 2.0, 1.0)],
+            Role::SolidInfill,
+        );
+        let program = |items| Program {
+            layers: vec![Layer {
+                index: 0,
+                z: 3.0,
+                height: 0.2,
+                items,
+            }],
+        };
+        let hit = replay(&program(vec![wall.clone(), near]), &head);
+        assert_eq!(hit.count, 1);
+        assert_eq!(hit.listed[0].part, HeadPart::Cone);
+        assert!((hit.listed[0].material[0] - 10.0).abs() < 1e-9);
+        assert_eq!(replay(&program(vec![wall, far]), &head).count, 0);
+    }
+}

@@ -1,0 +1,760 @@
+//! Conformal printing (`conduit conform`): generated surfaces (a stepped part, a ramp, bumps
+//! from 0.4·d to 20 mm, a sawtooth fold, a wrinkled film) and the corpus dome and bunny, with
+//! a spiral, a Hilbert loop, a triangular monopole and straight lines: no nozzle contact in a
+//! replay of the written G-code, and the full method's deposit error below both controls.
+//! Registration against a known random transform, marker holes, and the geodesic mapping.
+
+use std::path::Path;
+
+use conduit::config::{ConformSettings, Corrections, Mapping};
+use conduit::conform::deposit::DepositStats;
+use conduit::conform::register::{least_squares, three_point};
+use conduit::conform::{ConformParams, Placement, Surface, plan};
+use conduit::geom::Point3;
+use conduit_svg::{Design, DesignPath};
+use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
+use serde_json::Value;
+
+use crate::support::{conduit, corpus, sample, stderr, temp_dir};
+
+/// A small deterministic generator (64-bit LCG, high bits).
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn normal(&mut self) -> f64 {
+        let (u, v) = (self.next().max(1e-300), self.next());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+}
+
+/// Triangles of the height field z = f(x, y) over a grid of `n × n` cells (top surface only).
+fn height_field(
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+    n: usize,
+    f: &dyn Fn(f64, f64) -> f64,
+) -> Vec<[Point3; 3]> {
+    let (dx, dy) = ((x1 - x0) / n as f64, (y1 - y0) / n as f64);
+    let p = |i: usize, j: usize| {
+        let (x, y) = (x0 + i as f64 * dx, y0 + j as f64 * dy);
+        Point3::new(x, y, f(x, y))
+    };
+    let mut t = Vec::with_capacity(2 * n * n);
+    for j in 0..n {
+        for i in 0..n {
+            t.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+            t.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+        }
+    }
+    t
+}
+
+/// Binary STL of triangles.
+fn write_stl(path: &Path, tris: &[[Point3; 3]]) {
+    let mut b = vec![0u8; 80];
+    b.extend((tris.len() as u32).to_le_bytes());
+    for t in tris {
+        let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
+        for v in [n.x, n.y, n.z] {
+            b.extend((v as f32).to_le_bytes());
+        }
+        for p in t {
+            for v in [p.x, p.y, p.z] {
+                b.extend((v as f32).to_le_bytes());
+            }
+        }
+        b.extend([0, 0]);
+    }
+    std::fs::write(path, b).expect("STL written");
+}
+
+fn line(points: Vec<[f64; 2]>) -> DesignPath {
+    DesignPath {
+        id: None,
+        points,
+        closed: false,
+    }
+}
+
+/// Archimedean spiral of pitch `pitch` from radius 0.5 until `length` mm.
+fn spiral(pitch: f64, length: f64) -> Vec<[f64; 2]> {
+    let a = pitch / std::f64::consts::TAU;
+    let (mut th, mut l, mut pts) = (0.0f64, 0.0, vec![[0.5, 0.0]]);
+    while l < length {
+        th += 0.02;
+        let r = 0.5 + a * th;
+        let p = [r * th.cos(), r * th.sin()];
+        let q = pts[pts.len() - 1];
+        l += (p[0] - q[0]).hypot(p[1] - q[1]);
+        pts.push(p);
+    }
+    pts
+}
+
+/// A closed Hilbert-curve loop of order `order` filling a square of side `size`.
+fn hilbert_loop(order: u32, size: f64) -> Vec<[f64; 2]> {
+    let n = 1u32 << order;
+    let d2xy = |d: u32| {
+        let (mut x, mut y, mut t) = (0u32, 0u32, d);
+        let mut s = 1;
+        while s < n {
+            let rx = 1 & (t / 2);
+            let ry = 1 & (t ^ rx);
+            if ry == 0 {
+                if rx == 1 {
+                    x = s - 1 - x;
+                    y = s - 1 - y;
+                }
+                std::mem::swap(&mut x, &mut y);
+            }
+            x += s * rx;
+            y += s * ry;
+            t /= 4;
+            s *= 2;
+        }
+        [x as f64, y as f64]
+    };
+    let cell = size / n as f64;
+    let mut pts: Vec<[f64; 2]> = (0..n * n)
+        .map(|d| {
+            let p = d2xy(d);
+            [(p[0] + 0.5) * cell, (p[1] + 0.5) * cell + cell]
+        })
+        .collect();
+    // Close the loop below the curve: both ends are on the bottom row.
+    let (first, last) = (pts[0], pts[pts.len() - 1]);
+    pts.push([last[0], cell * 0.5]);
+    pts.push([first[0], cell * 0.5]);
+    pts.push(first);
+    pts
+}
+
+/// A triangular monopole: a feed line and a triangle patch outline.
+fn monopole(size: f64) -> Vec<Vec<[f64; 2]>> {
+    vec![
+        vec![[0.0, 0.0], [0.0, size * 0.4]],
+        vec![
+            [0.0, size * 0.4],
+            [-size * 0.5, size],
+            [size * 0.5, size],
+            [0.0, size * 0.4],
+        ],
+    ]
+}
+
+fn design(paths: Vec<Vec<[f64; 2]>>) -> Design {
+    Design {
+        width_mm: None,
+        height_mm: None,
+        paths: paths.into_iter().map(line).collect(),
+    }
+}
+
+fn settings() -> ConformSettings {
+    ConformSettings::default()
+}
+
+fn params(corrections: Corrections, mapping: Mapping) -> ConformParams {
+    let mut s = settings();
+    s.corrections = corrections;
+    s.mapping = mapping;
+    match ConformParams::from_settings(&s) {
+        Ok(p) => p,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+struct Case {
+    name: &'static str,
+    surface: Surface,
+    design: Design,
+    place: Placement,
+}
+
+fn at(x: f64, y: f64) -> Placement {
+    Placement {
+        x,
+        y,
+        rot_deg: 0.0,
+        scale: 1.0,
+    }
+}
+
+fn surface(t: Vec<[Point3; 3]>) -> Surface {
+    match Surface::from_triangles(t) {
+        Ok(s) => s,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// The generated surfaces with their designs.
+fn cases() -> Vec<Case> {
+    let d = settings().inner_diameter;
+    let mut out = Vec::new();
+    // An 80 × 80 mm part with a 3 mm step at x = 40 (over 1 mm) and a gentle roof.
+    let step = |x: f64, y: f64| 5.0 + 3.0 * ((x - 39.5).clamp(0.0, 1.0)) + 0.02 * y;
+    out.push(Case {
+        name: "step part, straight lines",
+        surface: surface(height_field(0.0, 0.0, 80.0, 80.0, 160, &step)),
+        design: design(
+            (0..5)
+                .map(|k| vec![[0.0, k as f64 * 4.0], [60.0, k as f64 * 4.0]])
+                .collect(),
+        ),
+        place: at(40.0, 40.0),
+    });
+    out.push(Case {
+        name: "ramp 30°, spiral",
+        surface: surface(height_field(0.0, 0.0, 60.0, 60.0, 60, &|x, _| {
+            x * 30f64.to_radians().tan()
+        })),
+        design: design(vec![spiral(1.5, 150.0)]),
+        place: at(30.0, 30.0),
+    });
+    // Bumps from 0.4·d to 20 mm radius (spherical caps of height 0.6 r), one surface each.
+    for r in [0.4 * d, 1.0, 5.0, 20.0] {
+        let cell = (r / 8.0).min(0.5);
+        let half = (2.0 * r + 3.0).min(40.0);
+        let n = ((2.0 * half / cell) as usize).min(400);
+        let cap = move |x: f64, y: f64| {
+            let q = x * x + y * y;
+            let h = 0.6 * r;
+            let rs = (r * r + h * h) / (2.0 * h);
+            if q < r * r {
+                (rs * rs - q).sqrt() - (rs - h)
+            } else {
+                0.0
+            }
+        };
+        out.push(Case {
+            name: Box::leak(format!("bump r = {r:.2} mm, lines").into_boxed_str()),
+            surface: surface(height_field(-half, -half, half, half, n, &cap)),
+            design: design(
+                [-0.3, 0.0, 0.3]
+                    .iter()
+                    .map(|o| vec![[-half * 0.9, o * r], [half * 0.9, o * r]])
+                    .collect(),
+            ),
+            place: at(0.0, 0.0),
+        });
+    }
+    // A sawtooth fold: 45° flanks, 2 mm high, 4 mm period.
+    let saw = |x: f64, _y: f64| {
+        let u = x.rem_euclid(4.0);
+        if u < 2.0 { u } else { 4.0 - u }
+    };
+    out.push(Case {
+        name: "sawtooth fold, Hilbert loop",
+        surface: surface(height_field(0.0, 0.0, 40.0, 40.0, 160, &saw)),
+        design: design(vec![hilbert_loop(3, 24.0)]),
+        place: at(20.0, 20.0),
+    });
+    // A random wrinkled film: sum of random waves.
+    let mut rng = Lcg(7);
+    let waves: Vec<[f64; 4]> = (0..12)
+        .map(|_| {
+            let k = 0.2 + 1.2 * rng.next();
+            let a = std::f64::consts::TAU * rng.next();
+            [
+                k * a.cos(),
+                k * a.sin(),
+                0.6 * rng.next() / k.sqrt(),
+                std::f64::consts::TAU * rng.next(),
+            ]
+        })
+        .collect();
+    let film = move |x: f64, y: f64| {
+        2.0 + waves
+            .iter()
+            .map(|w| w[2] * (w[0] * x + w[1] * y + w[3]).sin())
+            .sum::<f64>()
+    };
+    out.push(Case {
+        name: "wrinkled film, monopole",
+        surface: surface(height_field(0.0, 0.0, 40.0, 40.0, 200, &film)),
+        design: design(monopole(20.0)),
+        place: at(20.0, 20.0),
+    });
+    out
+}
+
+fn mae(s: &DepositStats) -> f64 {
+    s.mean_abs_error
+}
+
+#[test]
+fn full_method_beats_both_controls_and_leaves_no_contact() {
+    let p = params(Corrections::Full, Mapping::Projection);
+    let (mut full, mut slope, mut none) = (0.0, 0.0, 0.0);
+    for c in cases() {
+        let planned = match plan(&c.surface, &c.design, &c.place, &p, |_| {}) {
+            Ok(x) => x,
+            Err(e) => panic!("{}: {e}", c.name),
+        };
+        let r = &planned.report;
+        let cmp = &r.comparison;
+        println!(
+            "{}: MAE full {:.4} slope {:.4} none {:.4}; remaining {} lifted {} deposit contacts {}",
+            c.name,
+            mae(&cmp.full),
+            mae(&cmp.slope),
+            mae(&cmp.none),
+            r.remaining_contacts,
+            r.lifted,
+            r.deposit.contact
+        );
+        full += mae(&cmp.full) * cmp.full.samples as f64;
+        slope += mae(&cmp.slope) * cmp.slope.samples as f64;
+        none += mae(&cmp.none) * cmp.none.samples as f64;
+        // The whole nozzle, checked on every path point after the clearance pass.
+        for q in planned.paths.iter().flatten() {
+            let pen = p.nozzle.penetration(&c.surface, q);
+            assert!(
+                pen <= 0.0,
+                "{}: nozzle meets the surface at {q:?} by {pen}",
+                c.name
+            );
+        }
+    }
+    println!("total: full {full:.3} slope {slope:.3} none {none:.3}");
+    assert!(
+        full < slope && full < none,
+        "full {full} slope {slope} none {none}"
+    );
+}
+
+/// A random rigid transform.
+fn random_transform(rng: &mut Lcg) -> Isometry3<f64> {
+    let axis = Unit::new_normalize(Vector3::new(rng.normal(), rng.normal(), rng.normal()));
+    Isometry3::from_parts(
+        Translation3::new(200.0 * rng.next(), 200.0 * rng.next(), 50.0 * rng.next()),
+        UnitQuaternion::from_axis_angle(&axis, std::f64::consts::PI * rng.next()),
+    )
+}
+
+#[test]
+fn registration_recovers_a_random_rigid_transform_from_noisy_points() {
+    let mut rng = Lcg(2024);
+    let g = random_transform(&mut rng);
+    let scan: Vec<Point3> = (0..8)
+        .map(|_| Point3::new(80.0 * rng.next(), 80.0 * rng.next(), 20.0 * rng.next()))
+        .collect();
+    let sigma = 0.01;
+    let machine: Vec<Point3> = scan
+        .iter()
+        .map(|p| {
+            g.transform_point(p) + Vector3::new(rng.normal(), rng.normal(), rng.normal()) * sigma
+        })
+        .collect();
+    let r = match least_squares(&scan, &machine) {
+        Ok(r) => r,
+        Err(e) => panic!("{e}"),
+    };
+    // Residuals at the noise level: the expected rms is σ·√(3·(n − 2)/n) ≈ 1.5 σ for n = 8.
+    assert!(r.rms < 2.5 * sigma && r.rms > 0.3 * sigma, "rms {}", r.rms);
+    assert_eq!(r.residuals.len(), 8);
+    for p in [Point3::new(0.0, 0.0, 0.0), Point3::new(80.0, 80.0, 20.0)] {
+        let err = (r.transform.transform_point(&p) - g.transform_point(&p)).norm();
+        assert!(err < 3.0 * sigma, "{err}");
+    }
+    // Three exact points: the constructive method is exact.
+    let s3 = [scan[0], scan[1], scan[2]];
+    let m3 = s3.map(|p| g.transform_point(&p));
+    let r3 = match three_point(&s3, &m3) {
+        Ok(r) => r,
+        Err(e) => panic!("{e}"),
+    };
+    assert!(r3.rms < 1e-9, "{}", r3.rms);
+    let probe = Point3::new(13.0, -7.0, 5.0);
+    assert!((r3.transform.transform_point(&probe) - g.transform_point(&probe)).norm() < 1e-9);
+}
+
+#[test]
+fn geodesic_mapping_keeps_a_lines_length_on_a_45_degree_ramp() {
+    let ramp = surface(height_field(0.0, 0.0, 100.0, 40.0, 50, &|x, _| x));
+    let line50 = design(vec![vec![[0.0, 0.0], [50.0, 0.0]]]);
+    let length = |mapping| {
+        let p = params(Corrections::Full, mapping);
+        match plan(&ramp, &line50, &at(40.0, 20.0), &p, |_| {}) {
+            Ok(x) => x.report.geometry.length_3d,
+            Err(e) => panic!("{e}"),
+        }
+    };
+    let geodesic = length(Mapping::Geodesic);
+    let projected = length(Mapping::Projection);
+    assert!((geodesic - 50.0).abs() < 0.25, "geodesic {geodesic}");
+    assert!(
+        (projected - 50.0 * 2f64.sqrt()).abs() < 0.35,
+        "projection {projected}"
+    );
+}
+
+/// A config with a start G-code that stays off the surface (the default primes a line on the
+/// bed's front edge).
+fn cli_config(dir: &Path) -> std::path::PathBuf {
+    let path = dir.join("conform.toml");
+    std::fs::write(
+        &path,
+        "[printer]\nstart_gcode = \"G28 ; home\\n\"\nbed_size = [300, 300]\n",
+    )
+    .expect("config written");
+    path
+}
+
+fn spiral_svg(dir: &Path) -> std::path::PathBuf {
+    let pts = spiral(1.5, 556.0);
+    let d: Vec<String> = pts
+        .iter()
+        .map(|p| format!("{:.4},{:.4}", p[0] + 20.0, 20.0 - p[1]))
+        .collect();
+    let path = dir.join("spiral.svg");
+    std::fs::write(
+        &path,
+        format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"40mm\" height=\"40mm\" viewBox=\"0 0 40 40\"><path d=\"M {}\"/></svg>",
+            d.join(" L ")
+        ),
+    )
+    .expect("svg written");
+    path
+}
+
+/// Runs `conduit conform` and returns the report; asserts success, no replay contact and a
+/// clean `conduit check`.
+fn run_conform(dir: &Path, args: &[&str]) -> Value {
+    let out = dir.join("out.gcode");
+    let report = dir.join("report.json");
+    let cfg = cli_config(dir);
+    let mut all: Vec<String> = vec!["conform".into()];
+    all.extend(args.iter().map(|s| s.to_string()));
+    for s in [
+        "-c",
+        cfg.to_str().unwrap_or_default(),
+        "-o",
+        out.to_str().unwrap_or_default(),
+        "--report",
+        report.to_str().unwrap_or_default(),
+    ] {
+        all.push(s.to_owned());
+    }
+    let o = conduit(&all);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: Value = serde_json::from_slice(&std::fs::read(&report).expect("report")).expect("JSON");
+    let replay = &r["replay"];
+    assert_eq!(replay["printing"], 0, "{replay}");
+    assert_eq!(replay["travel"], 0, "{replay}");
+    assert_eq!(replay["custom"], 0, "{replay}");
+    let check = conduit([
+        "check",
+        out.to_str().unwrap_or_default(),
+        "-c",
+        cfg.to_str().unwrap_or_default(),
+    ]);
+    assert!(check.status.success(), "{}", stderr(&check));
+    r
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap_or(f64::NAN)
+}
+
+#[test]
+fn the_corpus_dome_takes_a_556_mm_spiral_without_contact() {
+    let Some(corpus) = corpus() else { return };
+    let dome = corpus.join("curved/conformal/Dome.stl");
+    let dir = temp_dir();
+    let svg = spiral_svg(dir.path());
+    // The dome is modelled y-up: three reference points turn it z-up, centred at (100, 100).
+    let r = run_conform(
+        dir.path(),
+        &[
+            "--surface",
+            dome.to_str().unwrap_or_default(),
+            "--design",
+            svg.to_str().unwrap_or_default(),
+            "--refs-scan",
+            "0,0,0;10,0,0;0,10,0",
+            "--refs-machine",
+            "100,100,0;110,100,0;100,100,10",
+        ],
+    );
+    assert!(f(&r["registration"]["rms"]) < 1e-9);
+    assert!(
+        (f(&r["geometry"]["length_2d"]) - 556.0).abs() < 2.0,
+        "{}",
+        r["geometry"]
+    );
+    // On a sphere of radius 20 the top of the path is the dome's top.
+    assert!((f(&r["surface"]["max"][2]) - 20.0).abs() < 0.01);
+    let cmp = &r["comparison"];
+    assert!(
+        f(&cmp["full"]["mean_abs_error"]) < f(&cmp["none"]["mean_abs_error"]),
+        "{cmp}"
+    );
+}
+
+#[test]
+fn the_bunny_scan_as_a_point_cloud_is_folded_and_printed_on_its_top() {
+    let Some(corpus) = corpus() else { return };
+    let bytes = std::fs::read(corpus.join("trimesh/models/bunny.ply")).expect("bunny");
+    let cloud = conduit_pointcloud::read_ply(&bytes).expect("bunny parses");
+    // Metres, y up → millimetres, z up.
+    let dir = temp_dir();
+    let xyz = dir.path().join("bunny.xyz");
+    let text: String = cloud
+        .points
+        .iter()
+        .map(|p| {
+            format!(
+                "{:.4} {:.4} {:.4}\n",
+                1000.0 * p[0] + 100.0,
+                -1000.0 * p[2] + 100.0,
+                1000.0 * p[1]
+            )
+        })
+        .collect();
+    std::fs::write(&xyz, text).expect("xyz written");
+    let design = dir.path().join("lines.svg");
+    std::fs::write(
+        &design,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"30mm\" height=\"20mm\" viewBox=\"0 0 30 20\">\
+         <path d=\"M0,5 L30,5 M0,10 L30,10 M0,15 L30,15\"/></svg>",
+    )
+    .expect("svg written");
+    let r = run_conform(
+        dir.path(),
+        &[
+            "--surface",
+            xyz.to_str().unwrap_or_default(),
+            "--design",
+            design.to_str().unwrap_or_default(),
+        ],
+    );
+    let c = &r["surface"]["cloud"];
+    assert_eq!(c["folds"], true, "{c}");
+    assert!(c["below_fold"].as_u64().unwrap_or(0) > 1000, "{c}");
+    assert_eq!(r["paths"], 3);
+}
+
+/// A 60 × 60 mm plate (z = 0.05·x, away from the machine's home at the origin) with holes of radius 1.5 mm at `centres` (grid vertices).
+fn drilled_plate(centres: &[[f64; 2]]) -> Vec<[Point3; 3]> {
+    height_field(20.0, 20.0, 80.0, 80.0, 120, &|x, _| 0.05 * x)
+        .into_iter()
+        .filter(|t| {
+            let c = (t[0].coords + t[1].coords + t[2].coords) / 3.0;
+            centres.iter().all(|m| (c.x - m[0]).hypot(c.y - m[1]) > 1.5)
+        })
+        .collect()
+}
+
+#[test]
+fn refs_auto_finds_three_drilled_marker_holes() {
+    let centres = [[30.0, 30.0], [70.0, 35.0], [40.0, 70.0]];
+    let dir = temp_dir();
+    let mut rng = Lcg(99);
+    let g = random_transform(&mut rng);
+    // The scan is the plate seen from a random pose; the machine knows where the holes are.
+    let scan: Vec<[Point3; 3]> = drilled_plate(&centres)
+        .into_iter()
+        .map(|t| t.map(|p| g.inverse_transform_point(&p)))
+        .collect();
+    let stl = dir.path().join("scan.stl");
+    write_stl(&stl, &scan);
+    let machine: Vec<String> = centres
+        .iter()
+        .rev()
+        .map(|c| format!("{},{},{}", c[0], c[1], 0.05 * c[0]))
+        .collect();
+    let design = dir.path().join("line.svg");
+    std::fs::write(&design, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"20mm\" height=\"1mm\" viewBox=\"0 0 20 1\"><path d=\"M0,0.5 L20,0.5\"/></svg>").expect("svg");
+    let r = run_conform(
+        dir.path(),
+        &[
+            "--surface",
+            stl.to_str().unwrap_or_default(),
+            "--design",
+            design.to_str().unwrap_or_default(),
+            "--refs-auto",
+            "--refs-machine",
+            &machine.join(";"),
+            "--place",
+            "30,30,0,1",
+        ],
+    );
+    assert_eq!(
+        r["markers"].as_array().map(Vec::len),
+        Some(3),
+        "{}",
+        r["markers"]
+    );
+    // f32 STL coordinates after a transform of up to 200 mm: about 10 µm of rounding.
+    assert!(f(&r["registration"]["rms"]) < 0.02, "{}", r["registration"]);
+    // The registered plate is the plate: z = 0.05·x under the line.
+    let zmax = f(&r["surface"]["max"][2]);
+    assert!((zmax - 4.0).abs() < 0.05, "{zmax}");
+}
+
+#[test]
+fn bad_inputs_fail_with_the_file_named() {
+    let dir = temp_dir();
+    let svg = spiral_svg(dir.path());
+    let missing = dir.path().join("missing.stl");
+    let out = dir.path().join("o.gcode");
+    let o = conduit([
+        "conform",
+        "--surface",
+        missing.to_str().unwrap_or_default(),
+        "--design",
+        svg.to_str().unwrap_or_default(),
+        "-o",
+        out.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("missing.stl"), "{}", stderr(&o));
+    let stl = dir.path().join("ramp.stl");
+    write_stl(&stl, &height_field(0.0, 0.0, 10.0, 10.0, 4, &|x, _| x));
+    let not_svg = dir.path().join("design.svg");
+    std::fs::write(&not_svg, "<html>").expect("written");
+    let o = conduit([
+        "conform",
+        "--surface",
+        stl.to_str().unwrap_or_default(),
+        "--design",
+        not_svg.to_str().unwrap_or_default(),
+        "-o",
+        out.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("design.svg"), "{}", stderr(&o));
+    let o = conduit([
+        "conform",
+        "--surface",
+        stl.to_str().unwrap_or_default(),
+        "--design",
+        svg.to_str().unwrap_or_default(),
+        "--refs-scan",
+        "0,0,0;1,1,1",
+        "--refs-machine",
+        "0,0,0;1,1,1",
+        "-o",
+        out.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(!out.exists());
+}
+
+#[test]
+fn corpus_dome_and_bunny_take_the_other_designs_without_contact() {
+    // The spiral on the dome runs through the command line above; here the library alone.
+    let Some(corpus) = corpus() else { return };
+    // The dome, y-up in its file, turned z-up.
+    let (scene, _) = conduit::scene::load_scene(
+        &corpus.join("curved/conformal/Dome.stl"),
+        &conduit::scene::LoadOptions::default(),
+    )
+    .expect("dome loads");
+    let tris: Vec<[Point3; 3]> = conduit::scene::placed_meshes(&scene)
+        .iter()
+        .flat_map(|m| m.triangle_corners().collect::<Vec<_>>())
+        .map(|t| t.map(|p| Point3::new(p.x, -p.z, p.y)))
+        .collect();
+    let dome = surface(tris);
+    // The bunny's points, metres y-up → millimetres z-up, as a cloud.
+    let bytes = std::fs::read(corpus.join("trimesh/models/bunny.ply")).expect("bunny");
+    let cloud = conduit_pointcloud::read_ply(&bytes).expect("bunny parses");
+    let pts: Vec<[f64; 3]> = cloud
+        .points
+        .iter()
+        .map(|p| [1000.0 * p[0], -1000.0 * p[2], 1000.0 * p[1]])
+        .collect();
+    let (bunny, info) = Surface::from_cloud(&pts, 1.0).expect("bunny surface");
+    assert!(info.folds);
+    let b = (bunny.min(), bunny.max());
+    let bunny_centre = at((b.0.x + b.1.x) / 2.0, (b.0.y + b.1.y) / 2.0);
+    let designs = [
+        ("hilbert", design(vec![hilbert_loop(3, 24.0)]), 1.0),
+        ("monopole", design(monopole(20.0)), 1.0),
+        (
+            "lines",
+            design(
+                (0..3)
+                    .map(|k| vec![[0.0, 5.0 * k as f64], [30.0, 5.0 * k as f64]])
+                    .collect(),
+            ),
+            1.0,
+        ),
+    ];
+    let p = params(Corrections::Full, Mapping::Projection);
+    for (sname, s, place) in [
+        ("dome", &dome, at(0.0, 0.0)),
+        ("bunny", &bunny, bunny_centre),
+    ] {
+        for (dname, d, _) in &designs {
+            let planned = plan(s, d, &place, &p, |_| {}).expect("planned");
+            let cmp = &planned.report.comparison;
+            println!(
+                "{sname} {dname}: MAE full {:.4} slope {:.4} none {:.4}; remaining {} lifted {}",
+                mae(&cmp.full),
+                mae(&cmp.slope),
+                mae(&cmp.none),
+                planned.report.remaining_contacts,
+                planned.report.lifted
+            );
+            assert!(mae(&cmp.full) < mae(&cmp.none), "{sname} {dname}");
+            for q in planned.paths.iter().flatten() {
+                assert!(p.nozzle.penetration(s, q) <= 0.0, "{sname} {dname}: {q:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_readme_example_prints_the_monopole_on_the_sample_film() {
+    // The README's command on the bundled samples: exit 0, a report with the whole monopole
+    // (two strokes: feed line and triangle), no contact left, and `conduit check` clean.
+    let dir = temp_dir();
+    let (out, report) = (dir.path().join("monopole.gcode"), dir.path().join("m.json"));
+    let film = sample("conform/wrinkled_film.xyz");
+    let design = sample("conform/monopole.svg");
+    let o = conduit([
+        "conform".as_ref(),
+        "--surface".as_ref(),
+        film.as_os_str(),
+        "--design".as_ref(),
+        design.as_os_str(),
+        "--set".as_ref(),
+        "printer.start_gcode=G28".as_ref(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--report".as_ref(),
+        report.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    // The design's own length: an 8 mm feed line and a triangle of base 20 mm and height 12 mm.
+    let length_2d = 8.0 + 20.0 + 2.0 * (10.0f64.powi(2) + 12.0f64.powi(2)).sqrt();
+    let g = &r["geometry"];
+    assert_eq!(r["paths"], 2, "{r}");
+    // Corrections move points sideways (downhill shifts), so the path's top view differs from
+    // the design by a little.
+    let measured = g["length_2d"].as_f64().expect("length");
+    assert!(
+        (measured - length_2d).abs() < 0.05,
+        "{measured} vs {length_2d}"
+    );
+    assert!(g["length_3d"].as_f64().expect("length") > length_2d, "{g}");
+    assert_eq!(r["remaining_contacts"], 0, "{r}");
+    assert_eq!(r["replay"]["printing"], 0, "{r}");
+    let check = conduit(["check".as_ref(), out.as_os_str()]);
+    assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+}
