@@ -133,7 +133,7 @@ pub fn place(
             body_height: p.body_height,
             object: p.object,
             pads,
-            footprint: convex_hull(hull_points),
+            footprint: Polygon::convex_hull(&hull_points),
         });
     }
     Ok(out)
@@ -233,34 +233,6 @@ fn ccw(mut p: Polygon) -> Polygon {
         p.points.reverse();
     }
     p
-}
-
-/// Convex hull (Andrew's monotone chain), counter-clockwise, without collinear vertices.
-fn convex_hull(mut pts: Vec<Point2>) -> Polygon {
-    pts.sort_unstable();
-    pts.dedup();
-    if pts.len() < 3 {
-        return Polygon::new(pts);
-    }
-    let mut hull: Vec<Point2> = Vec::with_capacity(pts.len() + 1);
-    for pass in 0..2 {
-        let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &Point2>> = if pass == 0 {
-            Box::new(pts.iter())
-        } else {
-            Box::new(pts.iter().rev())
-        };
-        for &p in iter {
-            while hull.len() >= start + 2
-                && hull[hull.len() - 2].cross(hull[hull.len() - 1], p) <= 0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop(); // the last point starts the other chain
-    }
-    Polygon::new(hull)
 }
 
 #[cfg(test)]
@@ -463,7 +435,7 @@ mod tests {
         let pts = [(0, 0), (2, 0), (1, 0), (2, 2), (0, 2), (1, 1), (0, 1)]
             .map(|(x, y)| Point2::new(x, y))
             .to_vec();
-        let h = convex_hull(pts);
+        let h = Polygon::convex_hull(&pts);
         let want = [(0, 0), (2, 0), (2, 2), (0, 2)].map(|(x, y)| Point2::new(x, y));
         assert_eq!(h.points, want);
     }

@@ -15,6 +15,37 @@ impl Polygon {
         Self { points }
     }
 
+    /// The convex hull of `points` (Andrew's monotone chain, exact in integers),
+    /// counter-clockwise, without collinear vertices; fewer than three distinct points are
+    /// returned as they are, sorted.
+    pub fn convex_hull(points: &[Point2]) -> Self {
+        let mut pts = points.to_vec();
+        pts.sort_unstable();
+        pts.dedup();
+        if pts.len() < 3 {
+            return Self::new(pts);
+        }
+        let mut hull: Vec<Point2> = Vec::with_capacity(pts.len() + 1);
+        for pass in 0..2 {
+            let start = hull.len();
+            let iter: Box<dyn Iterator<Item = &Point2>> = if pass == 0 {
+                Box::new(pts.iter())
+            } else {
+                Box::new(pts.iter().rev())
+            };
+            for &p in iter {
+                while hull.len() >= start + 2
+                    && hull[hull.len() - 2].cross(hull[hull.len() - 1], p) <= 0
+                {
+                    hull.pop();
+                }
+                hull.push(p);
+            }
+            hull.pop(); // the last point starts the other chain
+        }
+        Self::new(hull)
+    }
+
     /// Twice the signed area in square nanometres (positive when counter-clockwise), exact.
     pub fn signed_area2(&self) -> i128 {
         let n = self.points.len();

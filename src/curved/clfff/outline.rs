@@ -47,44 +47,14 @@ pub fn outline(shell: &Shell) -> Vec<ExPolygon> {
     union(&tris)
 }
 
-/// The convex hull of `points` (Andrew's monotone chain, exact in `i128`), counter-clockwise,
-/// without collinear points; fewer than three distinct points give an empty polygon.
-pub fn convex_hull(points: &[Point2]) -> Polygon {
-    let mut pts = points.to_vec();
-    pts.sort_unstable();
-    pts.dedup();
-    if pts.len() < 3 {
-        return Polygon::default();
-    }
-    let mut hull: Vec<Point2> = Vec::with_capacity(pts.len() + 1);
-    for pass in 0..2 {
-        let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &Point2>> = if pass == 0 {
-            Box::new(pts.iter())
-        } else {
-            Box::new(pts.iter().rev())
-        };
-        for &p in iter {
-            while hull.len() >= start + 2
-                && hull[hull.len() - 2].cross(hull[hull.len() - 1], p) <= 0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
-    Polygon::new(hull)
-}
-
 /// The scaffold area: the convex hull of the outline grown by `margin_mm` (round corners).
 pub fn scaffold_area(outline: &[ExPolygon], margin_mm: f64) -> Vec<ExPolygon> {
     let pts: Vec<Point2> = outline
         .iter()
         .flat_map(|ex| ex.contour.points.iter().copied())
         .collect();
-    let hull = convex_hull(&pts);
-    if hull.points.is_empty() {
+    let hull = Polygon::convex_hull(&pts);
+    if hull.points.len() < 3 {
         return Vec::new();
     }
     let ex = ExPolygon {
@@ -164,7 +134,7 @@ mod tests {
             p(0.0, 10.0),
             p(5.0, 0.0),
         ];
-        let h = convex_hull(&pts);
+        let h = Polygon::convex_hull(&pts);
         assert_eq!(h.points.len(), 5, "{h:?}");
         assert!(h.is_counter_clockwise());
         // (0,0) (10,0) (10,2) (2,10) (0,10): the square less the corner triangle ½·8·8.
