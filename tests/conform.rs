@@ -755,6 +755,26 @@ fn the_readme_example_prints_the_monopole_on_the_sample_film() {
     assert!(g["length_3d"].as_f64().expect("length") > length_2d, "{g}");
     assert_eq!(r["remaining_contacts"], 0, "{r}");
     assert_eq!(r["replay"]["printing"], 0, "{r}");
-    let check = conduit(["check".as_ref(), out.as_os_str()]);
+    let check = conduit(["check".as_ref(), out.as_os_str(), "--json".as_ref()]);
     assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+    // The dispensed path counts as printing (no E on a paste tool; the `;DISPENSE:` markers),
+    // so `conduit check` measures it and `conduit preview` draws it.
+    let stats: Value = serde_json::from_slice(&check.stdout).expect("check JSON");
+    let printed = stats["stats"]["print_distance_mm"]
+        .as_f64()
+        .expect("print distance");
+    let length_3d = g["length_3d"].as_f64().expect("length");
+    assert!(
+        (printed - length_3d).abs() < 0.05 * length_3d,
+        "{printed} vs {length_3d}"
+    );
+    let views = dir.path().join("preview");
+    let p = conduit([
+        "preview".as_ref(),
+        out.as_os_str(),
+        "--out-dir".as_ref(),
+        views.as_os_str(),
+    ]);
+    assert!(p.status.success(), "{}", stderr(&p));
+    assert!(views.join("side_xz.svg").is_file() && views.join("layer_0001.svg").is_file());
 }

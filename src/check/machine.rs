@@ -287,7 +287,8 @@ impl Machine<'_> {
             self.planner.push(de.abs(), v, [0.0; 3], [0.0; 3]);
         }
 
-        let extruding = has_xy && de > 0.0;
+        // XY moves that extrude, or that dispense paste between `;DISPENSE:` markers.
+        let extruding = mv.extruding;
         let usage = self.usage.entry(mv.tool).or_default();
         usage.e_net_mm += de;
         if extruding {

@@ -130,6 +130,9 @@ pub struct Replay {
     last_motion: Option<u8>,
     role: Option<Arc<str>>,
     width: Option<f64>,
+    /// Between `;DISPENSE:ON` and `;DISPENSE:OFF`: a paste tool's valve is open, so XY moves
+    /// print although they carry no E.
+    dispensing: bool,
 }
 
 impl Replay {
@@ -148,6 +151,7 @@ impl Replay {
             last_motion: None,
             role: None,
             width: None,
+            dispensing: false,
         }
     }
 
@@ -244,7 +248,7 @@ impl Replay {
         None
     }
 
-    /// `;TYPE:<role>`, `; FEATURE: <role>` and `;WIDTH:<mm>` comment lines.
+    /// `;TYPE:<role>`, `; FEATURE: <role>`, `;WIDTH:<mm>` and `;DISPENSE:ON|OFF` comment lines.
     fn comment(&mut self, line: &Line) {
         let Some(text) = line.comment_text() else {
             return;
@@ -256,6 +260,12 @@ impl Replay {
             let role = role.trim();
             if self.role.as_deref() != Some(role) {
                 self.role = Some(Arc::from(role));
+            }
+        } else if let Some(state) = text.strip_prefix("DISPENSE:") {
+            match state.trim() {
+                "ON" => self.dispensing = true,
+                "OFF" => self.dispensing = false,
+                _ => {}
             }
         } else if let Some(w) = text.strip_prefix("WIDTH:") {
             if let Ok(w) = w.trim().parse::<f64>() {
@@ -323,7 +333,7 @@ impl Replay {
             length,
             e: de,
             has_xy,
-            extruding: has_xy && de > 0.0,
+            extruding: has_xy && (de > 0.0 || (self.dispensing && g != 0)),
             arc,
             arc_error,
             feed: self.feed,

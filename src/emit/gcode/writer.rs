@@ -743,6 +743,8 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         let is_paste = ts.feed == Feed::Paste;
         if is_paste {
             self.lines(&paste_on);
+            // Marks the dispensing moves, which carry no E, for `conduit check` and preview.
+            self.line(";DISPENSE:ON");
         }
         let closing = path.closed.then(|| path.points[0]);
         let start = self
@@ -791,6 +793,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         }
         if is_paste {
             self.lines(&paste_off);
+            self.line(";DISPENSE:OFF");
         }
         Ok(())
     }
