@@ -262,6 +262,50 @@ impl HeightField {
     }
 }
 
+/// The points of the flat path `path` (xy, mm) with the points where it crosses a surface's
+/// triangle edges and subdivisions to at most `step` mm inserted, so that each segment lies over
+/// one triangle and a path lifted onto the surface stays on it; `crossings(a, b)` gives the
+/// parameters in (0, 1), ascending, where the segment `a`–`b` crosses a triangle edge. A closed
+/// path's closing segment is densified too and its first point is not repeated at the end.
+pub fn densify_path(
+    path: &[(f64, f64)],
+    closed: bool,
+    step: f64,
+    crossings: &dyn Fn((f64, f64), (f64, f64)) -> Vec<f64>,
+) -> Vec<(f64, f64)> {
+    let n = path.len();
+    let mut out = Vec::with_capacity(n * 4);
+    if n == 0 {
+        return out;
+    }
+    let segments = if closed { n } else { n - 1 };
+    for i in 0..segments {
+        let (a, b) = (path[i], path[(i + 1) % n]);
+        out.push(a);
+        let len = (b.0 - a.0).hypot(b.1 - a.1);
+        if !(len.is_finite() && len > 0.0) {
+            continue;
+        }
+        let mut ts = vec![0.0];
+        ts.extend(crossings(a, b));
+        ts.push(1.0);
+        for w in ts.windows(2) {
+            let pieces = ((w[1] - w[0]) * len / step).ceil().max(1.0) as usize;
+            for k in 1..=pieces {
+                if k == pieces && w[1] >= 1.0 {
+                    break;
+                }
+                let t = w[0] + (w[1] - w[0]) * k as f64 / pieces as f64;
+                out.push((a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t));
+            }
+        }
+    }
+    if !closed {
+        out.push(path[n - 1]);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

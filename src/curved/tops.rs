@@ -28,7 +28,7 @@
 //! [`MIN_THICKNESS_FRACTION`]` · h` are dropped (the path is split there), and so are points
 //! over another surface than the region's (a crack in the mesh) or next to a step in it.
 
-use super::surface::HeightField;
+use super::surface::{HeightField, densify_path};
 use crate::geom::{ExPolygon, Point2, Point3, Polygon, difference, intersection, union};
 use crate::slice::LayerZ;
 
@@ -455,36 +455,8 @@ impl Projector<'_> {
     /// inserted; a closed path's closing segment is densified too, so the loop ends just before
     /// its first point (a loop split by dropped points loses its closing segment).
     fn densify(&self, path: &[(f64, f64)], closed: bool) -> Vec<(f64, f64)> {
-        let mut out = Vec::with_capacity(path.len() * 4);
-        let n = path.len();
-        if n == 0 {
-            return out;
-        }
-        let segments = if closed { n } else { n - 1 };
-        for i in 0..segments {
-            let (a, b) = (path[i], path[(i + 1) % n]);
-            out.push(a);
-            let len = (b.0 - a.0).hypot(b.1 - a.1);
-            if !(len.is_finite() && len > 0.0) {
-                continue;
-            }
-            let mut ts = vec![0.0];
-            ts.extend(self.surface.edge_crossings(a, b));
-            ts.push(1.0);
-            for w in ts.windows(2) {
-                let pieces = ((w[1] - w[0]) * len / self.step).ceil().max(1.0) as usize;
-                for k in 1..=pieces {
-                    let t = w[0] + (w[1] - w[0]) * k as f64 / pieces as f64;
-                    if k == pieces && w[1] >= 1.0 {
-                        break;
-                    }
-                    out.push((a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t));
-                }
-            }
-        }
-        if !closed {
-            out.push(path[n - 1]);
-        }
-        out
+        densify_path(path, closed, self.step, &|a, b| {
+            self.surface.edge_crossings(a, b)
+        })
     }
 }

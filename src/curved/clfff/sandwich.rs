@@ -37,9 +37,9 @@
 //! and where the state changes the boundary point is repeated with each side's thickness, so
 //! the extrusion changes exactly there.
 
-use super::densify::densify_with;
 use super::layers::{LayerSpec, LiftedLayer, MAX_THICKNESS_FACTOR, flat_paths};
 use super::shell::Shell;
+use crate::curved::surface::densify_path;
 use crate::curved::tops::Projected;
 use crate::geom::{ExPolygon, Point3};
 
@@ -400,9 +400,9 @@ pub fn lift_skin_layer(
     for (xy, closed, role, width) in flat_paths(outline, &spec) {
         let dense = match spec.surface {
             Follows::Bottom => {
-                densify_with(&xy, closed, step, &|a, b| shell.bottom_crossings(a, b))
+                densify_path(&xy, closed, step, &|a, b| shell.bottom_crossings(a, b))
             }
-            Follows::Top => densify_with(&xy, closed, step, &|a, b| shell.top_crossings(a, b)),
+            Follows::Top => densify_path(&xy, closed, step, &|a, b| shell.top_crossings(a, b)),
         };
         let (pieces, dropped) = lift_path(&dense, closed, &lift);
         layer.dropped += dropped;
