@@ -24,12 +24,13 @@
 //! ([`super::sandwich::Sandwich::core_lift`], [`crate::curved::motion`]).
 
 use super::densify::densify;
+use super::outline::ccw_region;
 use super::sandwich::{Column, Sandwich, lift_path};
 use super::shell::Shell;
 use crate::config::Config;
 use crate::curved::motion;
 use crate::curved::surface::SurfaceTriangle;
-use crate::geom::{ExPolygon, Point2, Point3, Polygon, intersection, union};
+use crate::geom::{ExPolygon, Point2, Point3, intersection, union};
 use crate::program::{ObjectLayers, ProgramParams, Toolpath, build_program};
 use crate::region::{RegionError, make_regions_with_heights};
 use crate::slice::LayerZ;
@@ -64,25 +65,7 @@ fn clip(corners: &[Point3; 3], v: [f64; 3]) -> Option<ExPolygon> {
             pts.push((a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t));
         }
     }
-    if pts.len() < 3 {
-        return None;
-    }
-    let mut ring = Polygon::new(pts.iter().map(|&(x, y)| Point2::from_mm(x, y)).collect());
-    ring.points.dedup();
-    if ring.points.len() < 3 {
-        return None;
-    }
-    let a = ring.signed_area2();
-    if a == 0 {
-        return None;
-    }
-    if a < 0 {
-        ring.points.reverse();
-    }
-    Some(ExPolygon {
-        contour: ring,
-        holes: Vec::new(),
-    })
+    ccw_region(pts.iter().map(|&(x, y)| Point2::from_mm(x, y)).collect())
 }
 
 /// The z range of a triangle's corners.

@@ -19,29 +19,39 @@ const ROUND_TOLERANCE_MM: f64 = 0.02;
 /// Spacing of the rim samples along the outline, mm.
 const RIM_STEP_MM: f64 = 0.5;
 
+/// The polygon through `points` (repeated neighbours dropped), counter-clockwise, as a region
+/// without holes; `None` when fewer than three points remain or it has no area.
+pub(super) fn ccw_region(points: Vec<Point2>) -> Option<ExPolygon> {
+    let mut ring = Polygon::new(points);
+    ring.points.dedup();
+    if ring.points.len() < 3 {
+        return None;
+    }
+    let a = ring.signed_area2();
+    if a == 0 {
+        return None;
+    }
+    if a < 0 {
+        ring.points.reverse();
+    }
+    Some(ExPolygon {
+        contour: ring,
+        holes: Vec::new(),
+    })
+}
+
 /// The top-down projection of the shell's bottom surface, as non-overlapping ExPolygons.
 pub fn outline(shell: &Shell) -> Vec<ExPolygon> {
     let tris: Vec<ExPolygon> = shell
         .bottom_triangles()
         .iter()
         .filter_map(|t| {
-            let mut ring = Polygon::new(
+            ccw_region(
                 t.corners
                     .iter()
                     .map(|p| Point2::from_mm(p.x, p.y))
                     .collect(),
-            );
-            let a = ring.signed_area2();
-            if a == 0 {
-                return None;
-            }
-            if a < 0 {
-                ring.points.reverse();
-            }
-            Some(ExPolygon {
-                contour: ring,
-                holes: Vec::new(),
-            })
+            )
         })
         .collect();
     union(&tris)
