@@ -3,8 +3,10 @@
 //! Tests that need the shared corpus (`../shared/corpus` beside the checkout) print
 //! `skipped: corpus not found` and pass when it is absent.
 
+mod calibrate;
 mod clfff;
 mod cli;
+mod compensate;
 mod conform;
 mod conformance;
 mod curved;
@@ -14,6 +16,7 @@ mod jet;
 mod postprocess;
 mod postprocess_e2e;
 mod preview;
+mod robot;
 mod roundtrip;
 mod slice;
 mod support;

@@ -43,6 +43,12 @@ pub enum Command {
     /// a shutter gap in closed contours that moves every layer, direction reversed every block
     /// of layers. `conduit jet model ...` evaluates the corner accumulation model.
     Jet(JetArgs),
+    /// Robot calibration: the tool centre point from pivot poses (`tcp`), or the rigid
+    /// transform between two frames from corresponding points or poses (`register`).
+    Calibrate(super::calibrate::CalibrateArgs),
+    /// Gap compensation: move a robot path along its tool axis by the measured gaps (or gaps
+    /// simulated on a known surface with a robot error model), pass after pass.
+    Compensate(super::compensate::CompensateArgs),
 }
 
 /// Where settings come from: a config file plus `--set` overrides.

@@ -2,7 +2,9 @@
 //! (`args`), then each command runs (`info`, `convert`). Errors are printed with their cause chain.
 
 mod args;
+mod calibrate;
 mod check;
+mod compensate;
 mod config;
 mod conform;
 mod convert;
@@ -60,6 +62,8 @@ pub fn run() -> ExitCode {
         args::Command::Postprocess(a) => postprocess::run(a),
         args::Command::Conform(a) => conform::run(a),
         args::Command::Jet(a) => jet::run(a),
+        args::Command::Calibrate(a) => calibrate::run(a),
+        args::Command::Compensate(a) => compensate::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

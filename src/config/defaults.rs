@@ -4,14 +4,14 @@ use super::Config;
 
 /// One documented key: its section (`tools` stands for every `[tools.N]`), name, doc line, and
 /// for keys that are absent by default an example value written commented out.
-struct KeyDoc {
+pub(super) struct KeyDoc {
     section: &'static str,
     key: &'static str,
     doc: &'static str,
     example: Option<&'static str>,
 }
 
-const fn k(section: &'static str, key: &'static str, doc: &'static str) -> KeyDoc {
+pub(super) const fn k(section: &'static str, key: &'static str, doc: &'static str) -> KeyDoc {
     KeyDoc {
         section,
         key,
@@ -71,7 +71,24 @@ const SECTION_DOCS: &[(&str, &str)] = &[
         "Aerosol jet (conduit jet): corner fillet rules, shutter gap, direction blocks, shutter G-code,\n\
          fill and the corner accumulation model. Lengths mm (the command line takes µm).",
     ),
+    (
+        "robot",
+        "Robot arms and five-axis machines (conduit conform --output, conduit calibrate): arm model,\n\
+         frames, tool orientation and the dispense commands of each program dialect.",
+    ),
+    (
+        "compensate",
+        "Gap compensation (conduit compensate): measured tool-to-surface gaps move the path along the\n\
+         tool axis, pass after pass.",
+    ),
 ];
+
+/// Every documented key: the table below and the sections that keep their own.
+fn all_keys() -> impl Iterator<Item = &'static KeyDoc> {
+    KEYS.iter()
+        .chain(super::robot::KEYS)
+        .chain(super::compensate::KEYS)
+}
 
 const KEYS: &[KeyDoc] = &[
     k(
@@ -867,7 +884,7 @@ pub fn defaults_toml() -> String {
                 push_comment(&mut out, section_doc);
             }
             out.push_str(&format!("[{header}]\n"));
-            for doc in KEYS.iter().filter(|d| d.section == section) {
+            for doc in all_keys().filter(|d| d.section == section) {
                 // Tool keys are documented once, in the first tool's table.
                 if i == 0 {
                     push_comment(&mut out, doc.doc);
@@ -939,7 +956,7 @@ mod tests {
             }
         }
         let mut documented = std::collections::BTreeSet::new();
-        for d in KEYS {
+        for d in all_keys() {
             assert!(
                 documented.insert((d.section.to_owned(), d.key.to_owned())),
                 "{}.{} documented twice",
@@ -947,8 +964,7 @@ mod tests {
                 d.key
             );
         }
-        let optional: std::collections::BTreeSet<_> = KEYS
-            .iter()
+        let optional: std::collections::BTreeSet<_> = all_keys()
             .filter(|d| d.example.is_some())
             .map(|d| (d.section.to_owned(), d.key.to_owned()))
             .collect();

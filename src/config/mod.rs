@@ -26,7 +26,9 @@
 //! typo never passes silently. `[route]` and `[pnp]` configure cavities, trace routing and part
 //! placement ([`RouteSettings`], [`PnpSettings`]), `[curved]` curved layers (non-planar tops
 //! and curved-layer FFF, [`CurvedSettings`]), `[conform]` conformal printing on scanned
-//! surfaces ([`ConformSettings`]) and `[jet]` aerosol-jet toolpaths ([`JetSettings`]).
+//! surfaces ([`ConformSettings`]), `[jet]` aerosol-jet toolpaths ([`JetSettings`]), `[robot]`
+//! robot arms and five-axis machines ([`RobotSettings`]) and `[compensate]` gap compensation
+//! of robot paths ([`CompensateSettings`]).
 //!
 //! A `[tools.N]` table, when present, defines the tools: the tool numbers must run `0, 1, …`
 //! without gaps, and every key a table leaves out takes the default *of its kind*
@@ -38,20 +40,24 @@
 //! Lengths in millimetres, speeds in mm/s, accelerations in mm/s², temperatures in °C,
 //! fan speeds in percent, densities in g/cm³, volumetric flows in mm³/s.
 
+mod compensate;
 mod conform;
 mod curved;
 mod defaults;
 mod electronics;
 mod jet;
 pub mod prusa_ini;
+mod robot;
 mod template;
 
+pub use compensate::CompensateSettings;
 pub use conform::{ConformSettings, Corrections, Mapping};
 pub use curved::{CurvedMode, CurvedSettings};
 pub use defaults::defaults_toml;
 pub use electronics::{PnpSettings, RouteSettings};
 pub use jet::{JetFill, JetSettings};
 pub use prusa_ini::from_prusa_pairs;
+pub use robot::RobotSettings;
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -83,6 +89,10 @@ pub struct Config {
     pub conform: ConformSettings,
     /// Aerosol-jet toolpaths (`[jet]`).
     pub jet: JetSettings,
+    /// Robot arms and five-axis machines (`[robot]`).
+    pub robot: RobotSettings,
+    /// Gap compensation of robot paths (`[compensate]`).
+    pub compensate: CompensateSettings,
 }
 
 /// G-code dialect of the printer's firmware.
@@ -440,6 +450,8 @@ impl Default for Config {
             curved: CurvedSettings::default(),
             conform: ConformSettings::default(),
             jet: JetSettings::default(),
+            robot: RobotSettings::default(),
+            compensate: CompensateSettings::default(),
         }
     }
 }
@@ -642,6 +654,8 @@ impl Config {
         problems.extend(self.route.problems());
         problems.extend(self.curved.problems());
         problems.extend(self.jet.problems());
+        problems.extend(self.robot.problems());
+        problems.extend(self.compensate.problems());
         if !(self.pnp.lift.is_finite() && self.pnp.lift >= 0.0) {
             problems.push(format!("pnp.lift must be ≥ 0, got {}", self.pnp.lift));
         }

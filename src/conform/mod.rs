@@ -15,18 +15,23 @@
 //! 7. [`deposit`]: expected deposit thickness and its errors, for the method and two controls.
 //! 8. [`report`]: the JSON report; [`replay`] re-checks the written G-code for contacts.
 
+pub mod compensate;
 pub mod correct;
 pub mod deposit;
 pub mod design;
 pub mod geodesic;
+pub mod kinematics;
 pub mod markers;
 pub mod nozzle;
+pub mod orient;
+pub mod pattern;
 pub mod project;
 pub mod register;
 pub mod replay;
 pub mod report;
 pub mod spline;
 pub mod surface;
+pub mod tcp;
 
 pub use design::Placement;
 pub use nozzle::Nozzle;

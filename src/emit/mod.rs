@@ -10,4 +10,5 @@
 
 pub mod gcode;
 pub mod preview;
+pub mod robot;
 pub mod route_svg;
