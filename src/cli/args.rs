@@ -48,7 +48,7 @@ pub enum Command {
     Calibrate(super::calibrate::CalibrateArgs),
     /// Gap compensation: move a robot path along its tool axis by the measured gaps (or gaps
     /// simulated on a known surface with a robot error model), pass after pass.
-    Compensate(super::compensate::CompensateArgs),
+    Compensate(Box<super::compensate::CompensateArgs>),
 }
 
 /// Where settings come from: a config file plus `--set` overrides.
@@ -193,14 +193,40 @@ pub struct ConformArgs {
     /// `conform.mapping`.
     #[arg(long, value_name = "MAPPING", value_parser = ["projection", "geodesic"])]
     pub mapping: Option<String>,
-    /// Settings (`[conform]`, tools, printer).
+    /// Settings (`[conform]`, `[robot]`, tools, printer).
     #[command(flatten)]
     pub config: ConfigSource,
-    /// The G-code file to write.
-    #[arg(short, long, value_name = "OUT.gcode")]
-    pub output: PathBuf,
+    /// The file to write: G-code, or the program of `--output`.
+    #[arg(short = 'o', long = "out", value_name = "OUT")]
+    pub out: PathBuf,
+    /// What to write: `gcode` (3-axis, the printer's flavour), `urscript`, `krl` (KUKA .src),
+    /// `rapid` (ABB module), `poses-csv` (x,y,z,qw,qx,qy,qz,dispense) or `gcode-5axis`
+    /// (`robot.five_axis`: I J K tool vectors, or a head or table with rotary axes). The
+    /// `[robot]` section sets frames, clearance, speeds and the dispense output.
+    #[arg(
+        long = "output",
+        value_name = "DIALECT",
+        default_value = "gcode",
+        value_parser = ["gcode", "urscript", "krl", "rapid", "poses-csv", "gcode-5axis"]
+    )]
+    pub output: String,
+    /// Tool axis per point: `vertical` (3-axis planning with its corrections, the default),
+    /// `normal` (along the surface normal, smoothed along the path over
+    /// `robot.axis_smoothing`, tilt limited by `--max-tilt`; standoff along the axis) or
+    /// `fixed:i,j,k` (that direction, from the tip up toward the tool). A tilted tool needs a
+    /// multi-axis `--output`.
+    #[arg(
+        long,
+        value_name = "normal|vertical|fixed:i,j,k",
+        allow_hyphen_values = true
+    )]
+    pub tool_axis: Option<String>,
+    /// Largest tilt of the tool axis from the vertical, degrees (0 to 90). Overrides
+    /// `robot.max_tilt`.
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub max_tilt: Option<f64>,
     /// Also write the JSON report (geometry, corrections, deposit thickness against the
-    /// controls, contacts, replay).
+    /// controls, contacts, replay, tool orientation).
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
 }

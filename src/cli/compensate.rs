@@ -1,13 +1,568 @@
-//! `conduit compensate`: gap compensation of a robot path from measured gaps.
+//! `conduit compensate`: gap compensation of a robot path from measured gaps (`--gaps`) or from
+//! gaps simulated on a known surface under a robot error model (`--simulate`), and
+//! `conduit compensate pattern`, calibration print patterns on a surface.
 
-use super::Failure;
+use super::args::ConfigSource;
+use super::{Failure, config::resolve};
+use anyhow::{Context, anyhow};
+use conduit::config::{CompensateSettings, Config};
+use conduit::conform::Surface;
+use conduit::conform::compensate::simulate::{self, ErrorModel};
+use conduit::conform::compensate::substrate::{self, Substrate, SurfaceSpec};
+use conduit::conform::compensate::{self as comp, GapStats, Params, Path as PosePath, gaps};
+use conduit::conform::pattern::{self, PatternParams, Shape};
+use conduit::geom::Point3;
+use conduit::mesh::Mesh;
+use conduit::scene::{Content, LoadOptions, load, placed_meshes, write_atomically};
+use conduit_poses::Pose;
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Micrometres per millimetre.
+const UM: f64 = 1000.0;
 
 /// Arguments of `conduit compensate`.
 #[derive(Debug, clap::Args)]
-pub struct CompensateArgs {}
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct CompensateArgs {
+    /// `pattern`: write a calibration print pattern instead of compensating a path.
+    #[command(subcommand)]
+    pub command: Option<CompensateCommand>,
+    /// The path: a pose table `x,y,z,qw,qx,qy,qz[,dispense]` whose tool frame's z axis points
+    /// from the tool into the work.
+    #[arg(required = true, value_name = "PATH.csv")]
+    pub path: Option<PathBuf>,
+    /// Measured gaps: a `reading` column (mm) placed by `index` (pose number from 0) or `s`
+    /// (arc length along the path, mm), or one reading per pose.
+    #[arg(long, value_name = "MEASURED.csv", conflicts_with = "simulate")]
+    pub gaps: Option<PathBuf>,
+    /// Simulate the gaps on a known surface: `sphere:R`, `cylinder:R` (axis along y),
+    /// `plane`, `plane:waviness:AMPLITUDE,PERIOD` (mm) or a mesh file, moved by the error
+    /// model (--shift, --tilt, --z-error) and read with --noise.
+    #[arg(long, value_name = "SURFACE")]
+    pub simulate: Option<String>,
+    /// Angle between the sensor beam and the tool axis, degrees: a reading h is the gap
+    /// h·cos(angle) [compensate.sensor_angle].
+    #[arg(long = "sensor-angle", value_name = "DEG")]
+    pub sensor_angle: Option<f64>,
+    /// Gap to aim for, µm [compensate.target].
+    #[arg(long, value_name = "UM")]
+    pub target: Option<f64>,
+    /// Standard deviation of the Gaussian smoothing of the corrections along the path, mm
+    /// (0 = none) [compensate.smoothing].
+    #[arg(long, value_name = "MM")]
+    pub smoothing: Option<f64>,
+    /// Simulation: measure → compensate passes [compensate.passes].
+    #[arg(requires = "simulate", long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub passes: Option<u32>,
+    /// Simulation: shift of the real substrate, mm [compensate.error_shift].
+    #[arg(requires = "simulate", long, value_name = "DX,DY,DZ", allow_hyphen_values = true, value_parser = triple)]
+    pub shift: Option<[f64; 3]>,
+    /// Simulation: orientation error of the substrate about --tilt-axis through the middle of
+    /// the path, degrees [compensate.error_tilt].
+    #[arg(
+        requires = "simulate",
+        long,
+        value_name = "DEG",
+        allow_hyphen_values = true
+    )]
+    pub tilt: Option<f64>,
+    /// Simulation: axis of --tilt [compensate.error_axis].
+    #[arg(requires = "simulate", long = "tilt-axis", value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = triple)]
+    pub tilt_axis: Option<[f64; 3]>,
+    /// Simulation: tool-length error, mm, added to every gap [compensate.error_z].
+    #[arg(
+        requires = "simulate",
+        long = "z-error",
+        value_name = "MM",
+        allow_hyphen_values = true
+    )]
+    pub z_error: Option<f64>,
+    /// Simulation: standard deviation of the sensor noise, µm [compensate.noise].
+    #[arg(requires = "simulate", long, value_name = "UM")]
+    pub noise: Option<f64>,
+    /// Simulation: seed of the sensor noise [compensate.seed].
+    #[arg(requires = "simulate", long, value_name = "N")]
+    pub seed: Option<u64>,
+    /// Simulation: also write the readings of the first measurement as a gap table
+    /// (`index,s,reading`), for `--gaps`.
+    #[arg(long = "readings-out", value_name = "GAPS.csv", requires = "simulate")]
+    pub readings_out: Option<PathBuf>,
+    /// Settings (the `[compensate]` section).
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// The compensated pose table to write.
+    #[arg(short, long, value_name = "OUT.csv", required = true)]
+    pub output: Option<PathBuf>,
+    /// Also write a JSON report: gap statistics before, the corrections, and with --simulate
+    /// the real gaps after each pass.
+    #[arg(long, value_name = "R.json")]
+    pub report: Option<PathBuf>,
+}
 
-pub(crate) fn run(_args: CompensateArgs) -> Result<(), Failure> {
-    Err(Failure::Usage(
-        "conduit compensate: not available".to_owned(),
-    ))
+/// Subcommands of `conduit compensate`.
+#[derive(Debug, clap::Subcommand)]
+pub enum CompensateCommand {
+    /// A calibration print pattern projected onto a surface: a pose table with the tool along
+    /// the surface normal and the tip at the target gap.
+    Pattern(Box<PatternArgs>),
+}
+
+/// Arguments of `conduit compensate pattern`.
+#[derive(Debug, clap::Args)]
+pub struct PatternArgs {
+    /// The shape.
+    #[arg(value_enum)]
+    pub shape: Shape,
+    /// Diameter of a circle or spiral, side of a serpentine's square, mm.
+    #[arg(long, value_name = "MM")]
+    pub size: f64,
+    /// The surface: `sphere:R` (centred at the origin), `cylinder:R` (axis along y through the
+    /// origin), `plane` (z = 0), `plane:waviness:AMPLITUDE,PERIOD` or a mesh file.
+    #[arg(long, value_name = "SURFACE")]
+    pub surface: String,
+    /// Centre of the pattern in the top view, mm.
+    #[arg(long, value_name = "X,Y", allow_hyphen_values = true, value_parser = pair, default_value = "0,0")]
+    pub at: [f64; 2],
+    /// Draw the pattern in the tangent plane of the surface point above --at (and project it
+    /// along that plane's normal) instead of the top view.
+    #[arg(long)]
+    pub tangent: bool,
+    /// Distance between neighbouring points, mm [compensate.pattern_spacing].
+    #[arg(long, value_name = "MM")]
+    pub spacing: Option<f64>,
+    /// Distance between serpentine lines or spiral turns, mm [compensate.pattern_pitch].
+    #[arg(long, value_name = "MM")]
+    pub pitch: Option<f64>,
+    /// Tip-to-surface gap along the normal, µm [compensate.target].
+    #[arg(long, value_name = "UM")]
+    pub target: Option<f64>,
+    /// Settings (the `[compensate]` section).
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// The pose table to write.
+    #[arg(short, long, value_name = "PATH.csv")]
+    pub output: PathBuf,
+}
+
+/// `A,B,C` as three numbers.
+fn triple(text: &str) -> Result<[f64; 3], String> {
+    numbers::<3>(text)
+}
+
+/// `A,B` as two numbers.
+fn pair(text: &str) -> Result<[f64; 2], String> {
+    numbers::<2>(text)
+}
+
+fn numbers<const N: usize>(text: &str) -> Result<[f64; N], String> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|t| t.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected {N} comma-separated numbers, got {text:?}"))?;
+    let arr: [f64; N] = v
+        .try_into()
+        .map_err(|_| format!("expected {N} comma-separated numbers, got {text:?}"))?;
+    if arr.iter().all(|x| x.is_finite()) {
+        Ok(arr)
+    } else {
+        Err(format!("{text:?}: numbers must be finite"))
+    }
+}
+
+pub(crate) fn run(args: CompensateArgs) -> Result<(), Failure> {
+    if let Some(CompensateCommand::Pattern(p)) = args.command {
+        return run_pattern(*p);
+    }
+    let (Some(path), Some(output)) = (args.path.clone(), args.output.clone()) else {
+        return Err(Failure::Usage("PATH.csv and -o are required".to_owned()));
+    };
+    let mut cfg = resolve(&args.config)?;
+    overrides(&mut cfg.compensate, &args)?;
+    let params = Params::from_settings(&cfg.compensate).map_err(anyhow::Error::from)?;
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let poses = PosePath::parse(&text).with_context(|| path.display().to_string())?;
+    let job = Job {
+        args: &args,
+        header: leading_comments(&text),
+        cfg,
+        params,
+        poses,
+        path,
+        output,
+    };
+    match (&args.gaps, &args.simulate) {
+        (Some(g), None) => measured(&job, g),
+        (None, Some(spec)) => simulated(&job, spec),
+        _ => Err(Failure::Usage(
+            "give the measured gaps (--gaps MEASURED.csv) or a surface to simulate them on \
+             (--simulate SURFACE)"
+                .to_owned(),
+        )),
+    }
+}
+
+/// A compensation run, its inputs read and checked.
+struct Job<'a> {
+    args: &'a CompensateArgs,
+    cfg: Config,
+    params: Params,
+    /// The path.
+    poses: PosePath,
+    /// The `#` lines at the top of the path table.
+    header: Vec<String>,
+    path: PathBuf,
+    output: PathBuf,
+}
+
+/// Command-line values over the `[compensate]` settings, checked again.
+fn overrides(s: &mut CompensateSettings, a: &CompensateArgs) -> Result<(), Failure> {
+    if let Some(v) = a.target {
+        s.target = v / UM;
+    }
+    if let Some(v) = a.sensor_angle {
+        s.sensor_angle = v;
+    }
+    if let Some(v) = a.smoothing {
+        s.smoothing = v;
+    }
+    if let Some(v) = a.passes {
+        s.passes = v;
+    }
+    if let Some(v) = a.shift {
+        s.error_shift = v;
+    }
+    if let Some(v) = a.tilt {
+        s.error_tilt = v;
+    }
+    if let Some(v) = a.tilt_axis {
+        s.error_axis = v;
+    }
+    if let Some(v) = a.z_error {
+        s.error_z = v;
+    }
+    if let Some(v) = a.noise {
+        s.noise = v / UM;
+    }
+    if let Some(v) = a.seed {
+        s.seed = v;
+    }
+    let problems = s.problems();
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(Failure::Usage(problems.join("; ")))
+    }
+}
+
+/// The `#` lines before the header of a table (they state its frame), kept in the output.
+fn leading_comments(text: &str) -> Vec<String> {
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .take_while(|l| l.starts_with('#'))
+        .map(str::to_owned)
+        .collect()
+}
+
+/// Writes `poses` after the `comments` lines, all or nothing.
+fn write_table(path: &Path, comments: &[String], poses: &[Pose]) -> anyhow::Result<()> {
+    let mut buf: Vec<u8> = Vec::new();
+    for c in comments {
+        writeln!(buf, "{c}")?;
+    }
+    conduit_poses::write_poses(poses, &mut buf)
+        .with_context(|| format!("{}: cannot write poses", path.display()))?;
+    write_atomically(path, |f| f.write_all(&buf))
+        .with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// Writes a JSON report, all or nothing.
+fn write_report(path: &Path, report: &impl Serialize) -> anyhow::Result<()> {
+    let json = serde_json::to_vec_pretty(report).context("serialising the report")?;
+    write_atomically(path, |f| f.write_all(&json))
+        .with_context(|| format!("{}: cannot write report", path.display()))
+}
+
+/// The report of a pass over measured gaps.
+#[derive(Serialize)]
+struct MeasuredReport {
+    path: String,
+    gaps: String,
+    poses: usize,
+    closed: bool,
+    target_mm: f64,
+    sensor_angle_deg: f64,
+    smoothing_mm: f64,
+    placed_by: gaps::Key,
+    readings: usize,
+    poses_outside_measurement: usize,
+    before_mm: GapStats,
+    correction_mm: comp::CorrectionStats,
+}
+
+/// One pass over measured gaps.
+fn measured(job: &Job, gaps_path: &Path) -> Result<(), Failure> {
+    let Job {
+        args,
+        params,
+        poses,
+        header,
+        path,
+        output,
+        ..
+    } = job;
+    let text = std::fs::read_to_string(gaps_path)
+        .with_context(|| format!("{}: cannot read", gaps_path.display()))?;
+    let on =
+        gaps::read(&text, &poses.arc_lengths()).with_context(|| gaps_path.display().to_string())?;
+    if on.outside > 0 {
+        eprintln!(
+            "warning: {}: {} pose(s) lie outside the measured stretch and take the nearest reading",
+            gaps_path.display(),
+            on.outside
+        );
+    }
+    let pass = comp::compensate_pass(poses, &on.readings, params);
+    let mut comments = header.to_vec();
+    comments.push(format!(
+        "# compensated by conduit compensate: gaps {}, target {} mm, sensor angle {} deg, smoothing {} mm",
+        gaps_path.display(),
+        params.target,
+        params.sensor_angle,
+        params.smoothing
+    ));
+    let report = MeasuredReport {
+        path: path.display().to_string(),
+        gaps: gaps_path.display().to_string(),
+        poses: poses.poses.len(),
+        closed: poses.is_closed(),
+        target_mm: params.target,
+        sensor_angle_deg: params.sensor_angle,
+        smoothing_mm: params.smoothing,
+        placed_by: on.key,
+        readings: on.rows,
+        poses_outside_measurement: on.outside,
+        before_mm: pass.before,
+        correction_mm: pass.correction,
+    };
+    write_table(output, &comments, &pass.poses)?;
+    if let Some(r) = &args.report {
+        write_report(r, &report)?;
+    }
+    let b = pass.before;
+    eprintln!(
+        "{}: {} poses; gap before {:.4}..{:.4} mm (variation {:.1} µm, RMS {:.1} µm about {:.1} µm); \
+         correction {:.4}..{:.4} mm",
+        output.display(),
+        pass.poses.len(),
+        b.min,
+        b.max,
+        b.variation * UM,
+        b.rms_about_target * UM,
+        params.target * UM,
+        pass.correction.min,
+        pass.correction.max
+    );
+    Ok(())
+}
+
+/// The report of a simulation.
+#[derive(Serialize)]
+struct SimulatedReport {
+    path: String,
+    surface: String,
+    error_model: ErrorModel,
+    pivot: [f64; 3],
+    poses: usize,
+    target_mm: f64,
+    sensor_angle_deg: f64,
+    smoothing_mm: f64,
+    uncompensated_mm: GapStats,
+    passes: Vec<simulate::PassFigures>,
+    variation_um: Vec<f64>,
+}
+
+/// The measure → compensate loop on simulated gaps.
+fn simulated(job: &Job, spec: &str) -> Result<(), Failure> {
+    let Job {
+        args,
+        cfg,
+        params,
+        poses,
+        header,
+        path,
+        output,
+    } = job;
+    let substrate = load_substrate(spec, cfg)?;
+    let model = ErrorModel::from_settings(&cfg.compensate).map_err(anyhow::Error::from)?;
+    let passes = cfg.compensate.passes as usize;
+    let sim = simulate::run(poses, &substrate, &model, params, passes)
+        .with_context(|| path.display().to_string())?;
+    let mut variation = vec![sim.uncompensated.variation * UM];
+    variation.extend(sim.passes.iter().map(|p| p.after.variation * UM));
+    let report = SimulatedReport {
+        path: path.display().to_string(),
+        surface: spec.to_owned(),
+        error_model: model,
+        pivot: [sim.pivot.x, sim.pivot.y, sim.pivot.z],
+        poses: poses.poses.len(),
+        target_mm: params.target,
+        sensor_angle_deg: params.sensor_angle,
+        smoothing_mm: params.smoothing,
+        uncompensated_mm: sim.uncompensated,
+        passes: sim.passes.clone(),
+        variation_um: variation.clone(),
+    };
+    let mut readings = Vec::new();
+    if args.readings_out.is_some() {
+        let s = poses.arc_lengths();
+        let rows: Vec<Vec<f64>> = sim
+            .first_readings
+            .iter()
+            .enumerate()
+            .map(|(i, r)| vec![i as f64, s[i], *r])
+            .collect();
+        readings.push("# simulated gap readings, mm".to_owned());
+        let mut buf = Vec::new();
+        conduit_poses::write_table(&["index", "s", "reading"], &rows, 6, &mut buf)
+            .context("gap readings")?;
+        readings.push(String::from_utf8_lossy(&buf).into_owned());
+    }
+    let mut comments = header.to_vec();
+    comments.push(format!(
+        "# compensated by conduit compensate: {passes} simulated pass(es) on {spec}, target {} mm",
+        params.target
+    ));
+    write_table(output, &comments, &sim.poses)?;
+    if let Some(r) = &args.readings_out {
+        let text = readings.join("\n");
+        write_atomically(r, |f| f.write_all(text.as_bytes()))
+            .with_context(|| format!("{}: cannot write", r.display()))?;
+    }
+    if let Some(r) = &args.report {
+        write_report(r, &report)?;
+    }
+    let figures: Vec<String> = variation
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            if k == 0 {
+                format!("uncompensated {v:.1} µm")
+            } else {
+                format!("after pass {k} {v:.1} µm")
+            }
+        })
+        .collect();
+    eprintln!(
+        "{}: {} poses on {spec}; gap variation: {}",
+        output.display(),
+        poses.poses.len(),
+        figures.join(", ")
+    );
+    Ok(())
+}
+
+/// The substrate of a `--simulate` or `--surface` description (a file is loaded as a mesh or
+/// a point cloud).
+fn load_substrate(spec: &str, cfg: &Config) -> Result<Substrate, Failure> {
+    let parsed = substrate::parse_spec(spec).map_err(|e| Failure::Usage(e.to_string()))?;
+    let file = match parsed {
+        SurfaceSpec::Analytic(a) => return Ok(Substrate::Analytic(a)),
+        SurfaceSpec::File(f) => f,
+    };
+    let loaded = load(&file, &LoadOptions::default()).map_err(anyhow::Error::from)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {}: {w}", file.display());
+    }
+    let named = |e: conduit::conform::surface::SurfaceError| anyhow!("{}: {e}", file.display());
+    let surface = match loaded.content {
+        Content::Mesh { scene, .. } => {
+            let mut mesh = Mesh::default();
+            for m in placed_meshes(&scene) {
+                mesh.append(&m);
+            }
+            Surface::from_mesh(&mesh).map_err(named)?
+        }
+        Content::PointCloud(cloud) if !cloud.triangles.is_empty() => {
+            let mesh = Mesh {
+                name: String::new(),
+                vertices: cloud
+                    .points
+                    .iter()
+                    .map(|p| Point3::new(p[0], p[1], p[2]))
+                    .collect(),
+                triangles: cloud.triangles.clone(),
+            };
+            Surface::from_mesh(&mesh).map_err(named)?
+        }
+        Content::PointCloud(cloud) => {
+            Surface::from_cloud(&cloud.points, cfg.conform.fold_gap)
+                .map_err(named)?
+                .0
+        }
+        _ => {
+            return Err(anyhow!(
+                "{}: holds no surface (a mesh or a point cloud is needed)",
+                file.display()
+            )
+            .into());
+        }
+    };
+    Substrate::from_surface(&surface)
+        .ok_or_else(|| anyhow!("{}: the surface has no usable triangles", file.display()).into())
+}
+
+fn run_pattern(args: PatternArgs) -> Result<(), Failure> {
+    let mut cfg = resolve(&args.config)?;
+    let c = &mut cfg.compensate;
+    if let Some(v) = args.target {
+        c.target = v / UM;
+    }
+    if let Some(v) = args.spacing {
+        c.pattern_spacing = v;
+    }
+    if let Some(v) = args.pitch {
+        c.pattern_pitch = v;
+    }
+    let problems = c.problems();
+    if !problems.is_empty() {
+        return Err(Failure::Usage(problems.join("; ")));
+    }
+    let params = PatternParams {
+        shape: args.shape,
+        size: args.size,
+        at: args.at,
+        spacing: c.pattern_spacing,
+        pitch: c.pattern_pitch,
+        gap: c.target,
+        tangent: args.tangent,
+    };
+    let substrate = load_substrate(&args.surface, &cfg)?;
+    let poses = pattern::pattern(&substrate, &params).map_err(anyhow::Error::from)?;
+    let frame = format!("the frame of {}", args.surface);
+    let shape = format!("{:?}", args.shape).to_lowercase();
+    let comments = vec![format!(
+        "# conduit compensate pattern {shape}: size {} mm at ({}, {}){}, gap {} mm; positions mm in {frame}; tool z into the work",
+        params.size,
+        params.at[0],
+        params.at[1],
+        if params.tangent {
+            " in the tangent plane"
+        } else {
+            ""
+        },
+        params.gap
+    )];
+    write_table(&args.output, &comments, &poses)?;
+    eprintln!(
+        "{}: {shape}, {} poses on {}",
+        args.output.display(),
+        poses.len(),
+        args.surface
+    );
+    Ok(())
 }

@@ -1,16 +1,21 @@
 //! `conduit conform`: a 2D design laid onto a scanned surface and printed with a
-//! micro-extrusion nozzle (see [`conduit::conform`]).
+//! micro-extrusion nozzle (see [`conduit::conform`]), as 3-axis G-code or, with a tool axis per
+//! point ([`conduit::conform::orient`]), as a robot or five-axis program
+//! ([`conduit::emit::robot`]).
 
 use super::{Failure, args::ConformArgs, config::resolve};
 use anyhow::{Context, anyhow};
-use conduit::config::Mapping;
+use conduit::config::{Config, Mapping};
 use conduit::conform::markers::{Marker, find_markers};
+use conduit::conform::orient::{self, OrientParams, OrientationReport, ToolAxis};
 use conduit::conform::register::least_squares;
 use conduit::conform::surface::CloudInfo;
-use conduit::conform::{self, ConformParams, Placement, Registration, Surface};
-use conduit::geom::Point3;
+use conduit::conform::{self, ConformParams, ConformReport, Placement, Registration, Surface};
+use conduit::emit::robot::{Dialect, RobotJob, write_robot};
+use conduit::geom::{Point3, Vector3};
 use conduit::mesh::Mesh;
 use conduit::scene::{Content, LoadOptions, load, placed_meshes, write_atomically};
+use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
 
@@ -25,6 +30,27 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         None => {}
     }
     let params = ConformParams::from_settings(&cfg.conform).context("invalid configuration")?;
+    let dialect = Dialect::from_name(&args.output);
+    let axis = args
+        .tool_axis
+        .as_deref()
+        .map(ToolAxis::parse)
+        .transpose()
+        .map_err(|e| Failure::Usage(e.to_string()))?
+        .unwrap_or(ToolAxis::Vertical);
+    if dialect.is_none() && axis != ToolAxis::Vertical {
+        return Err(Failure::Usage(format!(
+            "--tool-axis {} tilts the tool, which 3-axis G-code cannot do: choose --output \
+             urscript, krl, rapid, poses-csv or gcode-5axis",
+            args.tool_axis.as_deref().unwrap_or_default()
+        )));
+    }
+    let orient_params = OrientParams::new(
+        axis,
+        args.max_tilt.unwrap_or(cfg.robot.max_tilt),
+        cfg.robot.axis_smoothing,
+    )
+    .map_err(|e| Failure::Usage(e.to_string()))?;
     let place = args.place.as_deref().map(parse_place).transpose()?;
     let (surface, mesh, cloud) = load_surface(&args.surface, args.as_cloud, cfg.conform.fold_gap)?;
 
@@ -85,14 +111,13 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         rot_deg: 0.0,
         scale: 1.0,
     });
-    let planned = conform::plan(&surface, &design, &place, &params, |_| {})
+    let planned = orient::plan(&surface, &design, &place, &params, &orient_params)
         .with_context(|| format!("{} on {}", args.design.display(), args.surface.display()))?;
     let mut report = planned.report;
     report.registration = registration;
     report.markers = markers;
     report.surface.cloud = cloud;
 
-    // G-code.
     let lowest = planned
         .paths
         .iter()
@@ -100,33 +125,68 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         .map(|p| p.z)
         .fold(f64::MAX, f64::min);
     let safe_z = hi.z + cfg.conform.travel_clearance;
-    let program = conform::program(&planned.paths, &cfg.conform, safe_z);
     let machine_cfg = conform::machine_config(&cfg, &surface, lowest).context("[conform]")?;
-    let mut gcode = Vec::new();
-    conduit::emit::gcode::write_gcode(&program, &machine_cfg, &mut gcode)
-        .context("writing G-code")?;
-    write_atomically(&args.output, |f| f.write_all(&gcode))
-        .with_context(|| format!("{}: cannot write G-code", args.output.display()))?;
-    let parsed = conduit_gcode::parse(&gcode).context("re-reading the written G-code")?;
-    report.replay = Some(conform::replay::replay(
-        &parsed,
-        cfg.printer.flavor,
-        &surface,
-        &params.nozzle,
-        cfg.conform.feed,
-        conform::replay::body_lines(&String::from_utf8_lossy(&gcode)),
-    ));
+    let moves = match dialect {
+        None => {
+            // 3-axis G-code, replayed against the surface.
+            let (gcode, replay) =
+                conform::write_and_replay(&planned.paths, &cfg, &surface, &params)
+                    .context("[conform]")?;
+            write_atomically(&args.out, |f| f.write_all(&gcode))
+                .with_context(|| format!("{}: cannot write G-code", args.out.display()))?;
+            report.replay = Some(replay);
+            None
+        }
+        Some(dialect) => Some(write_program(
+            &args,
+            dialect,
+            (&planned.paths, &planned.axes),
+            &cfg,
+            &machine_cfg,
+            safe_z,
+        )?),
+    };
     if let Some(path) = &args.report {
-        let json = serde_json::to_vec_pretty(&report).context("serialising the report")?;
+        let full = FullReport {
+            conform: &report,
+            orientation: &planned.orientation,
+        };
+        let json = serde_json::to_vec_pretty(&full).context("serialising the report")?;
         write_atomically(path, |f| f.write_all(&json))
             .with_context(|| format!("{}: cannot write report", path.display()))?;
+    }
+    if let Some(moves) = moves {
+        let o = &planned.orientation;
+        eprintln!(
+            "{}: {} program, {} path(s), {} points, {moves} moves, {:.1} mm on the surface; tool \
+             axis {}: largest tilt {:.1}°, largest angle to the surface normal {:.1}°{}; {} \
+             nozzle contact(s)",
+            args.out.display(),
+            args.output,
+            report.paths,
+            report.points,
+            report.geometry.length_3d,
+            o.tool_axis,
+            o.max_tilt_deg,
+            o.max_normal_deviation_deg,
+            if o.limited > 0 {
+                format!(
+                    " ({} axes held at the {}° limit)",
+                    o.limited, o.max_tilt_limit_deg
+                )
+            } else {
+                String::new()
+            },
+            o.contacts
+        );
+        return warnings(&args, &report);
     }
     let replay = report.replay.as_ref().map_or(0, |r| r.printing + r.travel);
     eprintln!(
         "{}: {} path(s), {} points, {:.1} mm on the surface ({:.1} mm in the plane), Δz {:.2} mm; \
          deposit error {:.3} mm mean (controls: {:.3} slope-only, {:.3} uncorrected); \
          {} nozzle contact(s) in the replay",
-        args.output.display(),
+        args.out.display(),
         report.paths,
         report.points,
         report.geometry.length_3d,
@@ -137,6 +197,64 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         report.comparison.none.mean_abs_error,
         replay
     );
+    warnings(&args, &report)
+}
+
+/// Writes the oriented paths as a robot or five-axis program to `--out`; returns the moves.
+fn write_program(
+    args: &ConformArgs,
+    dialect: Dialect,
+    (paths, axes): (&[Vec<Point3>], &[Vec<Vector3>]),
+    cfg: &Config,
+    machine_cfg: &Config,
+    safe_z: f64,
+) -> anyhow::Result<usize> {
+    let program = orient::program(paths, axes, &cfg.conform, safe_z);
+    let tool = cfg.conform.tool;
+    // The dispense snippets of `gcode-5axis`: the tool's paste snippets or [conform]'s.
+    let snippet = |key: &str, pick: fn(&conduit::config::Tool) -> &String| {
+        let text = machine_cfg
+            .tools
+            .get(tool)
+            .map(pick)
+            .cloned()
+            .unwrap_or_default();
+        machine_cfg
+            .render_template(&text, tool, &[])
+            .with_context(|| format!("tools.{tool}.{key}"))
+    };
+    let on = snippet("paste_on_gcode", |t| &t.paste_on_gcode)?;
+    let off = snippet("paste_off_gcode", |t| &t.paste_off_gcode)?;
+    let name = args
+        .out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let job = RobotJob {
+        settings: &cfg.robot,
+        name: &name,
+        dispense_on_gcode: &on,
+        dispense_off_gcode: &off,
+    };
+    let mut text = Vec::new();
+    let moves = write_robot(&program, dialect, &job, &mut text)
+        .with_context(|| format!("writing the {} program", args.output))?;
+    write_atomically(&args.out, |f| f.write_all(&text))
+        .with_context(|| format!("{}: cannot write the program", args.out.display()))?;
+    Ok(moves)
+}
+
+/// The conform report with the orientation section.
+#[derive(Serialize)]
+struct FullReport<'a> {
+    #[serde(flatten)]
+    conform: &'a ConformReport,
+    orientation: &'a OrientationReport,
+}
+
+/// Warnings about the run: contacts in the start/end G-code, design points off the surface, a
+/// folded point cloud.
+fn warnings(args: &ConformArgs, report: &ConformReport) -> Result<(), Failure> {
     if let Some(r) = &report.replay
         && r.custom > 0
     {

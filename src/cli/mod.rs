@@ -63,7 +63,7 @@ pub fn run() -> ExitCode {
         args::Command::Conform(a) => conform::run(a),
         args::Command::Jet(a) => jet::run(a),
         args::Command::Calibrate(a) => calibrate::run(a),
-        args::Command::Compensate(a) => compensate::run(a),
+        args::Command::Compensate(a) => compensate::run(*a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,5 +1,6 @@
 //! The `[compensate]` section of the configuration: gap compensation of robot paths from
-//! measured tool-to-surface gaps (`conduit compensate`).
+//! measured tool-to-surface gaps (`conduit compensate`), the robot error model of its
+//! simulation mode and the calibration print patterns (`conduit compensate pattern`).
 //!
 //! Place in the pipeline: read with the rest of [`super::Config`]; `conduit compensate` hands
 //! it to the gap compensation in [`crate::conform`]. Lengths in mm, angles in degrees.
@@ -12,11 +13,53 @@ use serde::{Deserialize, Serialize};
 pub struct CompensateSettings {
     /// Gap the compensation aims for, mm. Default 0.05.
     pub target: f64,
+    /// Standard deviation of the Gaussian that smooths the corrections along the path, mm of
+    /// arc length; 0 = no smoothing. Default 0.5.
+    pub smoothing: f64,
+    /// Angle between the displacement sensor's beam and the tool axis, degrees, in [0, 90):
+    /// a reading h is the gap h·cos(angle). Default 0.
+    pub sensor_angle: f64,
+    /// Measure → compensate passes of the simulation. Default 1.
+    pub passes: u32,
+    /// Simulation: shift of the real substrate from the nominal one, [dx, dy, dz] mm.
+    /// Default [0, 0, 0].
+    pub error_shift: [f64; 3],
+    /// Simulation: turn of the real substrate about `error_axis` through the middle of the
+    /// path, degrees. Default 0.
+    pub error_tilt: f64,
+    /// Simulation: axis of `error_tilt` (any length but zero). Default [1, 0, 0].
+    pub error_axis: [f64; 3],
+    /// Simulation: tool-length error, mm: the real tip stands this far further back along the
+    /// tool axis than commanded, adding it to every gap. Default 0.
+    pub error_z: f64,
+    /// Simulation: standard deviation of the sensor noise added to each reading, mm.
+    /// Default 0.
+    pub noise: f64,
+    /// Simulation: seed of the sensor noise (same seed, same readings). Default 1.
+    pub seed: u64,
+    /// Patterns: distance between neighbouring points along the pattern, mm. Default 0.1.
+    pub pattern_spacing: f64,
+    /// Patterns: distance between neighbouring lines of a serpentine or turns of a spiral, mm.
+    /// Default 1.
+    pub pattern_pitch: f64,
 }
 
 impl Default for CompensateSettings {
     fn default() -> Self {
-        Self { target: 0.05 }
+        Self {
+            target: 0.05,
+            smoothing: 0.5,
+            sensor_angle: 0.0,
+            passes: 1,
+            error_shift: [0.0; 3],
+            error_tilt: 0.0,
+            error_axis: [1.0, 0.0, 0.0],
+            error_z: 0.0,
+            noise: 0.0,
+            seed: 1,
+            pattern_spacing: 0.1,
+            pattern_pitch: 1.0,
+        }
     }
 }
 
@@ -24,10 +67,40 @@ impl CompensateSettings {
     /// Problems with the values, one line each.
     pub fn problems(&self) -> Vec<String> {
         let mut out = Vec::new();
-        if !(self.target.is_finite() && self.target >= 0.0) {
+        for (key, v) in [
+            ("target", self.target),
+            ("smoothing", self.smoothing),
+            ("noise", self.noise),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                out.push(format!("compensate.{key} must be ≥ 0, got {v}"));
+            }
+        }
+        for (key, v) in [
+            ("pattern_spacing", self.pattern_spacing),
+            ("pattern_pitch", self.pattern_pitch),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                out.push(format!("compensate.{key} must be > 0, got {v}"));
+            }
+        }
+        if !(0.0..90.0).contains(&self.sensor_angle) {
             out.push(format!(
-                "compensate.target must be ≥ 0, got {}",
-                self.target
+                "compensate.sensor_angle must be in [0, 90), got {}",
+                self.sensor_angle
+            ));
+        }
+        if self.passes == 0 {
+            out.push("compensate.passes must be at least 1".to_owned());
+        }
+        let finite = |v: &[f64]| v.iter().all(|c| c.is_finite());
+        if !finite(&self.error_shift) || !finite(&[self.error_tilt, self.error_z]) {
+            out.push("compensate.error_* values must be finite numbers".to_owned());
+        }
+        let axis = self.error_axis;
+        if !finite(&axis) || axis.iter().map(|c| c * c).sum::<f64>() < 1e-18 {
+            out.push(format!(
+                "compensate.error_axis must be a non-zero direction, got {axis:?}"
             ));
         }
         out
@@ -35,8 +108,69 @@ impl CompensateSettings {
 }
 
 /// Documentation of the `[compensate]` keys for `conduit config --defaults`.
-pub(super) const KEYS: &[super::defaults::KeyDoc] = &[super::defaults::k(
-    "compensate",
-    "target",
-    "Tool-to-surface gap the compensation aims for, mm (--target overrides, in µm).",
-)];
+pub(super) const KEYS: &[super::defaults::KeyDoc] = &[
+    super::defaults::k(
+        "compensate",
+        "target",
+        "Tool-to-surface gap the compensation aims for, mm (--target overrides, in µm).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "smoothing",
+        "Standard deviation of the Gaussian smoothing the corrections along the path, mm of arc \
+         length, so sensor noise does not become path noise; 0 = none (--smoothing).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "sensor_angle",
+        "Angle between the displacement sensor's beam and the tool axis, degrees in [0, 90): a \
+         reading h is a gap of h·cos(angle) (--sensor-angle).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "passes",
+        "Measure → compensate passes of --simulate (--passes).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "error_shift",
+        "Simulation: shift [dx, dy, dz] of the real substrate from the nominal one, mm (--shift).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "error_tilt",
+        "Simulation: turn of the real substrate about error_axis through the middle of the path, \
+         degrees (--tilt).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "error_axis",
+        "Simulation: axis [x, y, z] of error_tilt (--tilt-axis).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "error_z",
+        "Simulation: tool-length error, mm: the real tip stands this far further back along the \
+         tool axis, adding it to every gap (--z-error).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "noise",
+        "Simulation: standard deviation of the sensor noise, mm (--noise, in µm).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "seed",
+        "Simulation: seed of the sensor noise; the same seed gives the same readings (--seed).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "pattern_spacing",
+        "Patterns: distance between neighbouring points along the pattern, mm (--spacing).",
+    ),
+    super::defaults::k(
+        "compensate",
+        "pattern_pitch",
+        "Patterns: distance between serpentine lines or spiral turns, mm (--pitch).",
+    ),
+];

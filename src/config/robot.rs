@@ -5,11 +5,20 @@
 //! Place in the pipeline: read with the rest of [`super::Config`]; the robot emitters in
 //! [`crate::emit`] and the calibration in [`crate::conform`] take their frames, kinematics and
 //! dispense commands from here. Lengths in mm, angles in degrees.
+//!
+//! # Frames
+//!
+//! A frame is `[x, y, z, rx, ry, rz]`: a translation in mm and a rotation in degrees,
+//! R = Rz(rz)·Ry(ry)·Rx(rx) (turn about the fixed x axis first, then y, then z; KUKA's
+//! A = rz, B = ry, C = rx). `workpiece_frame` places the frame of the conform program (the
+//! machine frame of the scan and design) in the robot's base frame; `tool_frame` places the
+//! tool centre point (TCP: the nozzle tip, z pointing out of the tool into the work) in the
+//! flange frame.
 
 use serde::{Deserialize, Serialize};
 
 /// Robot and multi-axis settings (`[robot]`).
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RobotSettings {
     /// Denavit–Hartenberg parameters of the arm, one row per joint from the base:
@@ -17,6 +26,76 @@ pub struct RobotSettings {
     /// Rot_z(θᵢ + offset)·Trans_z(d)·Trans_x(a)·Rot_x(α)). Empty = no arm model (flange poses
     /// must then be given as positions and quaternions). Default empty.
     pub dh: Vec<[f64; 4]>,
+    /// The conform program's frame in the robot base frame, `[x, y, z, rx, ry, rz]` (mm,
+    /// degrees; see the module docs). Default all 0.
+    pub workpiece_frame: [f64; 6],
+    /// The tool centre point in the flange frame, `[x, y, z, rx, ry, rz]`. Default all 0.
+    pub tool_frame: [f64; 6],
+    /// Largest tilt of the tool axis from the vertical, degrees, in `--tool-axis normal`
+    /// (`--max-tilt` overrides). Default 60.
+    pub max_tilt: f64,
+    /// Length of path over which surface normals are averaged into tool axes, mm (0 = none).
+    /// Default 0.5.
+    pub axis_smoothing: f64,
+    /// Lift along the tool axis before and after every path, mm. Default 5.
+    pub clearance: f64,
+    /// Speed of travels, approaches and lifts, mm/s. Default 50.
+    pub travel_speed: f64,
+    /// Tool acceleration of URScript moves, mm/s². Default 500.
+    pub acceleration: f64,
+    /// Blend (approximation) radius between dispensing moves, mm; 0 = exact stop at every
+    /// point. Default 0.05.
+    pub blend: f64,
+    /// Digital output that switches the dispenser: URScript `set_digital_out(n, ...)`, KRL
+    /// `$OUT[n]`. Default 1.
+    pub dispense_output: u32,
+    /// Digital output signal of the dispenser in RAPID (`SetDO name, 1`). Default
+    /// `"doDispense"`.
+    pub dispense_signal: String,
+    /// Five-axis G-code: `"ijk"` (`G1 X Y Z I J K`: tip and unit tool vector, for a controller
+    /// with tool-centre-point interpolation), `"head"` (a tilting and rotating head: the pivot,
+    /// `pivot_length` up the tool axis from the tip, and the rotary angles) or `"table"` (a
+    /// tilting and rotating table: the part turned so the tool axis is vertical, the turned tip
+    /// and the rotary angles). Default `"ijk"`.
+    pub five_axis: String,
+    /// Rotary axes of a head or table: `"AC"` (tilt A about x, then C about z) or `"BC"` (tilt
+    /// B about y, then C about z). Default `"AC"`.
+    pub rotary_axes: String,
+    /// Direction of each rotary axis: 1 when its positive turn is right-handed about +x/+y
+    /// (tilt) and +z (C), −1 when reversed. Default [1, 1].
+    pub rotary_signs: [f64; 2],
+    /// Head: distance from the rotary pivot to the tool tip along the tool axis, mm. Default 0.
+    pub pivot_length: f64,
+    /// Table: where the rotary axes cross, in the program frame, mm. Default [0, 0, 0].
+    pub table_centre: [f64; 3],
+}
+
+/// The values of `five_axis`.
+const FIVE_AXIS: [&str; 3] = ["ijk", "head", "table"];
+/// The values of `rotary_axes`.
+const ROTARY_AXES: [&str; 2] = ["AC", "BC"];
+
+impl Default for RobotSettings {
+    fn default() -> Self {
+        Self {
+            dh: Vec::new(),
+            workpiece_frame: [0.0; 6],
+            tool_frame: [0.0; 6],
+            max_tilt: 60.0,
+            axis_smoothing: 0.5,
+            clearance: 5.0,
+            travel_speed: 50.0,
+            acceleration: 500.0,
+            blend: 0.05,
+            dispense_output: 1,
+            dispense_signal: "doDispense".to_owned(),
+            five_axis: "ijk".to_owned(),
+            rotary_axes: "AC".to_owned(),
+            rotary_signs: [1.0, 1.0],
+            pivot_length: 0.0,
+            table_centre: [0.0; 3],
+        }
+    }
 }
 
 impl RobotSettings {
@@ -30,14 +109,162 @@ impl RobotSettings {
                 ));
             }
         }
+        for (key, frame) in [
+            ("workpiece_frame", &self.workpiece_frame),
+            ("tool_frame", &self.tool_frame),
+        ] {
+            if let Some(i) = frame.iter().position(|v| !v.is_finite()) {
+                out.push(format!(
+                    "robot.{key}[{i}] is not a finite number (a frame is [x, y, z, rx, ry, rz] \
+                     in mm and degrees)"
+                ));
+            }
+        }
+        if let Some(i) = self.table_centre.iter().position(|v| !v.is_finite()) {
+            out.push(format!("robot.table_centre[{i}] is not a finite number"));
+        }
+        if !(self.max_tilt.is_finite() && (0.0..=90.0).contains(&self.max_tilt)) {
+            out.push(format!(
+                "robot.max_tilt must be in [0, 90] degrees, got {}",
+                self.max_tilt
+            ));
+        }
+        for (key, v) in [
+            ("axis_smoothing", self.axis_smoothing),
+            ("clearance", self.clearance),
+            ("blend", self.blend),
+            ("pivot_length", self.pivot_length),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                out.push(format!("robot.{key} must be ≥ 0, got {v}"));
+            }
+        }
+        for (key, v) in [
+            ("travel_speed", self.travel_speed),
+            ("acceleration", self.acceleration),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                out.push(format!("robot.{key} must be > 0, got {v}"));
+            }
+        }
+        let s = &self.dispense_signal;
+        let identifier = s.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+            && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !identifier {
+            out.push(format!(
+                "robot.dispense_signal must be a RAPID signal name (a letter, then letters, \
+                 digits or _), got `{s}`"
+            ));
+        }
+        if !FIVE_AXIS.contains(&self.five_axis.as_str()) {
+            out.push(format!(
+                "robot.five_axis must be \"ijk\", \"head\" or \"table\", got `{}`",
+                self.five_axis
+            ));
+        }
+        if !ROTARY_AXES.contains(&self.rotary_axes.as_str()) {
+            out.push(format!(
+                "robot.rotary_axes must be \"AC\" or \"BC\", got `{}`",
+                self.rotary_axes
+            ));
+        }
+        for (i, v) in self.rotary_signs.iter().enumerate() {
+            if *v != 1.0 && *v != -1.0 {
+                out.push(format!("robot.rotary_signs[{i}] must be 1 or -1, got {v}"));
+            }
+        }
         out
     }
 }
 
 /// Documentation of the `[robot]` keys for `conduit config --defaults`.
-pub(super) const KEYS: &[super::defaults::KeyDoc] = &[super::defaults::k(
-    "robot",
-    "dh",
-    "Denavit–Hartenberg rows of the arm from the base, [a mm, alpha deg, d mm, theta_offset deg] \
-     (standard convention); empty = no arm model.",
-)];
+pub(super) const KEYS: &[super::defaults::KeyDoc] = &[
+    super::defaults::k(
+        "robot",
+        "dh",
+        "Denavit–Hartenberg rows of the arm from the base, [a mm, alpha deg, d mm, theta_offset deg] \
+         (standard convention); empty = no arm model.",
+    ),
+    super::defaults::k(
+        "robot",
+        "workpiece_frame",
+        "The conform program's frame in the robot base frame, [x, y, z, rx, ry, rz] in mm and \
+         degrees, rotation Rz(rz)·Ry(ry)·Rx(rx) (KUKA A = rz, B = ry, C = rx): $BASE, wobjdata, \
+         and the base-frame poses of URScript.",
+    ),
+    super::defaults::k(
+        "robot",
+        "tool_frame",
+        "The tool centre point (nozzle tip, z into the work) in the flange frame, [x, y, z, rx, \
+         ry, rz] as workpiece_frame: $TOOL, tooldata, set_tcp.",
+    ),
+    super::defaults::k(
+        "robot",
+        "max_tilt",
+        "Largest tilt of the tool axis from the vertical with --tool-axis normal, degrees \
+         (--max-tilt overrides).",
+    ),
+    super::defaults::k(
+        "robot",
+        "axis_smoothing",
+        "Length of path over which surface normals are averaged into tool axes, mm (0 = none).",
+    ),
+    super::defaults::k(
+        "robot",
+        "clearance",
+        "Lift along the tool axis before and after every path, mm.",
+    ),
+    super::defaults::k(
+        "robot",
+        "travel_speed",
+        "Speed of travels, approaches and lifts, mm/s.",
+    ),
+    super::defaults::k(
+        "robot",
+        "acceleration",
+        "Tool acceleration of URScript moves, mm/s² (written in m/s²).",
+    ),
+    super::defaults::k(
+        "robot",
+        "blend",
+        "Blend radius between dispensing moves, mm (URScript r, KRL C_DIS, RAPID zone); 0 = exact \
+         stop at every point.",
+    ),
+    super::defaults::k(
+        "robot",
+        "dispense_output",
+        "Digital output of the dispenser: URScript set_digital_out(n, ...), KRL $OUT[n].",
+    ),
+    super::defaults::k(
+        "robot",
+        "dispense_signal",
+        "Digital output signal of the dispenser in RAPID (SetDO name, 1/0).",
+    ),
+    super::defaults::k(
+        "robot",
+        "five_axis",
+        "gcode-5axis output: \"ijk\" (G1 X Y Z I J K, tip and tool vector), \"head\" (pivot \
+         position and rotary angles) or \"table\" (part turned so the tool is vertical).",
+    ),
+    super::defaults::k(
+        "robot",
+        "rotary_axes",
+        "Rotary axes of a head or table: \"AC\" (tilt about x, then C about z) or \"BC\" (tilt \
+         about y).",
+    ),
+    super::defaults::k(
+        "robot",
+        "rotary_signs",
+        "Direction of the tilt and C axes: 1 = right-handed about +x/+y and +z, -1 = reversed.",
+    ),
+    super::defaults::k(
+        "robot",
+        "pivot_length",
+        "Head: distance from the rotary pivot to the tool tip along the tool axis, mm.",
+    ),
+    super::defaults::k(
+        "robot",
+        "table_centre",
+        "Table: where the rotary axes cross, in the program frame [x, y, z], mm.",
+    ),
+];

@@ -23,6 +23,9 @@ use super::surface::Surface;
 use crate::config::Corrections;
 use crate::geom::Point3;
 
+/// Rounds of the clearance pass (lifting a point can bring its segments into contact).
+const CLEAR_ROUNDS: usize = 32;
+
 /// Steps along [tip, tip − d·V] looking for the surface.
 const BEHIND_STEPS: usize = 16;
 
@@ -55,7 +58,7 @@ pub fn correct(
                 return tip;
             }
             let kappa = if mode == Corrections::Full {
-                g.curvature
+                g.section_curvature
             } else {
                 0.0
             };
@@ -106,18 +109,41 @@ pub fn correct(
         .collect()
 }
 
+/// The G-code's grid: XYZ are written with [`conduit_gcode::XYZ_DECIMALS`] decimals.
+fn grid() -> f64 {
+    10f64.powi(-(conduit_gcode::XYZ_DECIMALS as i32))
+}
+
+/// `p` as the G-code will hold it: x and y rounded to the grid, z rounded up (never closer to
+/// the surface).
+fn snap(p: Point3) -> Point3 {
+    let g = grid();
+    Point3::new(
+        (p.x / g).round() * g,
+        (p.y / g).round() * g,
+        (p.z / g - 1e-6).ceil() * g,
+    )
+}
+
 /// Lifts points until no sample of the whole nozzle, at the points and along the segments
 /// between them (every quarter of the inner diameter, as [`super::replay`] samples), meets the
 /// surface; returns how many points were lifted. `margin` is the clearance kept, mm.
+///
+/// Points are first put on the G-code's 1 µm grid and every lift is rounded up to it, so the
+/// path checked is the path written: on a steep flank half a micrometre sideways is several
+/// micrometres of height.
 pub fn clear(surface: &Surface, nozzle: &Nozzle, path: &mut [Point3], margin: f64) -> usize {
     let step = nozzle.inner / 4.0;
+    for p in path.iter_mut() {
+        *p = snap(*p);
+    }
     let mut lifted = vec![false; path.len()];
-    for _ in 0..4 {
+    for _ in 0..CLEAR_ROUNDS {
         let mut changed = false;
         for i in 0..path.len() {
             let need = nozzle.penetration(surface, &path[i]) + margin;
             if need > 0.0 {
-                path[i].z += need;
+                path[i] = snap(path[i] + crate::geom::Vector3::new(0.0, 0.0, need));
                 lifted[i] = true;
                 changed = true;
             }
@@ -130,8 +156,9 @@ pub fn clear(surface: &Surface, nozzle: &Nozzle, path: &mut [Point3], margin: f6
                 .fold(f64::MIN, f64::max)
                 + margin;
             if need > 0.0 {
-                path[i].z += need;
-                path[i + 1].z += need;
+                let up = crate::geom::Vector3::new(0.0, 0.0, need);
+                path[i] = snap(path[i] + up);
+                path[i + 1] = snap(path[i + 1] + up);
                 lifted[i] = true;
                 lifted[i + 1] = true;
                 changed = true;

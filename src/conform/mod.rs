@@ -14,11 +14,18 @@
 //!    clearance pass with the whole nozzle ([`nozzle`]) lifts what still touches.
 //! 7. [`deposit`]: expected deposit thickness and its errors, for the method and two controls.
 //! 8. [`report`]: the JSON report; [`replay`] re-checks the written G-code for contacts.
+//!
+//! Robot and five-axis work builds on the same stages: [`orient`] sets a tool axis per point
+//! (surface normal, vertical or fixed) for the robot emitters in [`crate::emit::robot`];
+//! [`tcp`] (with [`kinematics`]) calibrates the tool centre point from pivot poses, [`frames`]
+//! registers two frames from points or poses; [`compensate`] moves a robot path along its tool
+//! axis by measured (or simulated) gaps, and [`pattern`] draws calibration patterns on a surface.
 
 pub mod compensate;
 pub mod correct;
 pub mod deposit;
 pub mod design;
+pub mod frames;
 pub mod geodesic;
 pub mod kinematics;
 pub mod markers;
@@ -42,7 +49,7 @@ pub use surface::Surface;
 use crate::config::{Config, ConformSettings, Corrections, Mapping};
 use crate::geom::Point3;
 use crate::program::{Layer, LayerItem, Program, Role, Toolpath};
-use deposit::{DepositStats, Thresholds};
+use deposit::Thresholds;
 
 /// The stages of a conform run, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -51,10 +58,9 @@ pub enum Stage {
     Surface,
     /// Registration.
     Register,
-    /// Placing and discretising the design.
+    /// Placing and discretising the design, and mapping it onto the surface (projection or
+    /// geodesic).
     Design,
-    /// Projection or geodesic mapping.
-    Project,
     /// Local geometry.
     Geometry,
     /// Corrections and clearance.
@@ -87,6 +93,16 @@ pub enum ConformError {
     /// How to fix: the SVG must hold paths or shapes (text is not read).
     #[error("the design has no paths")]
     EmptyDesign,
+    /// The G-code could not be written.
+    ///
+    /// How to fix: see the message (usually a `[printer]` or tool snippet setting).
+    #[error("writing G-code: {0}")]
+    Emit(#[from] crate::emit::gcode::EmitError),
+    /// The written G-code could not be read back for the replay.
+    ///
+    /// How to fix: a custom G-code snippet in the configuration is not valid G-code.
+    #[error("re-reading the written G-code: {0}")]
+    Reread(#[from] conduit_gcode::GcodeError),
 }
 
 /// Validated parameters of a run.
@@ -198,6 +214,89 @@ fn corrected(
         .collect()
 }
 
+/// The design on the surface: its discretised top view and the zero-standoff paths T.
+#[derive(Debug, Clone)]
+pub struct OnSurface {
+    /// The design placed and discretised, two points per inner diameter.
+    pub planar: Vec<design::PlanarPath>,
+    /// The zero-standoff paths T.
+    pub projected: project::Projected,
+}
+
+/// Steps 3 and 4: `design` placed by `place`, discretised and mapped onto `surface`.
+pub fn on_surface(
+    surface: &Surface,
+    design: &conduit_svg::Design,
+    place: &Placement,
+    params: &ConformParams,
+) -> Result<OnSurface, ConformError> {
+    let placed = design::place(design, place);
+    if placed.is_empty() {
+        return Err(ConformError::EmptyDesign);
+    }
+    let planar: Vec<design::PlanarPath> = placed
+        .iter()
+        .map(|p| design::discretise(p, params.nozzle.inner / 2.0))
+        .collect();
+    let projected = match params.mapping {
+        Mapping::Projection => project::project(surface, &planar),
+        Mapping::Geodesic => geodesic::map_geodesic(surface, &planar),
+    };
+    if projected.paths.is_empty() {
+        return Err(ConformError::OffSurface);
+    }
+    Ok(OnSurface { planar, projected })
+}
+
+/// Step 5: every zero-standoff path with its local geometry (the section curvature from the
+/// surface's normals under the path).
+pub fn local_geometry(
+    surface: &Surface,
+    projected: &project::Projected,
+) -> Vec<(Vec<Point3>, Vec<spline::Local>)> {
+    projected
+        .paths
+        .iter()
+        .map(|p| {
+            let normals: Vec<_> = p
+                .iter()
+                .map(|q| {
+                    surface
+                        .top(q.x, q.y)
+                        .map_or_else(crate::geom::Vector3::z, |t| t.1)
+                })
+                .collect();
+            (p.clone(), spline::local_geometry(p, &normals))
+        })
+        .collect()
+}
+
+/// The tips of the configured corrections (with what they did) and the deposit comparison of
+/// the full method and its two controls on the same paths, before any clearance pass.
+pub fn corrections_compared(
+    surface: &Surface,
+    params: &ConformParams,
+    geometry: &[(Vec<Point3>, Vec<spline::Local>)],
+) -> (
+    Vec<Vec<Point3>>,
+    correct::CorrectionCounts,
+    report::Comparison,
+) {
+    let mut counts = correct::CorrectionCounts::default();
+    let method = corrected(surface, params, params.corrections, geometry, &mut counts);
+    let mut scratch = correct::CorrectionCounts::default();
+    let [none, slope, full] =
+        [Corrections::None, Corrections::Slope, Corrections::Full].map(|mode| {
+            let paths = if mode == params.corrections {
+                method.clone()
+            } else {
+                corrected(surface, params, mode, geometry, &mut scratch)
+            };
+            deposit::deposit(surface, &paths, &params.nozzle, &params.thresholds)
+        });
+    (method, counts, report::Comparison { full, slope, none })
+}
+
 /// Plans the paths of `design` placed by `place` on `surface` (already in the machine frame):
 /// steps 3 to 7 of the module docs. `progress` is called at the start of each stage.
 pub fn plan(
@@ -207,41 +306,12 @@ pub fn plan(
     params: &ConformParams,
     mut progress: impl FnMut(Stage),
 ) -> Result<Planned, ConformError> {
-    let d = params.nozzle.inner;
     progress(Stage::Design);
-    let placed = design::place(design, place);
-    if placed.is_empty() {
-        return Err(ConformError::EmptyDesign);
-    }
-    let planar: Vec<design::PlanarPath> = placed
-        .iter()
-        .map(|p| design::discretise(p, d / 2.0))
-        .collect();
-    progress(Stage::Project);
-    let projected = match params.mapping {
-        Mapping::Projection => project::project(surface, &planar),
-        Mapping::Geodesic => geodesic::map_geodesic(surface, &planar),
-    };
-    if projected.paths.is_empty() {
-        return Err(ConformError::OffSurface);
-    }
+    let on = on_surface(surface, design, place, params)?;
     progress(Stage::Geometry);
-    let t: Vec<(Vec<Point3>, Vec<spline::Local>)> = projected
-        .paths
-        .iter()
-        .map(|p| (p.clone(), spline::local_geometry(p)))
-        .collect();
+    let t = local_geometry(surface, &on.projected);
     progress(Stage::Correct);
-    let mut counts = correct::CorrectionCounts::default();
-    let method = corrected(surface, params, params.corrections, &t, &mut counts);
-    let mut scratch = correct::CorrectionCounts::default();
-    let controls = [Corrections::None, Corrections::Slope, Corrections::Full].map(|mode| {
-        if mode == params.corrections {
-            (mode, method.clone())
-        } else {
-            (mode, corrected(surface, params, mode, &t, &mut scratch))
-        }
-    });
+    let (method, counts, comparison) = corrections_compared(surface, params, &t);
     // The whole-nozzle check of the method's path, before anything is lifted.
     let mut remaining = Vec::new();
     for p in method.iter().flatten() {
@@ -253,31 +323,23 @@ pub fn plan(
             });
         }
     }
-    let mut paths = method.clone();
+    let mut paths = method;
     // 5 µm over the G-code's 1 µm rounding.
     let lifted: usize = paths
         .iter_mut()
         .map(|p| correct::clear(surface, &params.nozzle, p, 0.005))
         .sum();
     progress(Stage::Deposit);
-    let dep = |p: &[Vec<Point3>]| -> DepositStats {
-        deposit::deposit(surface, p, d, params.nozzle.outer, &params.thresholds)
-    };
-    let comparison = report::Comparison {
-        full: dep(&controls[2].1),
-        slope: dep(&controls[1].1),
-        none: dep(&controls[0].1),
-    };
     let report = report::build(report::Inputs {
         surface,
-        planar: &planar,
-        projected: &projected,
+        planar: &on.planar,
+        projected: &on.projected,
         geometry: &t,
         params,
         counts,
         remaining,
         lifted,
-        deposit: dep(&paths),
+        deposit: deposit::deposit(surface, &paths, &params.nozzle, &params.thresholds),
         comparison,
     });
     Ok(Planned { paths, report })
@@ -342,4 +404,31 @@ pub fn machine_config(
     tool.travel_lift = Some((surface.max().z - lowest_tip).max(0.0) + c.travel_clearance);
     out.printer.retract_before_travel = 0.0;
     Ok(out)
+}
+
+/// The G-code of `paths` for `cfg` over `surface`, and its replay: every move of the written
+/// file checked against the surface with the whole nozzle. The program's first travel arrives at
+/// the surface's top plus `conform.travel_clearance`.
+pub fn write_and_replay(
+    paths: &[Vec<Point3>],
+    cfg: &Config,
+    surface: &Surface,
+    params: &ConformParams,
+) -> Result<(Vec<u8>, replay::ReplayContacts), ConformError> {
+    let lowest = paths.iter().flatten().map(|p| p.z).fold(f64::MAX, f64::min);
+    let safe_z = surface.max().z + cfg.conform.travel_clearance;
+    let program = program(paths, &cfg.conform, safe_z);
+    let machine_cfg = machine_config(cfg, surface, lowest)?;
+    let mut gcode = Vec::new();
+    crate::emit::gcode::write_gcode(&program, &machine_cfg, &mut gcode)?;
+    let parsed = conduit_gcode::parse(&gcode)?;
+    let contacts = replay::replay(
+        &parsed,
+        cfg.printer.flavor,
+        surface,
+        &params.nozzle,
+        cfg.conform.feed,
+        replay::body_lines(&String::from_utf8_lossy(&gcode)),
+    );
+    Ok((gcode, contacts))
 }

@@ -10,6 +10,14 @@
 //! horizontal speed, κ = (σ·z'' − z'·σ') / (σ² + z'²)^{3/2}, negative where the path is concave
 //! down (over a bump), positive where it is concave up (in a valley). Vᵢ is (x', y')
 //! normalised: the direction of travel seen from above.
+//!
+//! Where the design turns in the plane, z'' also holds the turn times the surface's slope
+//! across the path (z'' = ∇S·(x'', y'') + (x', y')ᵀ·H·(x', y')): a spiral on a flat ramp rises
+//! and falls, so its path is curved in z though the surface is a plane. The nozzle's back edge
+//! looks straight back along −Vᵢ, over the surface's section in the direction of travel, so
+//! the downhill correction takes the curvature of that section ([`Local::section_curvature`]):
+//! the same formula with the turn's term ∇S·(x'', y'') removed, ∇S from the surface normal at
+//! Tᵢ. On a plane it is exactly 0.
 
 use crate::geom::{Point3, Vector3};
 
@@ -20,8 +28,11 @@ pub struct Local {
     pub tangent: Vector3,
     /// Horizontal direction of travel, unit (x, y, 0).
     pub travel: Vector3,
-    /// Signed curvature in the vertical plane of travel, 1/mm.
+    /// Signed curvature of the path in the vertical plane of travel, 1/mm.
     pub curvature: f64,
+    /// Signed curvature of the surface's vertical section in the direction of travel, 1/mm
+    /// (equal to `curvature` when no surface normals are given).
+    pub section_curvature: f64,
     /// Whether the curvature changes sign between this point and the next.
     pub inflection: bool,
 }
@@ -66,8 +77,10 @@ fn first_derivatives(t: &[f64], y: &[f64], m: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Local geometry of every point of `path` (at least two points).
-pub fn local_geometry(path: &[Point3]) -> Vec<Local> {
+/// Local geometry of every point of `path` (at least two points). `normals` holds the surface's
+/// upward unit normal at each point (for [`Local::section_curvature`]); an empty slice leaves
+/// the section curvature equal to the path's.
+pub fn local_geometry(path: &[Point3], normals: &[Vector3]) -> Vec<Local> {
     let n = path.len();
     if n < 2 {
         return Vec::new();
@@ -99,7 +112,14 @@ pub fn local_geometry(path: &[Point3]) -> Vec<Local> {
             let (x2, y2, z2) = (m[0][i], m[1][i], m[2][i]);
             let sigma = x1.hypot(y1).max(1e-12);
             let sigma1 = (x1 * x2 + y1 * y2) / sigma;
-            let curvature = (sigma * z2 - z1 * sigma1) / (sigma * sigma + z1 * z1).powf(1.5);
+            let bend = (sigma * sigma + z1 * z1).powf(1.5);
+            let curvature = (sigma * z2 - z1 * sigma1) / bend;
+            // The turn's share of z'': ∇S·(x'', y'') with ∇S = −(n_x, n_y)/n_z.
+            let turn = match normals.get(i) {
+                Some(n) if n.z > 1e-6 => -(n.x * x2 + n.y * y2) / n.z,
+                _ => 0.0,
+            };
+            let section_curvature = (sigma * (z2 - turn) - z1 * sigma1) / bend;
             let tangent = Vector3::new(x1, y1, z1)
                 .try_normalize(1e-12)
                 .unwrap_or_else(Vector3::x);
@@ -108,6 +128,7 @@ pub fn local_geometry(path: &[Point3]) -> Vec<Local> {
                 tangent,
                 travel,
                 curvature,
+                section_curvature,
                 inflection: false,
             }
         })
@@ -132,12 +153,37 @@ mod tests {
                 Point3::new(-r * a.cos(), 0.0, r * a.sin())
             })
             .collect();
-        let g = local_geometry(&path);
+        let g = local_geometry(&path, &[]);
         let mid = g[100];
         assert!((mid.curvature + 0.1).abs() < 1e-4, "{}", mid.curvature);
         assert!((mid.tangent - Vector3::x()).norm() < 1e-6);
         // A valley: κ = +0.1.
         let flipped: Vec<Point3> = path.iter().map(|p| Point3::new(p.x, p.y, -p.z)).collect();
-        assert!((local_geometry(&flipped)[100].curvature - 0.1).abs() < 1e-4);
+        assert!((local_geometry(&flipped, &[])[100].curvature - 0.1).abs() < 1e-4);
+    }
+
+    #[test]
+    fn a_circle_on_a_ramp_is_curved_but_its_surface_section_is_straight() {
+        // A circle of radius 5 on the plane z = 0.5·x: the path rises and falls (curved in its
+        // vertical plane of travel), the surface under it is a plane.
+        let n = Vector3::new(-0.5, 0.0, 1.0).normalize();
+        let path: Vec<Point3> = (0..=400)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / 400.0;
+                let (x, y) = (5.0 * a.cos(), 5.0 * a.sin());
+                Point3::new(x, y, 0.5 * x)
+            })
+            .collect();
+        let g = local_geometry(&path, &vec![n; path.len()]);
+        // At a = 180° (x = −5, heading −y, level): z'' = 0.5·x'' = 0.5·(1/5), a valley of the
+        // path with κ = 0.1 — from the turn alone.
+        assert!(
+            (g[200].curvature - 0.1).abs() < 1e-4,
+            "{}",
+            g[200].curvature
+        );
+        for l in &g[20..380] {
+            assert!(l.section_curvature.abs() < 1e-6, "{}", l.section_curvature);
+        }
     }
 }

@@ -254,8 +254,8 @@ pub fn read_poses(text: &str) -> Result<Vec<Pose>, TableError> {
             }
             let on = match dispense.map(|c| r[c]) {
                 None => true,
-                Some(v) if v == 0.0 => false,
-                Some(v) if v == 1.0 => true,
+                Some(0.0) => false,
+                Some(1.0) => true,
                 Some(value) => return Err(TableError::Dispense { line, value }),
             };
             Ok(Pose {
@@ -267,10 +267,13 @@ pub fn read_poses(text: &str) -> Result<Vec<Pose>, TableError> {
         .collect()
 }
 
-/// Writes poses as CSV ([`POSE_COLUMNS`]); each quaternion is normalised and turned to
-/// `qw ≥ 0` (the same rotation).
+/// Writes poses as CSV ([`POSE_COLUMNS`]); each quaternion is normalised, the first turned to
+/// `qw ≥ 0` and each later one to the sign nearest its predecessor (q and −q are the same
+/// rotation; a sign that flips between neighbours makes some controllers interpolate the long
+/// way round).
 pub fn write_poses(poses: &[Pose], out: &mut impl io::Write) -> io::Result<()> {
     writeln!(out, "{}", POSE_COLUMNS.join(","))?;
+    let mut previous: Option<[f64; 4]> = None;
     for (i, p) in poses.iter().enumerate() {
         let q = p.quaternion;
         let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
@@ -280,8 +283,11 @@ pub fn write_poses(poses: &[Pose], out: &mut impl io::Write) -> io::Result<()> {
                 format!("pose {i}: not finite or zero quaternion"),
             ));
         }
-        let sign = if q[0] < 0.0 { -1.0 } else { 1.0 };
+        let reference = previous.unwrap_or([1.0, 0.0, 0.0, 0.0]);
+        let dot: f64 = (0..4).map(|k| q[k] * reference[k]).sum();
+        let sign = if dot < 0.0 { -1.0 } else { 1.0 };
         let q = q.map(|c| sign * c / n);
+        previous = Some(q);
         let pos: Vec<String> = p.position.iter().map(|v| fixed(*v, 4)).collect();
         let quat: Vec<String> = q.iter().map(|v| fixed(*v, 9)).collect();
         writeln!(
@@ -371,6 +377,30 @@ mod tests {
         write_poses(&poses, &mut out).expect("writes");
         let text = String::from_utf8(out).expect("utf-8");
         assert!(text.contains("12.3457,0.0000,300.0000,0.707106781,0.000000000,0.707106781"));
+        // Nearly half turns about x written one after the other keep one sign (qw changes sign
+        // with the rotation, not from pose to pose).
+        let turn = |a: f64| Pose {
+            position: [0.0; 3],
+            quaternion: [(a / 2.0).cos(), (a / 2.0).sin(), 0.0, 0.0],
+            dispense: true,
+        };
+        let flips: Vec<Pose> = [179.0f64, 181.0, 179.5]
+            .iter()
+            .map(|d| {
+                let mut p = turn(d.to_radians());
+                p.quaternion = p.quaternion.map(|c| -c);
+                p
+            })
+            .collect();
+        let mut out = Vec::new();
+        write_poses(&flips, &mut out).expect("writes");
+        let back = read_poses(&String::from_utf8_lossy(&out)).expect("reads");
+        for w in back.windows(2) {
+            let dot: f64 = (0..4)
+                .map(|k| w[0].quaternion[k] * w[1].quaternion[k])
+                .sum();
+            assert!(dot > 0.99, "{back:?}");
+        }
         let back = read_poses(&text).expect("reads");
         assert_eq!(back.len(), 2);
         assert!(!back[0].dispense && back[1].dispense);
