@@ -9,6 +9,7 @@ mod clip;
 mod point;
 mod polygon;
 mod tolerances;
+mod tool_frame;
 mod transform;
 
 pub use clip::{
@@ -18,4 +19,5 @@ pub use clip::{
 pub use point::{Coord, Point2, Point3, Vector3, scaled, unscaled};
 pub use polygon::{ExPolygon, Polygon, Polyline};
 pub use tolerances::{Tolerance, Tolerances};
+pub use tool_frame::tool_frame;
 pub use transform::{BoundingBox, Transform};

@@ -7,10 +7,7 @@
 //! projected onto the plane across z, or +Y where +X is (nearly) along z.
 
 use crate::geom::Vector3;
-use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion};
-
-/// Below this length the projection of +X is too short to give a stable x axis.
-const DEGENERATE: f64 = 1e-6;
+use nalgebra::{Quaternion, UnitQuaternion};
 
 /// The tool frame's z axis (out of the tool into the work) of the unit quaternion
 /// `[w, x, y, z]`.
@@ -20,18 +17,10 @@ pub fn into_work(q: [f64; 4]) -> Vector3 {
 }
 
 /// The tool frame (`[w, x, y, z]`) whose z axis is `into_work` (any non-zero length), with the
-/// module's rule for x. `None` for a zero or non-finite direction.
+/// project's rule for x ([`crate::geom::tool_frame`]). `None` for a zero or non-finite
+/// direction.
 pub fn quaternion(into_work: &Vector3) -> Option<[f64; 4]> {
-    let z = into_work.try_normalize(1e-12)?;
-    let project = |v: Vector3| v - z * z.dot(&v);
-    let x = [Vector3::x(), Vector3::y()]
-        .into_iter()
-        .map(project)
-        .find(|v| v.norm() > DEGENERATE)?
-        .normalize();
-    let y = z.cross(&x);
-    let m = Matrix3::from_columns(&[x, y, z]);
-    let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m));
+    let q = UnitQuaternion::from_rotation_matrix(&crate::geom::tool_frame(into_work)?);
     Some([q.w, q.i, q.j, q.k])
 }
 

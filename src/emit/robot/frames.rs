@@ -11,10 +11,7 @@
 //! to z, or +Y when +X is (nearly) along z; y = z × x.
 
 use crate::geom::{Point3, Vector3};
-use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
-
-/// Below this length the projection of +X onto the tool's xy plane is taken as degenerate.
-const DEGENERATE: f64 = 1e-6;
+use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
 
 /// The rigid transform of a frame `[x, y, z, rx, ry, rz]` (mm, degrees; see the module docs).
 pub fn frame(v: &[f64; 6]) -> Isometry3<f64> {
@@ -28,13 +25,10 @@ pub fn frame(v: &[f64; 6]) -> Isometry3<f64> {
 /// The tool frame's rotation for a tool axis `axis` (unit, from the tip toward the tool body):
 /// columns x, y, z of the frame with z = −axis (see the module docs).
 pub fn tool_rotation(axis: &Vector3) -> Rotation3<f64> {
-    let z = -axis.normalize();
-    let project = |v: Vector3| (v - z * v.dot(&z)).try_normalize(DEGENERATE);
-    let x = project(Vector3::x())
-        .or_else(|| project(Vector3::y()))
-        .unwrap_or_else(Vector3::x);
-    let y = z.cross(&x);
-    Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[x, y, z]))
+    // Tool axes are unit vectors by construction; a degenerate one points the tool down.
+    crate::geom::tool_frame(&-axis)
+        .or_else(|| crate::geom::tool_frame(&-Vector3::z()))
+        .unwrap_or_else(Rotation3::identity)
 }
 
 /// ZYX Euler angles `[a, b, c]` in degrees of `r` (R = Rz(a)·Ry(b)·Rx(c): KUKA's A, B, C).
