@@ -323,8 +323,36 @@ fn pattern_simulate_compensate_round_trip_on_the_command_line() {
         s(&out),
         "--report",
         s(&rep2),
+        "--program",
+        s(&d.join("out.script")),
+        "--dialect",
+        "urscript",
     ]);
     let (a, b) = (poses_of(&sim), poses_of(&out));
+    // The same path as the next robot program: every compensated pose is a URScript target
+    // (within its 1 µm), its tool frame the table's.
+    let script = std::fs::read_to_string(d.join("out.script")).expect("program written");
+    let (targets, switches) =
+        crate::robot::read_urscript(&script, &nalgebra::Isometry3::identity());
+    assert_eq!(
+        switches,
+        vec![true, false],
+        "one dispensing run: on, then off"
+    );
+    for p in &b {
+        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            p.quaternion[0],
+            p.quaternion[1],
+            p.quaternion[2],
+            p.quaternion[3],
+        ));
+        let at = conduit::geom::Point3::new(p.position[0], p.position[1], p.position[2]);
+        assert!(
+            targets.iter().any(|t| (t.position - at).norm() < 2e-3
+                && t.rotation.angle_to(&q.to_rotation_matrix()) < 1e-5),
+            "{p:?} not in the program"
+        );
+    }
     assert_eq!(a.len(), nominal.len());
     assert_eq!(a.len(), b.len());
     for ((p, q), n) in a.iter().zip(&b).zip(&nominal) {

@@ -151,9 +151,9 @@ fn run(stl: &Path, svg: &Path, cfg: &Path, out: &Path, args: &[&str]) -> Value {
 
 /// A pose read back from a program: tip position in the workpiece frame and the tool frame.
 #[derive(Debug, Clone, Copy)]
-struct Read {
-    position: Point3,
-    rotation: Rotation3<f64>,
+pub(crate) struct Read {
+    pub(crate) position: Point3,
+    pub(crate) rotation: Rotation3<f64>,
 }
 
 /// The rotation of a `[x, y, z, rx, ry, rz]` frame, R = Rz(rz)·Ry(ry)·Rx(rx).
@@ -176,7 +176,7 @@ fn numbers(s: &str) -> Vec<f64> {
 }
 
 /// URScript `movel(p[...])` poses, brought from the base frame back to the workpiece frame.
-fn read_urscript(text: &str, workpiece: &Isometry3<f64>) -> (Vec<Read>, Vec<bool>) {
+pub(crate) fn read_urscript(text: &str, workpiece: &Isometry3<f64>) -> (Vec<Read>, Vec<bool>) {
     let mut poses = Vec::new();
     let mut switches = Vec::new();
     assert!(text.starts_with("def conduit_program():\n"), "{text}");

@@ -10,7 +10,9 @@ use conduit::conform::Surface;
 use conduit::conform::compensate::simulate::{self, ErrorModel};
 use conduit::conform::compensate::substrate::{self, Substrate, SurfaceSpec};
 use conduit::conform::compensate::{self as comp, GapStats, Params, Path as PosePath, gaps};
+use conduit::conform::orient;
 use conduit::conform::pattern::{self, PatternParams, Shape};
+use conduit::emit::robot::Dialect;
 use conduit::geom::Point3;
 use conduit::mesh::Mesh;
 use conduit::scene::{Content, LoadOptions, load, placed_meshes, write_atomically};
@@ -95,6 +97,15 @@ pub struct CompensateArgs {
     /// The compensated pose table to write.
     #[arg(short, long, value_name = "OUT.csv", required = true)]
     pub output: Option<PathBuf>,
+    /// Also write the compensated path as a robot or five-axis program (dialect from
+    /// `--dialect`): the next run on the machine.
+    #[arg(long, value_name = "FILE", requires = "dialect")]
+    pub program: Option<PathBuf>,
+    /// The program's dialect: `urscript`, `krl`, `rapid` or `gcode-5axis` (as `conduit conform
+    /// --output`; frames, speeds and dispense outputs from `[robot]`).
+    #[arg(long, value_name = "DIALECT", requires = "program",
+          value_parser = ["urscript", "krl", "rapid", "gcode-5axis"])]
+    pub dialect: Option<String>,
     /// Also write a JSON report: gap statistics before, the corrections, and with --simulate
     /// the real gaps after each pass.
     #[arg(long, value_name = "R.json")]
@@ -280,6 +291,35 @@ fn write_table(path: &Path, comments: &[String], poses: &[Pose]) -> anyhow::Resu
         .with_context(|| format!("{}: cannot write", path.display()))
 }
 
+/// With `--program`, writes the compensated `poses` (their dispensing runs) as a robot or
+/// five-axis program; travels clear the highest tip by `conform.travel_clearance`.
+fn write_program(job: &Job, poses: &[Pose]) -> Result<(), Failure> {
+    let (Some(out), Some(name)) = (&job.args.program, &job.args.dialect) else {
+        return Ok(());
+    };
+    let Some(dialect) = Dialect::from_name(name) else {
+        return Err(Failure::Usage(format!("unknown program dialect {name:?}")));
+    };
+    let (paths, axes) = comp::runs(poses);
+    if paths.is_empty() {
+        return Err(anyhow!(
+            "{}: no dispensing run of two or more poses",
+            job.path.display()
+        )
+        .into());
+    }
+    let top = paths.iter().flatten().map(|p| p.z).fold(f64::MIN, f64::max);
+    let program = orient::program(
+        &paths,
+        &axes,
+        &job.cfg.conform,
+        top + job.cfg.conform.travel_clearance,
+    );
+    let cfg = conduit::conform::pressure_config(&job.cfg).context("[conform]")?;
+    super::robot_out::write_robot_file(out, dialect, &program, &cfg)?;
+    Ok(())
+}
+
 /// Writes a JSON report, all or nothing.
 fn write_report(path: &Path, report: &impl Serialize) -> anyhow::Result<()> {
     let json = serde_json::to_vec_pretty(report).context("serialising the report")?;
@@ -350,6 +390,7 @@ fn measured(job: &Job, gaps_path: &Path) -> Result<(), Failure> {
         correction_mm: pass.correction,
     };
     write_table(output, &comments, &pass.poses)?;
+    write_program(job, &pass.poses)?;
     if let Some(r) = &args.report {
         write_report(r, &report)?;
     }
@@ -438,6 +479,7 @@ fn simulated(job: &Job, spec: &str) -> Result<(), Failure> {
         params.target
     ));
     write_table(output, &comments, &sim.poses)?;
+    write_program(job, &sim.poses)?;
     if let Some(r) = &args.readings_out {
         let text = readings.join("\n");
         write_atomically(r, |f| f.write_all(text.as_bytes()))

@@ -11,7 +11,7 @@ use conduit::conform::orient::{self, OrientParams, OrientationReport, ToolAxis};
 use conduit::conform::register::least_squares;
 use conduit::conform::surface::CloudInfo;
 use conduit::conform::{self, ConformParams, ConformReport, Placement, Registration, Surface};
-use conduit::emit::robot::{Dialect, RobotJob, write_robot};
+use conduit::emit::robot::Dialect;
 use conduit::geom::{Point3, Vector3};
 use conduit::mesh::Mesh;
 use conduit::scene::{Content, LoadOptions, load, placed_meshes, write_atomically};
@@ -210,38 +210,7 @@ fn write_program(
     safe_z: f64,
 ) -> anyhow::Result<usize> {
     let program = orient::program(paths, axes, &cfg.conform, safe_z);
-    let tool = cfg.conform.tool;
-    // The dispense snippets of `gcode-5axis`: the tool's paste snippets or [conform]'s.
-    let snippet = |key: &str, pick: fn(&conduit::config::Tool) -> &String| {
-        let text = machine_cfg
-            .tools
-            .get(tool)
-            .map(pick)
-            .cloned()
-            .unwrap_or_default();
-        machine_cfg
-            .render_template(&text, tool, &[])
-            .with_context(|| format!("tools.{tool}.{key}"))
-    };
-    let on = snippet("paste_on_gcode", |t| &t.paste_on_gcode)?;
-    let off = snippet("paste_off_gcode", |t| &t.paste_off_gcode)?;
-    let name = args
-        .out
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let job = RobotJob {
-        settings: &cfg.robot,
-        name: &name,
-        dispense_on_gcode: &on,
-        dispense_off_gcode: &off,
-    };
-    let mut text = Vec::new();
-    let moves = write_robot(&program, dialect, &job, &mut text)
-        .with_context(|| format!("writing the {} program", args.output))?;
-    write_atomically(&args.out, |f| f.write_all(&text))
-        .with_context(|| format!("{}: cannot write the program", args.out.display()))?;
-    Ok(moves)
+    super::robot_out::write_robot_file(&args.out, dialect, &program, machine_cfg)
 }
 
 /// The conform report with the orientation section.

@@ -13,6 +13,7 @@ mod jet;
 mod postprocess;
 mod preview;
 mod progress;
+mod robot_out;
 mod route;
 mod slice;
 

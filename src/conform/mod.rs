@@ -375,14 +375,9 @@ pub fn program(paths: &[Vec<Point3>], settings: &ConformSettings, safe_z: f64) -
     }
 }
 
-/// `cfg` adjusted for writing a conform program over `surface`: the pressure snippets of
-/// `[conform]` (when set) as the tool's paste snippets, and every travel lifted over the
-/// surface's top by `travel_clearance` (a hop on every travel, however short).
-pub fn machine_config(
-    cfg: &Config,
-    surface: &Surface,
-    lowest_tip: f64,
-) -> Result<Config, ConformError> {
+/// `cfg` with the pressure snippets of `[conform]` (when set) as the dispensing tool's paste
+/// snippets: what every conform program (G-code or robot) switches the dispenser with.
+pub fn pressure_config(cfg: &Config) -> Result<Config, ConformError> {
     let c = &cfg.conform;
     let mut out = cfg.clone();
     let Some(tool) = out.tools.get_mut(c.tool) else {
@@ -401,7 +396,22 @@ pub fn machine_config(
     if !c.pressure_off_gcode.is_empty() {
         tool.paste_off_gcode = c.pressure_off_gcode.clone();
     }
-    tool.travel_lift = Some((surface.max().z - lowest_tip).max(0.0) + c.travel_clearance);
+    Ok(out)
+}
+
+/// `cfg` adjusted for writing a conform program over `surface`: the pressure snippets
+/// ([`pressure_config`]), and every travel lifted over the surface's top by
+/// `travel_clearance` (a hop on every travel, however short).
+pub fn machine_config(
+    cfg: &Config,
+    surface: &Surface,
+    lowest_tip: f64,
+) -> Result<Config, ConformError> {
+    let mut out = pressure_config(cfg)?;
+    let clearance = cfg.conform.travel_clearance;
+    if let Some(tool) = out.tools.get_mut(cfg.conform.tool) {
+        tool.travel_lift = Some((surface.max().z - lowest_tip).max(0.0) + clearance);
+    }
     out.printer.retract_before_travel = 0.0;
     Ok(out)
 }

@@ -272,6 +272,28 @@ pub fn compensate_pass(path: &Path, readings: &[f64], params: &Params) -> Pass {
     }
 }
 
+/// The dispensing runs of `poses` as tip paths with their tool axes (from the tip up toward
+/// the tool, the opposite of the tool frame's z): a pose with `dispense` 0 is reached by a
+/// travel and starts a run; runs of fewer than two poses print nothing and are left out.
+pub fn runs(poses: &[Pose]) -> (Vec<Vec<Point3>>, Vec<Vec<Vector3>>) {
+    let (mut paths, mut axes): (Vec<Vec<Point3>>, Vec<Vec<Vector3>>) = (Vec::new(), Vec::new());
+    for (i, p) in poses.iter().enumerate() {
+        if i == 0 || !p.dispense {
+            paths.push(Vec::new());
+            axes.push(Vec::new());
+        }
+        if let (Some(path), Some(axis)) = (paths.last_mut(), axes.last_mut()) {
+            path.push(Point3::new(p.position[0], p.position[1], p.position[2]));
+            axis.push(-frame::into_work(p.quaternion));
+        }
+    }
+    paths
+        .into_iter()
+        .zip(axes)
+        .filter(|(p, _)| p.len() >= 2)
+        .unzip()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,5 +329,36 @@ mod tests {
         assert!((b[0] - (5.0 - 0.03)).abs() < 1e-12 && (b[2] - 1.0).abs() < 1e-12);
         assert_eq!(pass.poses[1].quaternion, path.poses[1].quaternion);
         assert!((pass.before.variation - 0.23).abs() < 1e-12);
+    }
+
+    #[test]
+    fn dispense_off_poses_start_new_runs_with_the_tool_axis_up_the_tool() {
+        let down = [0.0, 1.0, 0.0, 0.0]; // half turn about x: tool z = −z (into the work)
+        let pose = |x: f64, dispense: bool| Pose {
+            position: [x, 0.0, 1.0],
+            quaternion: down,
+            dispense,
+        };
+        let poses = [
+            pose(0.0, false),
+            pose(1.0, true),
+            pose(2.0, true),
+            pose(5.0, false),
+            pose(6.0, false),
+            pose(7.0, true),
+        ];
+        let (paths, axes) = runs(&poses);
+        assert_eq!(paths.len(), 2);
+        assert_eq!(
+            paths[0].iter().map(|p| p.x).collect::<Vec<_>>(),
+            vec![0.0, 1.0, 2.0]
+        );
+        assert_eq!(
+            paths[1].iter().map(|p| p.x).collect::<Vec<_>>(),
+            vec![6.0, 7.0]
+        );
+        for a in axes.iter().flatten() {
+            assert!((a - Vector3::z()).norm() < 1e-12, "{a:?}");
+        }
     }
 }

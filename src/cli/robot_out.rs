@@ -1,0 +1,49 @@
+//! Writing conform paths with tool axes as a robot or five-axis program file: shared by
+//! `conduit conform --output DIALECT` and `conduit compensate --program`.
+
+use anyhow::Context;
+use conduit::config::Config;
+use conduit::emit::robot::{Dialect, RobotJob, write_robot};
+use conduit::program::Program;
+use conduit::scene::write_atomically;
+use std::io::Write;
+use std::path::Path;
+
+/// Writes `program` in `dialect` to `out` (all or nothing); returns the moves written. `cfg`
+/// holds the dispensing tool's paste snippets (used by `gcode-5axis`), already adjusted by
+/// `conduit::conform::pressure_config`.
+pub(crate) fn write_robot_file(
+    out: &Path,
+    dialect: Dialect,
+    program: &Program,
+    cfg: &Config,
+) -> anyhow::Result<usize> {
+    let tool = cfg.conform.tool;
+    let snippet = |key: &str, pick: fn(&conduit::config::Tool) -> &String| {
+        let text = cfg.tools.get(tool).map(pick).cloned().unwrap_or_default();
+        cfg.render_template(&text, tool, &[])
+            .with_context(|| format!("tools.{tool}.{key}"))
+    };
+    let on = snippet("paste_on_gcode", |t| &t.paste_on_gcode)?;
+    let off = snippet("paste_off_gcode", |t| &t.paste_off_gcode)?;
+    let name = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let job = RobotJob {
+        settings: &cfg.robot,
+        name: &name,
+        dispense_on_gcode: &on,
+        dispense_off_gcode: &off,
+    };
+    let dialect_name = Dialect::NAMES
+        .iter()
+        .find(|(_, d)| *d == dialect)
+        .map_or("robot", |(n, _)| n);
+    let mut text = Vec::new();
+    let moves = write_robot(program, dialect, &job, &mut text)
+        .with_context(|| format!("writing the {dialect_name} program"))?;
+    write_atomically(out, |f| f.write_all(&text))
+        .with_context(|| format!("{}: cannot write the program", out.display()))?;
+    Ok(moves)
+}
