@@ -529,6 +529,42 @@ fn geodesic_mapping_keeps_a_lines_length_on_a_45_degree_ramp() {
     );
 }
 
+#[test]
+fn geodesic_mapping_keeps_separate_paths_apart_by_their_design_distance_and_joins_joined() {
+    // Two level lines 10 mm apart up a 45° ramp: 10 mm apart along the surface, where
+    // projection puts them 10·√2 apart.
+    let ramp = surface(height_field(0.0, 0.0, 100.0, 40.0, 50, &|x, _| x));
+    let two = design(vec![
+        vec![[0.0, 0.0], [0.0, 20.0]],
+        vec![[10.0, 0.0], [10.0, 20.0]],
+    ]);
+    let gap = |mapping| {
+        let p = params(Corrections::Full, mapping);
+        let on = match conduit::conform::on_surface(&ramp, &two, &at(50.0, 20.0), &p) {
+            Ok(x) => x,
+            Err(e) => panic!("{e}"),
+        };
+        let (a, b) = (&on.projected.paths[0][0], &on.projected.paths[1][0]);
+        (a - b).norm()
+    };
+    let geodesic = gap(Mapping::Geodesic);
+    assert!((geodesic - 10.0).abs() < 0.01, "geodesic {geodesic}");
+    assert!((gap(Mapping::Projection) - 10.0 * 2f64.sqrt()).abs() < 0.01);
+    // The monopole's patch starts where its feed line ends, on the surface too.
+    let film = surface(height_field(0.0, 0.0, 40.0, 40.0, 80, &|x, y| {
+        2.0 + 0.8 * (0.3 * x).sin() * (0.2 * y).cos()
+    }));
+    let p = params(Corrections::Full, Mapping::Geodesic);
+    let on = match conduit::conform::on_surface(&film, &design(monopole(20.0)), &at(20.0, 20.0), &p)
+    {
+        Ok(x) => x,
+        Err(e) => panic!("{e}"),
+    };
+    let feed_end = on.projected.paths[0].last().copied().expect("feed line");
+    let patch_start = on.projected.paths[1][0];
+    assert_eq!(feed_end, patch_start);
+}
+
 /// A config with a start G-code that stays off the surface (the default primes a line on the
 /// bed's front edge).
 fn cli_config(dir: &Path) -> std::path::PathBuf {
