@@ -17,7 +17,7 @@ use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 use serde_json::Value;
 
-use crate::support::{conduit, corpus, sample, stderr, temp_dir};
+use crate::support::{conduit, corpus, sample, stderr, temp_dir, write_stl};
 
 /// A small deterministic generator (64-bit LCG, high bits).
 struct Lcg(u64);
@@ -58,25 +58,6 @@ fn height_field(
         }
     }
     t
-}
-
-/// Binary STL of triangles.
-fn write_stl(path: &Path, tris: &[[Point3; 3]]) {
-    let mut b = vec![0u8; 80];
-    b.extend((tris.len() as u32).to_le_bytes());
-    for t in tris {
-        let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
-        for v in [n.x, n.y, n.z] {
-            b.extend((v as f32).to_le_bytes());
-        }
-        for p in t {
-            for v in [p.x, p.y, p.z] {
-                b.extend((v as f32).to_le_bytes());
-            }
-        }
-        b.extend([0, 0]);
-    }
-    std::fs::write(path, b).expect("STL written");
 }
 
 fn line(points: Vec<[f64; 2]>) -> DesignPath {

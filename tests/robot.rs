@@ -16,7 +16,7 @@ use conduit_svg::{Design, DesignPath};
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
 use serde_json::Value;
 
-use crate::support::{conduit, stderr, temp_dir};
+use crate::support::{conduit, stderr, temp_dir, write_stl};
 
 /// Radius of the test sphere, mm.
 const R: f64 = 9.0;
@@ -45,25 +45,6 @@ fn sphere(r: f64, n: usize) -> Vec<[Point3; 3]> {
         }
     }
     t
-}
-
-/// Binary STL of triangles.
-fn write_stl(path: &Path, tris: &[[Point3; 3]]) {
-    let mut b = vec![0u8; 80];
-    b.extend((tris.len() as u32).to_le_bytes());
-    for t in tris {
-        let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
-        for v in [n.x, n.y, n.z] {
-            b.extend((v as f32).to_le_bytes());
-        }
-        for p in t {
-            for v in [p.x, p.y, p.z] {
-                b.extend((v as f32).to_le_bytes());
-            }
-        }
-        b.extend([0, 0]);
-    }
-    std::fs::write(path, b).expect("STL written");
 }
 
 /// Points of a circle of diameter `d` (closed by the design).

@@ -65,3 +65,22 @@ pub fn stl_triangles(path: &Path) -> Vec<[[f32; 3]; 3]> {
     let bytes = std::fs::read(path).expect("STL readable");
     conduit_stl::read(&bytes).expect("STL parses").triangles
 }
+
+/// Writes `tris` as a binary STL with their facet normals.
+pub fn write_stl(path: &Path, tris: &[[conduit::geom::Point3; 3]]) {
+    let mut b = vec![0u8; 80];
+    b.extend((tris.len() as u32).to_le_bytes());
+    for t in tris {
+        let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
+        for v in [n.x, n.y, n.z] {
+            b.extend((v as f32).to_le_bytes());
+        }
+        for p in t {
+            for v in [p.x, p.y, p.z] {
+                b.extend((v as f32).to_le_bytes());
+            }
+        }
+        b.extend([0, 0]);
+    }
+    std::fs::write(path, b).expect("STL written");
+}
