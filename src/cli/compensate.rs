@@ -554,8 +554,7 @@ fn load_substrate(spec: &str, cfg: &Config) -> Result<Substrate, Failure> {
             .into());
         }
     };
-    Substrate::from_surface(&surface)
-        .ok_or_else(|| anyhow!("{}: the surface has no usable triangles", file.display()).into())
+    Ok(Substrate::Mesh(Box::new(surface)))
 }
 
 fn run_pattern(args: PatternArgs) -> Result<(), Failure> {

@@ -318,12 +318,26 @@ impl Surface {
     /// surface.
     pub fn top(&self, x: f64, y: f64) -> Option<(f64, Vector3)> {
         let start = self.hi.z + 1.0;
-        let ray = Ray::new(PVec::new(x, y, start), PVec::new(0.0, 0.0, -1.0));
-        let max = start - self.lo.z + 1.0;
+        let (t, n) = self.cast(
+            &Point3::new(x, y, start),
+            &-Vector3::z(),
+            start - self.lo.z + 1.0,
+        )?;
+        Some((start - t, n))
+    }
+
+    /// Where the ray from `origin` along the unit `direction` first meets the surface within
+    /// `max` mm: the distance along the ray and the unit normal there, turned to face the ray's
+    /// origin.
+    pub fn cast(&self, origin: &Point3, direction: &Vector3, max: f64) -> Option<(f64, Vector3)> {
+        let ray = Ray::new(
+            PVec::new(origin.x, origin.y, origin.z),
+            PVec::new(direction.x, direction.y, direction.z),
+        );
         let hit = self.shape.cast_local_ray_and_get_normal(&ray, max, false)?;
         let n = Vector3::new(hit.normal.x, hit.normal.y, hit.normal.z);
-        let n = if n.z < 0.0 { -n } else { n };
-        Some((start - hit.time_of_impact, n))
+        let n = if n.dot(direction) > 0.0 { -n } else { n };
+        Some((hit.time_of_impact, n))
     }
 
     /// An upper bound of the surface's height over the square of half-side `r` around

@@ -10,9 +10,6 @@
 
 use super::super::surface::Surface;
 use crate::geom::{Point3, Vector3};
-use parry3d_f64::math::Vector as PVec;
-use parry3d_f64::query::{Ray, RayCast};
-use parry3d_f64::shape::TriMesh;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -134,8 +131,8 @@ pub struct Hit {
 pub enum Substrate {
     /// An analytic surface.
     Analytic(Analytic),
-    /// A triangle mesh (boxed: its hierarchy is large).
-    Mesh(Box<TriMesh>),
+    /// A scanned or meshed surface (boxed: its hierarchy is large).
+    Mesh(Box<Surface>),
 }
 
 impl std::fmt::Debug for Substrate {
@@ -144,7 +141,7 @@ impl std::fmt::Debug for Substrate {
             Substrate::Analytic(a) => f.debug_tuple("Analytic").field(a).finish(),
             Substrate::Mesh(m) => f
                 .debug_struct("Mesh")
-                .field("triangles", &m.indices().len())
+                .field("triangles", &m.triangles().len())
                 .finish(),
         }
     }
@@ -154,20 +151,6 @@ impl std::fmt::Debug for Substrate {
 const MAX_RAY: f64 = 1e4;
 
 impl Substrate {
-    /// The substrate of a conform surface's triangles.
-    pub fn from_surface(surface: &Surface) -> Option<Self> {
-        let mut vertices = Vec::with_capacity(surface.triangles().len() * 3);
-        let mut indices = Vec::with_capacity(surface.triangles().len());
-        for (i, c) in surface.triangles().iter().enumerate() {
-            vertices.extend(c.iter().map(|p| PVec::new(p.x, p.y, p.z)));
-            let b = (i * 3) as u32;
-            indices.push([b, b + 1, b + 2]);
-        }
-        TriMesh::new(vertices, indices)
-            .ok()
-            .map(|m| Substrate::Mesh(Box::new(m)))
-    }
-
     /// Where the ray from `o` along the unit direction `d` first meets the surface from outside
     /// (t ≥ 0); `None` if it does not, or starts inside a sphere or cylinder or under a plane.
     pub fn hit(&self, o: &Point3, d: &Vector3) -> Option<Hit> {
@@ -192,16 +175,7 @@ impl Substrate {
                 })
             }
             Substrate::Analytic(Analytic::Plane(w)) => plane_hit(o, d, w.as_ref()),
-            Substrate::Mesh(m) => {
-                let ray = Ray::new(PVec::new(o.x, o.y, o.z), PVec::new(d.x, d.y, d.z));
-                let h = m.cast_local_ray_and_get_normal(&ray, MAX_RAY, false)?;
-                let n = Vector3::new(h.normal.x, h.normal.y, h.normal.z);
-                let n = if n.dot(d) > 0.0 { -n } else { n };
-                Some(Hit {
-                    t: h.time_of_impact,
-                    normal: n,
-                })
-            }
+            Substrate::Mesh(m) => m.cast(o, d, MAX_RAY).map(|(t, normal)| Hit { t, normal }),
         }
     }
 }
