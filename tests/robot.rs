@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use conduit::config::{ConformSettings, RobotSettings};
+use conduit::config::{ConformSettings, FiveAxis, RobotSettings, RotaryAxes};
 use conduit::conform::orient::{self, OrientParams, ToolAxis};
 use conduit::conform::{ConformParams, Placement, Surface};
 use conduit::emit::robot::motion::{self, MotionParams, Step, Target};
@@ -287,7 +287,7 @@ fn read_5axis(text: &str, s: &RobotSettings) -> (Vec<(Point3, Vector3)>, Vec<boo
             word('Y').expect("Y"),
             word('Z').expect("Z"),
         );
-        if s.five_axis == "ijk" {
+        if s.five_axis == FiveAxis::Ijk {
             let a = Vector3::new(
                 word('I').expect("I"),
                 word('J').expect("J"),
@@ -296,7 +296,7 @@ fn read_5axis(text: &str, s: &RobotSettings) -> (Vec<(Point3, Vector3)>, Vec<boo
             out.push((p, a));
             continue;
         }
-        let about_x = s.rotary_axes == "AC";
+        let about_x = s.rotary_axes == RotaryAxes::AC;
         let tilt = s.rotary_signs[0] * word(if about_x { 'A' } else { 'B' }).expect("tilt");
         let c = s.rotary_signs[1] * word('C').expect("C");
         let t = if about_x {
@@ -305,7 +305,7 @@ fn read_5axis(text: &str, s: &RobotSettings) -> (Vec<(Point3, Vector3)>, Vec<boo
             Rotation3::from_axis_angle(&Vector3::y_axis(), tilt.to_radians())
         };
         let rz = Rotation3::from_axis_angle(&Vector3::z_axis(), c.to_radians());
-        if s.five_axis == "head" {
+        if s.five_axis == FiveAxis::Head {
             let a = rz * t * Vector3::z();
             out.push((p - a * s.pivot_length, a));
         } else {
@@ -463,16 +463,16 @@ fn every_dialect_reads_back_to_the_poses_of_the_motion_plan() {
 
     // Five-axis G-code: I J K, a head and a table, each in AC and BC with a reversed axis.
     let kinematics = [
-        ("ijk", "AC", [1.0, 1.0]),
-        ("head", "AC", [1.0, -1.0]),
-        ("head", "BC", [-1.0, 1.0]),
-        ("table", "AC", [1.0, 1.0]),
-        ("table", "BC", [1.0, -1.0]),
+        (FiveAxis::Ijk, RotaryAxes::AC, [1.0, 1.0]),
+        (FiveAxis::Head, RotaryAxes::AC, [1.0, -1.0]),
+        (FiveAxis::Head, RotaryAxes::BC, [-1.0, 1.0]),
+        (FiveAxis::Table, RotaryAxes::AC, [1.0, 1.0]),
+        (FiveAxis::Table, RotaryAxes::BC, [1.0, -1.0]),
     ];
     for (kind, axes, signs) in kinematics {
         let s = RobotSettings {
-            five_axis: kind.to_owned(),
-            rotary_axes: axes.to_owned(),
+            five_axis: kind,
+            rotary_axes: axes,
             rotary_signs: signs,
             pivot_length: 80.0,
             table_centre: [10.0, -5.0, -30.0],
@@ -480,18 +480,18 @@ fn every_dialect_reads_back_to_the_poses_of_the_motion_plan() {
         };
         let text = write(&program, Dialect::Gcode5Axis, &s);
         let (read, sw) = read_5axis(&text, &s);
-        assert_eq!(sw, switches, "{kind} {axes}");
-        assert_eq!(read.len(), targets.len(), "{kind} {axes}");
+        assert_eq!(sw, switches, "{kind:?} {axes:?}");
+        assert_eq!(read.len(), targets.len(), "{kind:?} {axes:?}");
         // 3 decimals of mm, angles 1e-4° (2e-6 rad: 0.2 µm per 100 mm of lever).
         for ((p, a), t) in read.iter().zip(&targets) {
             assert!(
                 (p - t.position).norm() < 2e-3,
-                "{kind} {axes}: {p} vs {}",
+                "{kind:?} {axes:?}: {p} vs {}",
                 t.position
             );
             assert!(
                 (a - t.axis).norm() < 1e-5,
-                "{kind} {axes}: {a} vs {}",
+                "{kind:?} {axes:?}: {a} vs {}",
                 t.axis
             );
         }

@@ -57,7 +57,7 @@ pub use defaults::defaults_toml;
 pub use electronics::{PnpSettings, RouteSettings};
 pub use jet::{JetFill, JetSettings};
 pub use prusa_ini::from_prusa_pairs;
-pub use robot::RobotSettings;
+pub use robot::{FiveAxis, RobotSettings, RotaryAxes};
 
 use std::collections::BTreeMap;
 use std::fmt;

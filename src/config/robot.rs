@@ -57,10 +57,10 @@ pub struct RobotSettings {
     /// `pivot_length` up the tool axis from the tip, and the rotary angles) or `"table"` (a
     /// tilting and rotating table: the part turned so the tool axis is vertical, the turned tip
     /// and the rotary angles). Default `"ijk"`.
-    pub five_axis: String,
+    pub five_axis: FiveAxis,
     /// Rotary axes of a head or table: `"AC"` (tilt A about x, then C about z) or `"BC"` (tilt
     /// B about y, then C about z). Default `"AC"`.
-    pub rotary_axes: String,
+    pub rotary_axes: RotaryAxes,
     /// Direction of each rotary axis: 1 when its positive turn is right-handed about +x/+y
     /// (tilt) and +z (C), −1 when reversed. Default [1, 1].
     pub rotary_signs: [f64; 2],
@@ -70,10 +70,38 @@ pub struct RobotSettings {
     pub table_centre: [f64; 3],
 }
 
-/// The values of `five_axis`.
-const FIVE_AXIS: [&str; 3] = ["ijk", "head", "table"];
-/// The values of `rotary_axes`.
-const ROTARY_AXES: [&str; 2] = ["AC", "BC"];
+/// The machine of five-axis G-code (`five_axis`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FiveAxis {
+    /// `G1 X Y Z I J K`: tip and unit tool vector.
+    #[default]
+    Ijk,
+    /// A tilting and rotating head.
+    Head,
+    /// A tilting and rotating table.
+    Table,
+}
+
+/// The rotary axes of a five-axis head or table (`rotary_axes`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum RotaryAxes {
+    /// Tilt A about x, then C about z.
+    #[default]
+    AC,
+    /// Tilt B about y, then C about z.
+    BC,
+}
+
+impl RotaryAxes {
+    /// The axes' letters as written in the config and the G-code.
+    pub fn name(self) -> &'static str {
+        match self {
+            RotaryAxes::AC => "AC",
+            RotaryAxes::BC => "BC",
+        }
+    }
+}
 
 impl Default for RobotSettings {
     fn default() -> Self {
@@ -89,8 +117,8 @@ impl Default for RobotSettings {
             blend: 0.05,
             dispense_output: 1,
             dispense_signal: "doDispense".to_owned(),
-            five_axis: "ijk".to_owned(),
-            rotary_axes: "AC".to_owned(),
+            five_axis: FiveAxis::Ijk,
+            rotary_axes: RotaryAxes::AC,
             rotary_signs: [1.0, 1.0],
             pivot_length: 0.0,
             table_centre: [0.0; 3],
@@ -154,18 +182,6 @@ impl RobotSettings {
             out.push(format!(
                 "robot.dispense_signal must be a RAPID signal name (a letter, then letters, \
                  digits or _), got `{s}`"
-            ));
-        }
-        if !FIVE_AXIS.contains(&self.five_axis.as_str()) {
-            out.push(format!(
-                "robot.five_axis must be \"ijk\", \"head\" or \"table\", got `{}`",
-                self.five_axis
-            ));
-        }
-        if !ROTARY_AXES.contains(&self.rotary_axes.as_str()) {
-            out.push(format!(
-                "robot.rotary_axes must be \"AC\" or \"BC\", got `{}`",
-                self.rotary_axes
             ));
         }
         for (i, v) in self.rotary_signs.iter().enumerate() {

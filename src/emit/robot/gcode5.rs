@@ -20,6 +20,7 @@
 
 use super::motion::Step;
 use super::{RobotError, RobotJob, banner};
+use crate::config::{FiveAxis, RotaryAxes};
 use crate::geom::{Point3, Vector3};
 use conduit_gcode::{fmt_f, fmt_fixed, fmt_xyz};
 use nalgebra::Rotation3;
@@ -28,16 +29,9 @@ use std::io::Write;
 /// Below this horizontal length of the tool axis, C is left where it was.
 const VERTICAL: f64 = 1e-9;
 
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Kind {
-    Ijk,
-    Head,
-    Table,
-}
-
 /// The machine words of a target.
 struct Machine {
-    kind: Kind,
+    kind: FiveAxis,
     /// Tilt about x (`AC`) or y (`BC`).
     about_x: bool,
     signs: [f64; 2],
@@ -50,7 +44,7 @@ struct Machine {
 impl Machine {
     /// The words after `G1` for tip `p` and axis `a`.
     fn words(&mut self, p: &Point3, a: &Vector3) -> String {
-        if self.kind == Kind::Ijk {
+        if self.kind == FiveAxis::Ijk {
             return format!(
                 "X{} Y{} Z{} I{} J{} K{}",
                 fmt_xyz(p.x),
@@ -66,8 +60,8 @@ impl Machine {
         if r > VERTICAL {
             let phi = a.y.atan2(a.x).to_degrees();
             let c = match (self.kind, self.about_x) {
-                (Kind::Head, true) => phi + 90.0,
-                (Kind::Head, false) => phi,
+                (FiveAxis::Head, true) => phi + 90.0,
+                (FiveAxis::Head, false) => phi,
                 (_, true) => 90.0 - phi,
                 (_, false) => 180.0 - phi,
             };
@@ -82,7 +76,7 @@ impl Machine {
             }
         };
         let xyz = match self.kind {
-            Kind::Head => p + a * self.pivot,
+            FiveAxis::Head => p + a * self.pivot,
             _ => {
                 let turn = tilt_rot(tilt)
                     * Rotation3::from_axis_angle(&Vector3::z_axis(), self.c.to_radians());
@@ -107,34 +101,25 @@ pub(super) fn write(
     out: &mut impl Write,
 ) -> Result<(), RobotError> {
     let s = job.settings;
-    let kind = match s.five_axis.as_str() {
-        "ijk" => Kind::Ijk,
-        "head" => Kind::Head,
-        "table" => Kind::Table,
-        other => {
-            return Err(RobotError::Settings(format!(
-                "robot.five_axis `{other}` is not \"ijk\", \"head\" or \"table\""
-            )));
-        }
-    };
+    let kind = s.five_axis;
     let mut m = Machine {
         kind,
-        about_x: s.rotary_axes != "BC",
+        about_x: s.rotary_axes == RotaryAxes::AC,
         signs: s.rotary_signs,
         pivot: s.pivot_length,
         centre: Point3::new(s.table_centre[0], s.table_centre[1], s.table_centre[2]),
         c: 0.0,
     };
     let what = match kind {
-        Kind::Ijk => "five-axis G-code: tip X Y Z, tool vector I J K".to_owned(),
-        Kind::Head => format!(
+        FiveAxis::Ijk => "five-axis G-code: tip X Y Z, tool vector I J K".to_owned(),
+        FiveAxis::Head => format!(
             "five-axis G-code: head {}, pivot X Y Z {} mm up the tool axis",
-            s.rotary_axes,
+            s.rotary_axes.name(),
             fmt_xyz(s.pivot_length)
         ),
-        Kind::Table => format!(
+        FiveAxis::Table => format!(
             "five-axis G-code: table {} about [{}, {}, {}], X Y Z of the turned tip",
-            s.rotary_axes,
+            s.rotary_axes.name(),
             fmt_xyz(m.centre.x),
             fmt_xyz(m.centre.y),
             fmt_xyz(m.centre.z)
