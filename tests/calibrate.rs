@@ -93,6 +93,24 @@ fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
     p
 }
 
+/// Runs `conduit calibrate register` on the tables `a` and `b` written to `dir` as `a.csv` and
+/// `b.csv`; asserts success and returns the output and the report's path.
+fn register_cli(dir: &Path, a: &str, b: &str) -> (std::process::Output, std::path::PathBuf) {
+    let fa = write(dir, "a.csv", a);
+    let fb = write(dir, "b.csv", b);
+    let report = dir.join("reg.json");
+    let o = conduit([
+        "calibrate".as_ref(),
+        "register".as_ref(),
+        fa.as_os_str(),
+        fb.as_os_str(),
+        "--report".as_ref(),
+        report.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    (o, report)
+}
+
 fn json(path: &Path) -> Value {
     serde_json::from_slice(&std::fs::read(path).expect("report written")).expect("JSON")
 }
@@ -383,18 +401,7 @@ fn registration_recovers_a_random_transform_and_flags_an_outlier() {
 
     // The same through the CLI, with the residual table and the three forms of the transform.
     let dir = temp_dir();
-    let fa = write(dir.path(), "scanner.csv", &point_csv(&a));
-    let fb = write(dir.path(), "robot.csv", &point_csv(&b));
-    let report = dir.path().join("reg.json");
-    let o = conduit([
-        "calibrate".as_ref(),
-        "register".as_ref(),
-        fa.as_os_str(),
-        fb.as_os_str(),
-        "--report".as_ref(),
-        report.as_os_str(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let (o, report) = register_cli(dir.path(), &point_csv(&a), &point_csv(&b));
     let out = stdout(&o);
     assert!(out.contains("15 point pairs, 14 used"), "{out}");
     assert!(out.contains("pair\tline_a\tline_b\tresidual_mm"), "{out}");
@@ -416,6 +423,7 @@ fn registration_recovers_a_random_transform_and_flags_an_outlier() {
         }
     }
     // A fixed threshold above the outlier keeps every pair.
+    let (fa, fb) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
     let o = conduit([
         "calibrate".as_ref(),
         "register".as_ref(),
@@ -450,18 +458,7 @@ fn pose_pairs_register_with_orientations_and_flag_a_turned_pose() {
     // Pose 3 of B turned by 2° about its z axis: its position is right, its orientation is not.
     b[2].rotation *= UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 2f64.to_radians());
     let dir = temp_dir();
-    let fa = write(dir.path(), "a.csv", &pose_csv(&a));
-    let fb = write(dir.path(), "b.csv", &pose_csv(&b));
-    let report = dir.path().join("reg.json");
-    let o = conduit([
-        "calibrate".as_ref(),
-        "register".as_ref(),
-        fa.as_os_str(),
-        fb.as_os_str(),
-        "--report".as_ref(),
-        report.as_os_str(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let (o, report) = register_cli(dir.path(), &pose_csv(&a), &pose_csv(&b));
     let out = stdout(&o);
     assert!(out.contains("8 pose pairs, 7 used"), "{out}");
     assert!(out.contains("position_mm\tangle_deg"), "{out}");
@@ -494,6 +491,7 @@ fn pose_pairs_register_with_orientations_and_flag_a_turned_pose() {
     // Rows that do not pair up: both files named.
     let short: String = pose_csv(&b[..5]);
     let fs = write(dir.path(), "short.csv", &short);
+    let fa = dir.path().join("a.csv");
     let o = conduit([
         "calibrate".as_ref(),
         "register".as_ref(),

@@ -4,6 +4,7 @@
 //! fails before anything is written.
 
 use std::path::{Path, PathBuf};
+use std::process::Output;
 
 use conduit::config::{ConformSettings, FiveAxis, RobotSettings, RotaryAxes};
 use conduit::conform::orient::{self, OrientParams, ToolAxis};
@@ -104,11 +105,9 @@ fn config(dir: &Path, extra: &str) -> PathBuf {
     path
 }
 
-/// Runs `conduit conform` on `stl` and `svg` with `args`, writing `out` and a report; returns
-/// the report.
-fn run(stl: &Path, svg: &Path, cfg: &Path, out: &Path, args: &[&str]) -> Value {
-    let report = out.with_extension("json");
-    let mut all: Vec<String> = [
+/// Runs `conduit conform` on `stl` and `svg` with `cfg`, writing `out`, with `args` after.
+fn conform_command(stl: &Path, svg: &Path, cfg: &Path, out: &Path, args: &[&str]) -> Output {
+    let mut all: Vec<&str> = vec![
         "conform",
         "--surface",
         stl.to_str().unwrap_or_default(),
@@ -116,16 +115,20 @@ fn run(stl: &Path, svg: &Path, cfg: &Path, out: &Path, args: &[&str]) -> Value {
         svg.to_str().unwrap_or_default(),
         "-c",
         cfg.to_str().unwrap_or_default(),
-        "-o",
+        "--out",
         out.to_str().unwrap_or_default(),
-        "--report",
-        report.to_str().unwrap_or_default(),
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    all.extend(args.iter().map(|s| s.to_string()));
-    let o = conduit(&all);
+    ];
+    all.extend(args);
+    conduit(&all)
+}
+
+/// Runs `conduit conform` on `stl` and `svg` with `args`, writing `out` and a report; returns
+/// the report.
+fn run(stl: &Path, svg: &Path, cfg: &Path, out: &Path, args: &[&str]) -> Value {
+    let report = out.with_extension("json");
+    let mut all = vec!["--report", report.to_str().unwrap_or_default()];
+    all.extend(args);
+    let o = conform_command(stl, svg, cfg, out, &all);
     assert!(o.status.success(), "{}", stderr(&o));
     serde_json::from_slice(&std::fs::read(&report).expect("report")).expect("JSON")
 }
@@ -718,22 +721,7 @@ fn bad_input_fails_with_a_clear_message_and_writes_nothing() {
     let out = dir.path().join("out.prg");
     let good = config(dir.path(), "");
     let run_fail = |cfg: &Path, args: &[&str]| {
-        let mut all: Vec<String> = [
-            "conform",
-            "--surface",
-            stl.to_str().unwrap_or_default(),
-            "--design",
-            svg.to_str().unwrap_or_default(),
-            "-c",
-            cfg.to_str().unwrap_or_default(),
-            "--out",
-            out.to_str().unwrap_or_default(),
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        all.extend(args.iter().map(|s| s.to_string()));
-        let o = conduit(&all);
+        let o = conform_command(&stl, &svg, cfg, &out, args);
         assert!(!out.exists(), "{args:?} wrote {}", out.display());
         (o.status.code(), stderr(&o))
     };
