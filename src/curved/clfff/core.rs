@@ -274,17 +274,7 @@ mod tests {
 
     /// A closed slab over [0, 20] × [0, 10]: bottom z = 1 + 0.1·x, top z = 4 + 0.05·x.
     fn slab() -> Mesh {
-        let b = |x: f64, y: f64| Point3::new(x, y, 1.0 + 0.1 * x);
-        let t = |x: f64, y: f64| Point3::new(x, y, 4.0 + 0.05 * x);
-        Mesh::from_triangle_soup(
-            "slab",
-            [
-                [t(0.0, 0.0), t(20.0, 0.0), t(20.0, 10.0)],
-                [t(0.0, 0.0), t(20.0, 10.0), t(0.0, 10.0)],
-                [b(0.0, 0.0), b(20.0, 10.0), b(20.0, 0.0)],
-                [b(0.0, 0.0), b(0.0, 10.0), b(20.0, 10.0)],
-            ],
-        )
+        super::super::test_meshes::ramp_sheet("slab", 20.0, 10.0, [1.0, 0.1], [4.0, 0.05])
     }
 
     #[test]

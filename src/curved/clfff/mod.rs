@@ -42,6 +42,8 @@ pub mod sandwich;
 pub mod scaffold;
 pub mod sections;
 pub mod shell;
+#[cfg(test)]
+mod test_meshes;
 pub mod travel;
 
 pub use report::ClfffReport;

@@ -427,17 +427,7 @@ mod tests {
     /// A closed wedge over [0, 10]²: bottom z = 1 + 0.05·x, top z = 1.1 + 0.25·x (0.1 mm thick
     /// at x = 0, 2.1 mm at x = 10).
     fn wedge() -> Mesh {
-        let b = |x: f64, y: f64| Point3::new(x, y, 1.0 + 0.05 * x);
-        let t = |x: f64, y: f64| Point3::new(x, y, 1.1 + 0.25 * x);
-        Mesh::from_triangle_soup(
-            "wedge",
-            [
-                [t(0.0, 0.0), t(10.0, 0.0), t(10.0, 10.0)],
-                [t(0.0, 0.0), t(10.0, 10.0), t(0.0, 10.0)],
-                [b(0.0, 0.0), b(10.0, 10.0), b(10.0, 0.0)],
-                [b(0.0, 0.0), b(0.0, 10.0), b(10.0, 10.0)],
-            ],
-        )
+        super::super::test_meshes::ramp_sheet("wedge", 10.0, 10.0, [1.0, 0.05], [1.1, 0.25])
     }
 
     #[test]
