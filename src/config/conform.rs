@@ -24,8 +24,14 @@ pub enum Mapping {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Corrections {
-    /// Standoff, nozzle contact and curvature-scaled downhill corrections (the full method).
+    /// Standoff and nozzle contact corrections; the downhill shift solved on the deposit
+    /// model (the outer back edge at thickness d over the surface's tangent plane), ramped so
+    /// the tip never runs backwards and limited so it never moves into a contact. The default:
+    /// it prints the deposit closest to d of all modes.
     #[default]
+    Deposit,
+    /// Standoff, nozzle contact and curvature-scaled downhill corrections: the published
+    /// method's formulas (the full method).
     Full,
     /// Standoff and nozzle contact corrections, downhill shift without curvature (κ = 0).
     Slope,
@@ -57,7 +63,8 @@ pub struct ConformSettings {
     /// `"projection"` or `"geodesic"` (also `conduit conform --mapping`). Default
     /// `"projection"`.
     pub mapping: Mapping,
-    /// `"full"`, `"slope"` or `"none"`: which corrections are applied. Default `"full"`.
+    /// `"deposit"`, `"full"`, `"slope"` or `"none"`: which corrections are applied. Default
+    /// `"deposit"`.
     pub corrections: Corrections,
     /// Length of the straight needle above the tip (outer diameter), mm. Default 6.
     pub needle_length: f64,
@@ -95,7 +102,7 @@ impl Default for ConformSettings {
             pressure_on_gcode: String::new(),
             pressure_off_gcode: String::new(),
             mapping: Mapping::Projection,
-            corrections: Corrections::Full,
+            corrections: Corrections::Deposit,
             needle_length: 6.0,
             cone_angle: 30.0,
             cone_height: 10.0,

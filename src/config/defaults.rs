@@ -704,7 +704,7 @@ const KEYS: &[KeyDoc] = &[
     k(
         "conform",
         "corrections",
-        "\"full\" (contact + curvature-scaled downhill), \"slope\" (downhill without curvature) or \"none\".",
+        "\"deposit\" (contact + downhill shift solved on the deposit model), \"full\" (the published method: contact + curvature-scaled downhill), \"slope\" (its downhill shift without curvature) or \"none\".",
     ),
     k(
         "conform",

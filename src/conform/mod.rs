@@ -10,9 +10,10 @@
 //! 3. [`design`]: SVG paths placed on the top view, two points per inner diameter.
 //! 4. [`project`] (or [`geodesic`]): the zero-standoff path T on the surface.
 //! 5. [`spline`]: tangent, signed curvature, inflections, direction of travel.
-//! 6. [`correct`]: standoff, tip-disk contact escape, curvature-scaled downhill shift; then a
-//!    clearance pass with the whole nozzle ([`nozzle`]) lifts what still touches.
-//! 7. [`deposit`]: expected deposit thickness and its errors, for the method and two controls.
+//! 6. [`correct`]: standoff, tip-disk contact escape, downhill shift (solved on the deposit
+//!    model, or the published method's curvature-scaled formula); then a clearance pass with the
+//!    whole nozzle ([`nozzle`]) lifts what still touches.
+//! 7. [`deposit`]: expected deposit thickness and its errors, for every corrections mode.
 //! 8. [`report`]: the JSON report; [`replay`] re-checks the written G-code for contacts.
 //!
 //! Robot and five-axis work builds on the same stages: [`orient`] sets a tool axis per point
@@ -272,7 +273,7 @@ pub fn local_geometry(
 }
 
 /// The tips of the configured corrections (with what they did) and the deposit comparison of
-/// the full method and its two controls on the same paths, before any clearance pass.
+/// every corrections mode on the same paths, before any clearance pass.
 pub fn corrections_compared(
     surface: &Surface,
     params: &ConformParams,
@@ -285,16 +286,30 @@ pub fn corrections_compared(
     let mut counts = correct::CorrectionCounts::default();
     let method = corrected(surface, params, params.corrections, geometry, &mut counts);
     let mut scratch = correct::CorrectionCounts::default();
-    let [none, slope, full] =
-        [Corrections::None, Corrections::Slope, Corrections::Full].map(|mode| {
-            let paths = if mode == params.corrections {
-                method.clone()
-            } else {
-                corrected(surface, params, mode, geometry, &mut scratch)
-            };
-            deposit::deposit(surface, &paths, &params.nozzle, &params.thresholds)
-        });
-    (method, counts, report::Comparison { full, slope, none })
+    let [none, slope, full, deposit] = [
+        Corrections::None,
+        Corrections::Slope,
+        Corrections::Full,
+        Corrections::Deposit,
+    ]
+    .map(|mode| {
+        let paths = if mode == params.corrections {
+            method.clone()
+        } else {
+            corrected(surface, params, mode, geometry, &mut scratch)
+        };
+        deposit::deposit(surface, &paths, &params.nozzle, &params.thresholds)
+    });
+    (
+        method,
+        counts,
+        report::Comparison {
+            deposit,
+            full,
+            slope,
+            none,
+        },
+    )
 }
 
 /// Plans the paths of `design` placed by `place` on `surface` (already in the machine frame):

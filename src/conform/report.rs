@@ -14,6 +14,7 @@ use super::register::Registration;
 use super::replay::ReplayContacts;
 use super::spline::Local;
 use super::surface::{CloudInfo, Surface};
+use crate::config::Corrections;
 use crate::geom::Point3;
 use serde::Serialize;
 
@@ -26,16 +27,30 @@ pub struct Contact {
     pub depth: f64,
 }
 
-/// Deposit errors of the method and of the two controls it is compared with, all before the
-/// clearance pass.
+/// Deposit errors of every corrections mode on the same paths, all before the clearance pass:
+/// the deposit-model shift, the published method and the two controls it is compared with.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Comparison {
+    /// Contact corrections and the downhill shift solved on the deposit model.
+    pub deposit: DepositStats,
     /// Full method: contact and curvature-scaled downhill corrections.
     pub full: DepositStats,
     /// Control: downhill correction without curvature.
     pub slope: DepositStats,
     /// Control: no corrections (standoff only).
     pub none: DepositStats,
+}
+
+impl Comparison {
+    /// The statistics of `mode`.
+    pub fn of(&self, mode: Corrections) -> &DepositStats {
+        match mode {
+            Corrections::Deposit => &self.deposit,
+            Corrections::Full => &self.full,
+            Corrections::Slope => &self.slope,
+            Corrections::None => &self.none,
+        }
+    }
 }
 
 /// Geometry of the zero-standoff path.

@@ -35,6 +35,8 @@ pub struct Local {
     pub section_curvature: f64,
     /// Whether the curvature changes sign between this point and the next.
     pub inflection: bool,
+    /// The surface's upward unit normal at the point (ẑ when no normals are given).
+    pub normal: Vector3,
 }
 
 /// Second derivatives of the natural cubic spline through (t, y) (Thomas algorithm).
@@ -115,6 +117,7 @@ pub fn local_geometry(path: &[Point3], normals: &[Vector3]) -> Vec<Local> {
             let bend = (sigma * sigma + z1 * z1).powf(1.5);
             let curvature = (sigma * z2 - z1 * sigma1) / bend;
             // The turn's share of z'': ∇S·(x'', y'') with ∇S = −(n_x, n_y)/n_z.
+            let normal = normals.get(i).copied().unwrap_or_else(Vector3::z);
             let turn = match normals.get(i) {
                 Some(n) if n.z > 1e-6 => -(n.x * x2 + n.y * y2) / n.z,
                 _ => 0.0,
@@ -130,6 +133,7 @@ pub fn local_geometry(path: &[Point3], normals: &[Vector3]) -> Vec<Local> {
                 curvature,
                 section_curvature,
                 inflection: false,
+                normal,
             }
         })
         .collect();
