@@ -1,5 +1,6 @@
 //! The corrections of point-cloud-based path planning: standoff, lateral escape from the
-//! surface where the tip disk touches it, and the downhill shift scaled by curvature.
+//! surface where the tip disk touches it, and the downhill shift (the published method's,
+//! scaled by curvature, or solved on the deposit model).
 //!
 //! Place in the pipeline: step 6, after the local geometry ([`super::spline`]), before the
 //! clearance pass and the deposit model.
