@@ -307,16 +307,6 @@ mod tests {
         }
     }
 
-    fn nozzle() -> Nozzle {
-        Nozzle {
-            inner: 0.25,
-            outer: 0.5,
-            needle_length: 6.0,
-            cone_angle_deg: 30.0,
-            cone_height: 10.0,
-        }
-    }
-
     /// The zero-standoff path along +x from `x0` to `x1` every d/2 and its local geometry.
     fn along_x(s: &Surface, x0: f64, x1: f64) -> (Vec<Point3>, Vec<Local>) {
         let n = ((x1 - x0) / 0.125).round() as usize;
@@ -336,7 +326,7 @@ mod tests {
 
     fn run(s: &Surface, mode: Corrections, t: &[Point3], local: &[Local]) -> Vec<Point3> {
         let mut counts = CorrectionCounts::default();
-        correct(s, &nozzle(), 0.1, mode, t, local, &mut counts)
+        correct(s, &Nozzle::for_tests(), 0.1, mode, t, local, &mut counts)
     }
 
     #[test]
@@ -401,7 +391,7 @@ mod tests {
         let s = extruded(-1.0, 7.0, wall);
         let (t, local) = along_x(&s, 0.0, 5.9);
         let tips = run(&s, Corrections::Deposit, &t, &local);
-        let n = nozzle();
+        let n = Nozzle::for_tests();
         let mut cut = 0;
         for (ti, tip) in t.iter().zip(&tips) {
             let unshifted = Point3::new(ti.x, ti.y, ti.z + 0.25);

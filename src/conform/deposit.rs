@@ -194,9 +194,7 @@ mod tests {
         Nozzle {
             inner: d,
             outer: d_o,
-            needle_length: 6.0,
-            cone_angle_deg: 30.0,
-            cone_height: 10.0,
+            ..Nozzle::for_tests()
         }
     }
 

@@ -173,3 +173,18 @@ impl Nozzle {
         worst
     }
 }
+
+#[cfg(test)]
+impl Nozzle {
+    /// The default nozzle (d = 0.25, d_o = 0.5, a 6 mm needle under a 30° cone 10 mm high) of
+    /// the module tests.
+    pub(crate) fn for_tests() -> Self {
+        Nozzle {
+            inner: 0.25,
+            outer: 0.5,
+            needle_length: 6.0,
+            cone_angle_deg: 30.0,
+            cone_height: 10.0,
+        }
+    }
+}

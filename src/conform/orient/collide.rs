@@ -83,16 +83,6 @@ pub fn penetration(surface: &Surface, nozzle: &Nozzle, tip: &Point3, axis: &Vect
 mod tests {
     use super::*;
 
-    fn nozzle() -> Nozzle {
-        Nozzle {
-            inner: 0.25,
-            outer: 0.5,
-            needle_length: 6.0,
-            cone_angle_deg: 30.0,
-            cone_height: 10.0,
-        }
-    }
-
     #[test]
     fn a_tilted_needle_meets_a_wall_beside_it_and_a_vertical_one_does_not() -> Result<(), String> {
         // A floor at z = 0 for x < 2 and a block 5 mm high for x ≥ 2 (a step).
@@ -114,7 +104,7 @@ mod tests {
         t.extend(quad(2.0, 10.0, 5.0));
         let s = Surface::from_triangles(t).map_err(|e| e.to_string())?;
         let tip = Point3::new(0.0, 0.0, 0.25);
-        let n = nozzle();
+        let n = Nozzle::for_tests();
         // Vertical: the needle stays 2 mm from the wall, the cone starts 6 mm up (above it).
         assert!(penetration(&s, &n, &tip, &Vector3::z()) <= 0.0);
         // Leaning 45° toward the wall: the needle at height 5 is 4.75 mm across, inside it.
