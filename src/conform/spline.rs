@@ -116,11 +116,12 @@ pub fn local_geometry(path: &[Point3], normals: &[Vector3]) -> Vec<Local> {
             let sigma1 = (x1 * x2 + y1 * y2) / sigma;
             let bend = (sigma * sigma + z1 * z1).powf(1.5);
             let curvature = (sigma * z2 - z1 * sigma1) / bend;
-            // The turn's share of z'': ∇S·(x'', y'') with ∇S = −(n_x, n_y)/n_z.
             let normal = normals.get(i).copied().unwrap_or_else(Vector3::z);
-            let turn = match normals.get(i) {
-                Some(n) if n.z > 1e-6 => -(n.x * x2 + n.y * y2) / n.z,
-                _ => 0.0,
+            // The turn's share of z'': ∇S·(x'', y'') with ∇S = −(n_x, n_y)/n_z (0 for ẑ).
+            let turn = if normal.z > 1e-6 {
+                -(normal.x * x2 + normal.y * y2) / normal.z
+            } else {
+                0.0
             };
             let section_curvature = (sigma * (z2 - turn) - z1 * sigma1) / bend;
             let tangent = Vector3::new(x1, y1, z1)
