@@ -184,8 +184,9 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
     let replay = report.replay.as_ref().map_or(0, |r| r.printing + r.travel);
     eprintln!(
         "{}: {} path(s), {} points, {:.1} mm on the surface ({:.1} mm in the plane), Δz {:.2} mm; \
-         deposit error {:.3} mm mean with {} corrections (published method {:.3}, slope-only \
-         {:.3}, uncorrected {:.3}); {} nozzle contact(s) in the replay",
+         deposit error {:.3} mm mean with {} corrections (deposit model on the tangent plane \
+         {:.3}, published method {:.3}, slope-only {:.3}, uncorrected {:.3}); {} nozzle \
+         contact(s) in the replay",
         args.out.display(),
         report.paths,
         report.points,
@@ -194,6 +195,7 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         report.geometry.delta_z,
         report.comparison.of(params.corrections).mean_abs_error,
         report.corrections,
+        report.comparison.deposit_plane.mean_abs_error,
         report.comparison.full.mean_abs_error,
         report.comparison.slope.mean_abs_error,
         report.comparison.none.mean_abs_error,

@@ -24,12 +24,17 @@ pub enum Mapping {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Corrections {
-    /// Standoff and nozzle contact corrections; the downhill shift solved on the deposit
-    /// model (the outer back edge at thickness d over the surface's tangent plane), ramped so
-    /// the tip never runs backwards and limited so it never moves into a contact. The default:
-    /// it prints the deposit closest to d of all modes.
+    /// The tip placed on the deposit model: the back edge (outer going down, inner going up)
+    /// over the design point, at distance d from the surface itself (the standoff solved on
+    /// the surface, curvature and all); nozzle contact escape; the shift ramped so the tip
+    /// never runs backwards and cut back where it would meet the surface. The default: it
+    /// prints the deposit closest to d of all modes.
     #[default]
     Deposit,
+    /// As `Deposit` with the standoff solved on the tangent plane (d/n_z): its slope-only
+    /// control, without the curvature.
+    #[serde(rename = "deposit-plane")]
+    DepositPlane,
     /// Standoff, nozzle contact and curvature-scaled downhill corrections: the published
     /// method's formulas (the full method).
     Full,
@@ -37,6 +42,25 @@ pub enum Corrections {
     Slope,
     /// Standoff only: the zero-standoff path lifted by the inner diameter.
     None,
+}
+
+impl Corrections {
+    /// Whether the mode places the tip on the deposit model (`Deposit`, `DepositPlane`)
+    /// rather than by the published method's formulas.
+    pub fn on_deposit_model(self) -> bool {
+        matches!(self, Self::Deposit | Self::DepositPlane)
+    }
+
+    /// The mode's name in a config file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Deposit => "deposit",
+            Self::DepositPlane => "deposit-plane",
+            Self::Full => "full",
+            Self::Slope => "slope",
+            Self::None => "none",
+        }
+    }
 }
 
 /// Conformal printing settings (`[conform]`).
@@ -63,7 +87,8 @@ pub struct ConformSettings {
     /// `"projection"` or `"geodesic"` (also `conduit conform --mapping`). Default
     /// `"projection"`.
     pub mapping: Mapping,
-    /// `"deposit"`, `"full"`, `"slope"` or `"none"`: which corrections are applied. Default
+    /// `"deposit"`, `"deposit-plane"`, `"full"`, `"slope"` or `"none"`: which corrections are
+    /// applied. Default
     /// `"deposit"`.
     pub corrections: Corrections,
     /// Length of the straight needle above the tip (outer diameter), mm. Default 6.

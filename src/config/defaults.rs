@@ -704,7 +704,7 @@ const KEYS: &[KeyDoc] = &[
     k(
         "conform",
         "corrections",
-        "\"deposit\" (contact + downhill shift solved on the deposit model), \"full\" (the published method: contact + curvature-scaled downhill), \"slope\" (its downhill shift without curvature) or \"none\".",
+        "\"deposit\" (the tip placed on the deposit model: back edge over the design point, standoff solved on the surface), \"deposit-plane\" (the same on the tangent plane: no curvature), \"full\" (the published method: contact + curvature-scaled downhill), \"slope\" (its downhill shift without curvature) or \"none\".",
     ),
     k(
         "conform",

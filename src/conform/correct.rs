@@ -1,6 +1,6 @@
 //! The corrections of point-cloud-based path planning: standoff, lateral escape from the
-//! surface where the tip disk touches it, and the downhill shift (the published method's,
-//! scaled by curvature, or solved on the deposit model).
+//! surface where the tip disk touches it, and the shift along the travel (the published
+//! method's downhill shift scaled by curvature, or the tip placed on the deposit model).
 //!
 //! Place in the pipeline: step 6, after the local geometry ([`super::spline`]), before the
 //! clearance pass and the deposit model.
@@ -16,30 +16,39 @@
 //!   [tip, tip − d·Vᵢ] (at the tip's height, behind the nozzle) inside the surface, or the
 //!   segment's end when it stays above the surface.
 //!
-//! The moves are horizontal: the tip keeps its height Tᵢ.z + d.
+//! The moves are horizontal: the tip keeps its height Tᵢ.z + d (the deposit modes below set
+//! their own standoff first).
 //!
 //! Those are the published method's formulas (`corrections = "full"`, and `"slope"` with
-//! κ = 0). With them the downhill shift is at most d, while the back edge the deposit model
-//! reads is d_o/2 behind the tip: on a plain slope the back edge stays over higher ground and
-//! the bead comes out thin, and the curvature term only moves that error around (measured on
-//! the test surfaces: with or without κ the mean error is the same within micrometres).
-//! `corrections = "deposit"` (the default) solves the shift on the deposit model instead:
+//! κ = 0). Their standoff is d vertically, d·n_z along the normal, so on any slope the bead
+//! comes out thin, and with a shift of at most d the back edge the deposit model reads (d_o/2
+//! behind the tip going down) stays over higher ground. The curvature term only moves that
+//! error around (measured on the test surfaces: with or without κ the mean error is the same
+//! within micrometres). `corrections = "deposit"` (the default) places the tip on the deposit
+//! model instead, the model the report scores (the back edge of the tip in the direction of
+//! travel, its distance to the surface along the normal):
 //!
-//! - Mᵢ puts the outer back edge at normal distance d from the surface's tangent plane at Tᵢ
-//!   (normal n, slope g < 0 along Vᵢ): Mᵢ = d_o/2 + d·(1/n_z − 1)/(−g), within
-//!   [0, d_o/2 + d] — at d_o/2 the back edge, where the paste leaves the nozzle, is over the
-//!   design point; more than d beyond that would lay the bead off the design. The tangent
-//!   plane is enough: solving on the surface itself, curvature and all, gave the same mean
-//!   error on the test surfaces.
-//! - Mᵢ exceeds the next point's shift by at most half the point spacing, so the shift ramps
-//!   down over a slope's last points: dropping from Mᵢ to 0 where the path turns uphill would
-//!   move the tip backwards and lay paste twice, and carrying the shift on past the turn
-//!   would push the nozzle into the rising surface (measured: more contacts and a larger
-//!   error than ramping down before it).
-//! - A shift that would bring the whole nozzle into the surface is cut back to the largest
-//!   shift without contact (the clearance pass handles points already in contact).
-//! - No contact and downhill: the shift is Mᵢ itself; the method's extra d_o/2 − |Tᵢqᵢ| is for
-//!   the back edge its Mᵢ does not model.
+//! - Shift: the back edge over the design point, Uᵢ = d_o/2 along Vᵢ where the path goes
+//!   down (the outer edge trails the paste) and d/2 where it goes up (the inner edge), faded
+//!   in over the first 2° of slope along the travel: on the flat the back edge's place does
+//!   not change the thickness, the bead stays centred on the design, and a scan's noise does
+//!   not flip the shift back and forth.
+//! - Standoff: the height hᵢ over Tᵢ at which that point is d from the surface itself
+//!   (bisection on the surface's distance, within [0, 2d]). This is the curvature
+//!   correction: the point is d·tan(slope) from Tᵢ along the surface, and over that reach a
+//!   valley comes closer (thin) and a crest falls away (thick) — on a 2 mm cylinder at 30°,
+//!   6 µm thin in the valley and 5 µm thick on the crest with the tangent plane.
+//!   `corrections = "deposit-plane"`, its slope-only control, solves on the tangent plane:
+//!   hᵢ = d/n_z (at most 2d). An explicit κ (the path spline's, or height differences along
+//!   the slope) scored worse than the tangent plane on the test meshes, whose curvature sits
+//!   at their edges; the solve on the surface reads the facets as they are.
+//! - Uᵢ exceeds the next point's shift by at most half the point spacing, so the shift ramps
+//!   down where it shrinks: dropping from Uᵢ to 0 at once would move the tip backwards and
+//!   lay paste twice (measured: carrying the shift on instead pushes the nozzle into a rising
+//!   surface).
+//! - A shift that would bring the whole nozzle within [`CLEARANCE`] of the surface is cut
+//!   back to the largest shift that keeps it (the clearance pass handles points already in
+//!   contact).
 
 use super::nozzle::Nozzle;
 use super::spline::Local;
@@ -53,9 +62,19 @@ const CLEAR_ROUNDS: usize = 32;
 /// Steps along [tip, tip − d·V] looking for the surface.
 const BEHIND_STEPS: usize = 16;
 
-/// Largest fall of the deposit mode's shift from one point to the next, as a fraction of the
+/// Largest fall of the deposit modes' shift from one point to the next, as a fraction of the
 /// point spacing: the tip always advances at least half a spacing.
 const RAMP: f64 = 0.5;
+
+/// Slope along the travel (rise per mm) at which the deposit modes' shift is complete (tan 2°).
+const FULL_SHIFT_SLOPE: f64 = 0.035;
+
+/// Bisection steps of the deposit mode's standoff over [0, 2d] (0.5 mm / 2²⁰ < 1 nm).
+const STANDOFF_STEPS: usize = 20;
+
+/// Clearance from the surface kept by the deposit modes' cut and by the clearance pass
+/// ([`clear`]), mm: 5 µm over the G-code's 1 µm rounding.
+pub const CLEARANCE: f64 = 0.005;
 
 /// Bisection steps that cut a shift back to the largest one without contact (0.5 mm / 2¹²
 /// ≈ 0.1 µm, below the G-code's 1 µm).
@@ -66,8 +85,10 @@ const CUT_STEPS: usize = 12;
 pub struct CorrectionCounts {
     /// Points moved away from a tip-disk contact (L·Q).
     pub contact: usize,
-    /// Points shifted downhill (M·V or M'·V).
+    /// Points shifted downhill (M·V or M'·V; the deposit modes' d_o/2).
     pub downhill: usize,
+    /// Points shifted uphill (the deposit modes' d/2).
+    pub uphill: usize,
 }
 
 /// One point's correction: the tip after the lateral escape, and the shift along the
@@ -94,7 +115,7 @@ pub fn correct(
         .zip(local)
         .map(|(ti, g)| point_move(surface, nozzle, tolerance, mode, ti, g, counts))
         .collect();
-    if mode != Corrections::Deposit {
+    if !mode.on_deposit_model() {
         return moves.iter().map(|m| m.base + m.travel * m.along).collect();
     }
     for i in (1..moves.len()).rev() {
@@ -106,15 +127,15 @@ pub fn correct(
         .map(|m| {
             let tip = m.base + m.travel * m.along;
             if m.along <= 0.0
-                || nozzle.penetration(surface, &tip) <= 0.0
-                || nozzle.penetration(surface, &m.base) > 0.0
+                || shortfall(surface, nozzle, &tip, CLEARANCE) <= 0.0
+                || shortfall(surface, nozzle, &m.base, CLEARANCE) > 0.0
             {
                 return tip;
             }
             let (mut free, mut hit) = (0.0, m.along);
             for _ in 0..CUT_STEPS {
                 let mid = 0.5 * (free + hit);
-                if nozzle.penetration(surface, &(m.base + m.travel * mid)) > 0.0 {
+                if shortfall(surface, nozzle, &(m.base + m.travel * mid), CLEARANCE) > 0.0 {
                     hit = mid;
                 } else {
                     free = mid;
@@ -125,19 +146,64 @@ pub fn correct(
         .collect()
 }
 
-/// The deposit mode's downhill shift at a point with surface normal `normal` travelling along
-/// `travel`: the outer back edge at normal distance d from the tangent plane (module docs).
-fn deposit_shift(normal: Vector3, travel: Vector3, d: f64, ro: f64) -> f64 {
-    let cap = ro + d;
-    if normal.z <= 1e-9 {
-        return cap;
+/// How far `tip` must rise for the whole nozzle to clear the surface by `margin`, mm; ≤ 0 when
+/// it does. Asked at the lowered tip so the answer is exact where it is > 0: where the surface
+/// is far, [`Nozzle::penetration`] answers with a bound of the clearance, not the clearance.
+fn shortfall(surface: &Surface, nozzle: &Nozzle, tip: &Point3, margin: f64) -> f64 {
+    nozzle.penetration(surface, &(tip - Vector3::new(0.0, 0.0, margin)))
+}
+
+/// The deposit modes' standoff over Tᵢ and shift along the travel (module docs). `trail` is
+/// the back edge's distance behind the axis: d_o/2 going down, d/2 going up, 0 on the level.
+fn deposit_placement(
+    surface: &Surface,
+    ti: &Point3,
+    g: &Local,
+    d: f64,
+    trail: f64,
+    mode: Corrections,
+) -> (f64, f64) {
+    let n = g.normal;
+    let standoff = if mode == Corrections::Deposit {
+        standoff_on_surface(surface, ti, d)
+    } else {
+        d / n.z.max(0.5)
+    };
+    let slope = if n.z > 1e-9 {
+        (n.x * g.travel.x + n.y * g.travel.y).abs() / n.z
+    } else {
+        FULL_SHIFT_SLOPE
+    };
+    (standoff, trail * (slope / FULL_SHIFT_SLOPE).min(1.0))
+}
+
+/// The lowest height over `ti` (within [0, 2d]) at which the surface is `d` away.
+fn standoff_on_surface(surface: &Surface, ti: &Point3, d: f64) -> f64 {
+    let (mut near, mut far) = (0.0, 2.0 * d);
+    for _ in 0..STANDOFF_STEPS {
+        let mid = 0.5 * (near + far);
+        if surface.signed_distance(&Point3::new(ti.x, ti.y, ti.z + mid)) < d {
+            near = mid;
+        } else {
+            far = mid;
+        }
     }
-    // Height change per mm along the travel; < 0 downhill.
-    let g = -(normal.x * travel.x + normal.y * travel.y) / normal.z;
-    if g >= 0.0 {
-        return 0.0;
+    far
+}
+
+/// The published method's downhill shift Mᵢ = 0.5·d·(1 + d·κᵢ), d beyond κᵢ = 1/d (κ = 0 for
+/// `"slope"`).
+fn published_shift(mode: Corrections, g: &Local, d: f64) -> f64 {
+    let kappa = if mode == Corrections::Full {
+        g.section_curvature
+    } else {
+        0.0
+    };
+    if kappa > 1.0 / d {
+        d
+    } else {
+        (0.5 * d * (1.0 + d * kappa)).max(0.0)
     }
-    (ro + d * (1.0 / normal.z - 1.0) / -g).clamp(0.0, cap)
 }
 
 /// The correction of one point Tᵢ (module docs).
@@ -152,31 +218,40 @@ fn point_move(
 ) -> Move {
     let d = nozzle.inner;
     let ro = nozzle.outer / 2.0;
-    let tip = Point3::new(ti.x, ti.y, ti.z + d);
     let v = g.travel;
+    // A slope under 0.1 % is level: rounding would otherwise make flat paths "downhill".
+    let downhill = g.tangent.z < -1e-3;
+    let uphill = g.tangent.z > 1e-3;
+    let on_model = mode.on_deposit_model();
+    let (standoff, shift) = if on_model {
+        let trail = if downhill {
+            ro
+        } else if uphill {
+            d / 2.0
+        } else {
+            0.0
+        };
+        deposit_placement(surface, ti, g, d, trail, mode)
+    } else {
+        (d, published_shift(mode, g, d))
+    };
+    let tip = Point3::new(ti.x, ti.y, ti.z + standoff);
     let unmoved = Move {
         base: tip,
         along: 0.0,
         travel: v,
     };
-    let m = match mode {
-        Corrections::None => return unmoved,
-        Corrections::Deposit => deposit_shift(g.normal, v, d, ro),
-        Corrections::Full | Corrections::Slope => {
-            let kappa = if mode == Corrections::Full {
-                g.section_curvature
-            } else {
-                0.0
-            };
-            if kappa > 1.0 / d {
-                d
-            } else {
-                (0.5 * d * (1.0 + d * kappa)).max(0.0)
-            }
+    if mode == Corrections::None {
+        return unmoved;
+    }
+    let mut count_shift = |along: f64| {
+        if along > 0.0 && downhill {
+            counts.downhill += 1;
+        } else if along > 0.0 && uphill {
+            counts.uphill += 1;
         }
+        along
     };
-    // A slope under 0.1 % is flat: rounding would otherwise make flat paths "downhill".
-    let downhill = g.tangent.z < -1e-3;
     match nozzle.disk_contact(surface, &tip) {
         Some(p) => {
             let (qx, qy) = (ti.x - p[0], ti.y - p[1]);
@@ -188,32 +263,31 @@ fn point_move(
                 (-v.x, -v.y)
             };
             let l = (ro - dist + tolerance).max(0.0);
+            let along = count_shift(if downhill || on_model { shift } else { 0.0 });
             counts.contact += 1;
-            if downhill {
-                counts.downhill += 1;
-            }
             Move {
                 base: Point3::new(tip.x + l * qx, tip.y + l * qy, tip.z),
-                along: if downhill { m } else { 0.0 },
+                along,
                 travel: v,
             }
         }
+        None if on_model => Move {
+            along: count_shift(shift),
+            ..unmoved
+        },
         None if downhill => {
-            counts.downhill += 1;
-            let along = if mode == Corrections::Deposit {
-                m
-            } else {
-                let behind = (1..=BEHIND_STEPS)
-                    .map(|k| d * k as f64 / BEHIND_STEPS as f64)
-                    .find(|&s| {
-                        surface
-                            .height(tip.x - s * v.x, tip.y - s * v.y)
-                            .is_some_and(|h| h >= tip.z)
-                    })
-                    .unwrap_or(d);
-                (ro - behind + m).max(0.0)
-            };
-            Move { along, ..unmoved }
+            let behind = (1..=BEHIND_STEPS)
+                .map(|k| d * k as f64 / BEHIND_STEPS as f64)
+                .find(|&s| {
+                    surface
+                        .height(tip.x - s * v.x, tip.y - s * v.y)
+                        .is_some_and(|h| h >= tip.z)
+                })
+                .unwrap_or(d);
+            Move {
+                along: count_shift((ro - behind + shift).max(0.0)),
+                ..unmoved
+            }
         }
         None => unmoved,
     }
@@ -251,7 +325,7 @@ pub fn clear(surface: &Surface, nozzle: &Nozzle, path: &mut [Point3], margin: f6
     for _ in 0..CLEAR_ROUNDS {
         let mut changed = false;
         for i in 0..path.len() {
-            let need = nozzle.penetration(surface, &path[i]) + margin;
+            let need = shortfall(surface, nozzle, &path[i], margin);
             if need > 0.0 {
                 path[i] = snap(path[i] + crate::geom::Vector3::new(0.0, 0.0, need));
                 lifted[i] = true;
@@ -262,9 +336,15 @@ pub fn clear(surface: &Surface, nozzle: &Nozzle, path: &mut [Point3], margin: f6
             let (a, b) = (path[i], path[i + 1]);
             let n = (((b - a).norm() / step).ceil() as usize).max(2);
             let need = (1..n)
-                .map(|k| nozzle.penetration(surface, &(a + (b - a) * (k as f64 / n as f64))))
-                .fold(f64::MIN, f64::max)
-                + margin;
+                .map(|k| {
+                    shortfall(
+                        surface,
+                        nozzle,
+                        &(a + (b - a) * (k as f64 / n as f64)),
+                        margin,
+                    )
+                })
+                .fold(f64::MIN, f64::max);
             if need > 0.0 {
                 let up = crate::geom::Vector3::new(0.0, 0.0, need);
                 path[i] = snap(path[i] + up);
@@ -329,30 +409,107 @@ mod tests {
         correct(s, &Nozzle::for_tests(), 0.1, mode, t, local, &mut counts)
     }
 
+    /// The back edge `trail` behind `tip` along +x, at the tip's height.
+    fn back_edge(tip: &Point3, trail: f64) -> Point3 {
+        Point3::new(tip.x - trail, tip.y, tip.z)
+    }
+
     #[test]
-    fn going_down_a_plain_slope_the_deposit_shift_puts_the_back_edge_at_d() {
-        // Down 30°: M = d_o/2 + d·(1/cos 30° − 1)/tan 30° = 0.25 + 0.0670 = 0.3170; the back
-        // edge d_o/2 behind the shifted tip is d from the plane along its normal.
+    fn on_a_plain_slope_the_deposit_modes_put_the_back_edge_over_the_design_at_d() {
+        // 30°: the standoff is d/cos 30° = 0.2887 on the plane and on the surface alike; the
+        // shift is d_o/2 going down, d/2 going up, so the back edge is over Tᵢ and d from the
+        // plane along its normal.
         let slope = 30f64.to_radians().tan();
-        let s = extruded(-1.0, 21.0, |x| -slope * x);
-        let (t, local) = along_x(&s, 0.0, 20.0);
-        let tips = run(&s, Corrections::Deposit, &t, &local);
-        let expected = 0.25 + 0.25 * (1.0 / 30f64.to_radians().cos() - 1.0) / slope;
-        assert!((expected - 0.3170).abs() < 1e-4);
-        for (ti, tip) in t.iter().zip(&tips).skip(4).take(150) {
-            assert!((tip.x - ti.x - expected).abs() < 1e-6, "{ti} {tip}");
-            assert!((tip.z - ti.z - 0.25).abs() < 1e-12);
-            let back = Point3::new(tip.x - 0.25, 0.0, tip.z);
-            assert!((s.signed_distance(&back) - 0.25).abs() < 1e-6);
+        let standoff = 0.25 / 30f64.to_radians().cos();
+        for (sign, trail) in [(-1.0, 0.25), (1.0, 0.125)] {
+            let s = extruded(-1.0, 21.0, |x| sign * slope * x);
+            let (t, local) = along_x(&s, 0.0, 20.0);
+            for mode in [Corrections::Deposit, Corrections::DepositPlane] {
+                let tips = run(&s, mode, &t, &local);
+                for (ti, tip) in t.iter().zip(&tips).skip(4).take(150) {
+                    assert!((tip.x - ti.x - trail).abs() < 1e-9, "{mode:?} {ti} {tip}");
+                    assert!(
+                        (tip.z - ti.z - standoff).abs() < 1e-6,
+                        "{mode:?} {ti} {tip}"
+                    );
+                    let back = back_edge(tip, trail);
+                    assert!((s.signed_distance(&back) - 0.25).abs() < 1e-6, "{mode:?}");
+                }
+            }
+            // The published method keeps the standoff d: d·cos 30° = 0.2165 along the normal.
+            let published = run(&s, Corrections::Slope, &t, &local);
+            assert!((published[40].z - t[40].z - 0.25).abs() < 1e-12);
         }
-        // The published method shifts by 0.5·d: its back edge stays d_o/2 − 0.125 behind.
-        let published = run(&s, Corrections::Slope, &t, &local);
-        assert!((published[40].x - t[40].x - 0.125).abs() < 1e-9);
+        // Across the slope (travel along y) there is no shift, only the standoff.
+        let s = extruded(-1.0, 21.0, |x| slope * x);
+        let t: Vec<Point3> = (0..=40)
+            .map(|i| Point3::new(10.0, -2.5 + 0.125 * i as f64, 10.0 * slope))
+            .collect();
+        let normals = vec![s.top(10.0, 0.0).map_or_else(Vector3::z, |h| h.1); t.len()];
+        let local = spline::local_geometry(&t, &normals);
+        let tips = run(&s, Corrections::Deposit, &t, &local);
+        for (ti, tip) in t.iter().zip(&tips).skip(2).take(36) {
+            assert!((tip.xy() - ti.xy()).norm() < 1e-9, "{ti} {tip}");
+            assert!((s.signed_distance(tip) - 0.25).abs() < 1e-6, "{ti} {tip}");
+        }
+    }
+
+    #[test]
+    fn in_a_valley_and_on_a_crest_the_standoff_solved_on_the_surface_keeps_d() {
+        // Cylinders of radius R = 2 mm, concave (a valley) and convex (a crest), crossed along
+        // x. At a slope θ the reference point over Tᵢ at the tangent plane's standoff is
+        // d·tan θ from Tᵢ along the surface, so about d ∓ 0.5·(d·tan θ)²/(R ∓ d) from it: at
+        // 30°, 6 µm thin in the valley and 5 µm thick on the crest (exactly R − |P − C| and
+        // |P − C| − R for the axis C). On the surface, the standoff brings it back to d.
+        let (r, d) = (2.0f64, 0.25);
+        let valley = extruded(-1.6, 1.6, move |x| r - (r * r - x * x).sqrt());
+        let crest = extruded(-1.6, 1.6, move |x| (r * r - x * x).sqrt() - r);
+        for (s, concave) in [(valley, true), (crest, false)] {
+            // Off the strips' edges, where a point would take one side's facet normal.
+            let (t, local) = along_x(&s, -1.2375, 1.2375);
+            let on_surface = run(&s, Corrections::Deposit, &t, &local);
+            let on_plane = run(&s, Corrections::DepositPlane, &t, &local);
+            let mut checked = 0;
+            for ((ti, a), b) in t.iter().zip(&on_surface).zip(&on_plane) {
+                let sin = ti.x / r;
+                let theta = sin.asin().abs();
+                if !(25f64.to_radians()..=35f64.to_radians()).contains(&theta) {
+                    continue;
+                }
+                // Going down on the left half of the valley and the right half of the crest.
+                let down = (ti.x < 0.0) == concave;
+                let trail = if down { 0.25 } else { 0.125 };
+                // Where the rising side ahead cuts the shift back, the back edge is elsewhere.
+                if (a.x - ti.x - trail).abs() > 1e-9 || (b.x - ti.x - trail).abs() > 1e-9 {
+                    continue;
+                }
+                let (ra, rb) = (back_edge(a, trail), back_edge(b, trail));
+                let axis = Point3::new(0.0, rb.y, if concave { r } else { -r });
+                let exact = if concave {
+                    r - (rb - axis).xz().norm()
+                } else {
+                    (rb - axis).xz().norm() - r
+                };
+                let plane = s.signed_distance(&rb);
+                assert!((plane - exact).abs() < 5e-4, "{ti}: {plane} {exact}");
+                let reach = d * theta.tan();
+                let second_order = 0.5 * reach * reach / if concave { r - d } else { r + d };
+                let error = if concave { d - plane } else { plane - d };
+                // Within half of it: the control reads the facet's normal, not the cylinder's.
+                assert!(
+                    (error - second_order).abs() < 0.5 * second_order,
+                    "{ti}: {plane} {second_order}"
+                );
+                assert!((s.signed_distance(&ra) - d).abs() < 5e-4, "{ti} {a}");
+                checked += 1;
+            }
+            assert!(checked >= 4, "{checked}");
+        }
     }
 
     #[test]
     fn after_a_slope_the_shift_ramps_down_and_the_tip_never_runs_backwards() {
-        // Down 30° to x = 5, then flat: the shift of 0.317 mm (2.5 point spacings) ramps down
+        // Down 30° to x = 5, then flat: the shift of d_o/2 (two point spacings) ramps down
         // over the slope's last points, by at most half a spacing per point.
         let slope = 30f64.to_radians().tan();
         let s = extruded(-1.0, 11.0, |x| -slope * x.min(5.0));
@@ -366,7 +523,7 @@ mod tests {
             if ti.x > 5.0 + 1e-9 {
                 assert!(shift.abs() < 1e-12, "{ti} {tip}");
             } else if ti.x > 0.5 && ti.x < 5.0 - 6.0 * 0.125 {
-                assert!((shift - 0.3170).abs() < 1e-4, "{ti} {tip}");
+                assert!((shift - 0.25).abs() < 1e-9, "{ti} {tip}");
             } else if ti.x > 0.5 {
                 // k spacings before the flat: at most (k + 1) half spacings.
                 let k = ((5.0 - ti.x) / 0.125).round();
@@ -394,18 +551,19 @@ mod tests {
         let n = Nozzle::for_tests();
         let mut cut = 0;
         for (ti, tip) in t.iter().zip(&tips) {
-            let unshifted = Point3::new(ti.x, ti.y, ti.z + 0.25);
-            if n.penetration(&s, &unshifted) <= 0.0 {
-                assert!(n.penetration(&s, tip) <= 0.0, "{ti} {tip}");
+            // The moves are horizontal: the unshifted tip is at the tip's height over Tᵢ.
+            let unshifted = Point3::new(ti.x, ti.y, tip.z);
+            if shortfall(&s, &n, &unshifted, CLEARANCE) <= 0.0 {
+                assert!(shortfall(&s, &n, tip, CLEARANCE) <= 1e-9, "{ti} {tip}");
             }
-            if tip.x - ti.x < 0.3 && ti.x > 1.0 {
+            if tip.x - ti.x < 0.25 - 1e-9 && ti.x > 1.0 {
                 cut += 1;
             }
         }
         assert!(cut > 0);
-        // Uncut, the last points' shift would reach into the wall.
-        let last = t[t.len() - 1];
-        let reach = Point3::new(last.x + 0.317, 0.0, last.z + 0.25);
+        // Uncut, the last point's shift would reach into the wall.
+        let (last, tip) = (t[t.len() - 1], tips[tips.len() - 1]);
+        let reach = Point3::new(last.x + 0.25, 0.0, tip.z);
         assert!(n.penetration(&s, &reach) > 0.0);
     }
 }

@@ -10,9 +10,9 @@
 //! 3. [`design`]: SVG paths placed on the top view, two points per inner diameter.
 //! 4. [`project`] (or [`geodesic`]): the zero-standoff path T on the surface.
 //! 5. [`spline`]: tangent, signed curvature, inflections, direction of travel.
-//! 6. [`correct`]: standoff, tip-disk contact escape, downhill shift (solved on the deposit
-//!    model, or the published method's curvature-scaled formula); then a clearance pass with the
-//!    whole nozzle ([`nozzle`]) lifts what still touches.
+//! 6. [`correct`]: standoff, tip-disk contact escape, shift along the travel (the tip placed
+//!    on the deposit model, or the published method's curvature-scaled downhill formula); then
+//!    a clearance pass with the whole nozzle ([`nozzle`]) lifts what still touches.
 //! 7. [`deposit`]: expected deposit thickness and its errors, for every corrections mode.
 //! 8. [`report`]: the JSON report; [`replay`] re-checks the written G-code for contacts.
 //!
@@ -286,10 +286,11 @@ pub fn corrections_compared(
     let mut counts = correct::CorrectionCounts::default();
     let method = corrected(surface, params, params.corrections, geometry, &mut counts);
     let mut scratch = correct::CorrectionCounts::default();
-    let [none, slope, full, deposit] = [
+    let [none, slope, full, deposit_plane, deposit] = [
         Corrections::None,
         Corrections::Slope,
         Corrections::Full,
+        Corrections::DepositPlane,
         Corrections::Deposit,
     ]
     .map(|mode| {
@@ -305,6 +306,7 @@ pub fn corrections_compared(
         counts,
         report::Comparison {
             deposit,
+            deposit_plane,
             full,
             slope,
             none,
@@ -339,10 +341,9 @@ pub fn plan(
         }
     }
     let mut paths = method;
-    // 5 µm over the G-code's 1 µm rounding.
     let lifted: usize = paths
         .iter_mut()
-        .map(|p| correct::clear(surface, &params.nozzle, p, 0.005))
+        .map(|p| correct::clear(surface, &params.nozzle, p, correct::CLEARANCE))
         .sum();
     progress(Stage::Deposit);
     let report = report::build(report::Inputs {

@@ -28,12 +28,17 @@ pub struct Contact {
 }
 
 /// Deposit errors of every corrections mode on the same paths, all before the clearance pass:
-/// the deposit-model shift, the published method and the two controls it is compared with.
+/// the tip placed on the deposit model (on the surface, and its slope-only control on the
+/// tangent plane), the published method and the two controls it is compared with.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Comparison {
-    /// Contact corrections and the downhill shift solved on the deposit model.
+    /// The tip placed on the deposit model, its standoff solved on the surface (curvature and
+    /// all).
     pub deposit: DepositStats,
-    /// Full method: contact and curvature-scaled downhill corrections.
+    /// Control: the same placement with the standoff solved on the tangent plane (slope, no
+    /// curvature).
+    pub deposit_plane: DepositStats,
+    /// Published full method: contact and curvature-scaled downhill corrections.
     pub full: DepositStats,
     /// Control: downhill correction without curvature.
     pub slope: DepositStats,
@@ -46,6 +51,7 @@ impl Comparison {
     pub fn of(&self, mode: Corrections) -> &DepositStats {
         match mode {
             Corrections::Deposit => &self.deposit,
+            Corrections::DepositPlane => &self.deposit_plane,
             Corrections::Full => &self.full,
             Corrections::Slope => &self.slope,
             Corrections::None => &self.none,
@@ -161,7 +167,7 @@ pub(super) fn build(i: Inputs<'_>) -> ConformReport {
         registration: Registration::identity(),
         markers: Vec::new(),
         mapping: format!("{:?}", i.params.mapping).to_lowercase(),
-        corrections: format!("{:?}", i.params.corrections).to_lowercase(),
+        corrections: i.params.corrections.name().to_owned(),
         paths: i.projected.paths.len(),
         points: i.projected.paths.iter().map(Vec::len).sum(),
         off_surface: i.projected.off_surface,
