@@ -35,8 +35,8 @@ pub enum Corrections {
     /// control, without the curvature.
     #[serde(rename = "deposit-plane")]
     DepositPlane,
-    /// Standoff, nozzle contact and curvature-scaled downhill corrections: the published
-    /// method's formulas (the full method).
+    /// Standoff d, nozzle contact and curvature-scaled downhill corrections: the published
+    /// method's formulas.
     Full,
     /// Standoff and nozzle contact corrections, downhill shift without curvature (κ = 0).
     Slope,
