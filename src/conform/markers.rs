@@ -5,7 +5,8 @@
 //! `--refs-scan`, and the correspondence with the machine points is the assignment (of every
 //! permutation) with the smallest registration residual.
 //!
-//! A boundary edge is used by one triangle only; boundary edges chain into loops. A loop whose
+//! A boundary edge is used by one triangle only; boundary edges chain into loops, one per hole
+//! even where holes touch at a vertex. A loop whose
 //! bounding box is at most `max_size` on its longest side is a marker; the outer rim of the
 //! scan is far larger. The centroid is that of the loop's polygon area (the vector area's
 //! weighting of a fan from the loop's first vertex), which for a round hole is its centre even
@@ -29,76 +30,113 @@ pub struct Marker {
 /// The small boundary loops of `mesh` (longest bounding-box side ≤ `max_size`), sorted by x,
 /// then y, then z of their centroids.
 pub fn find_markers(mesh: &Mesh, max_size: f64) -> Vec<Marker> {
-    // Directed edges; a boundary edge has no twin.
-    let mut count: BTreeMap<(u32, u32), u32> = BTreeMap::new();
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *count.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    let mut next: BTreeMap<u32, u32> = BTreeMap::new();
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if count.get(&(a.min(b), a.max(b))) == Some(&1) {
-                next.insert(a, b);
+    let mut markers: Vec<Marker> = boundary_loops(mesh)
+        .into_iter()
+        .filter_map(|ring| {
+            let pts: Vec<Point3> = ring
+                .iter()
+                .filter_map(|&i| mesh.vertices.get(i as usize).copied())
+                .collect();
+            if pts.len() != ring.len() || pts.len() < 3 {
+                return None;
             }
-        }
-    }
-    let mut markers = Vec::new();
-    let mut seen = std::collections::BTreeSet::new();
-    for &start in next.keys() {
-        if seen.contains(&start) {
-            continue;
-        }
-        let mut ring = vec![start];
-        seen.insert(start);
-        let mut cur = start;
-        let closed = loop {
-            let Some(&n) = next.get(&cur) else {
-                break false;
-            };
-            if n == start {
-                break true;
+            let (mut lo, mut hi) = (pts[0], pts[0]);
+            for p in &pts {
+                lo = lo.inf(p);
+                hi = hi.sup(p);
             }
-            if !seen.insert(n) || ring.len() > next.len() {
-                break false;
-            }
-            ring.push(n);
-            cur = n;
-        };
-        if !closed || ring.len() < 3 {
-            continue;
-        }
-        let pts: Vec<Point3> = ring
-            .iter()
-            .filter_map(|&i| mesh.vertices.get(i as usize).copied())
-            .collect();
-        if pts.len() != ring.len() {
-            continue;
-        }
-        let (mut lo, mut hi) = (pts[0], pts[0]);
-        for p in &pts {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
-        let size = (hi - lo).max();
-        if size > max_size {
-            continue;
-        }
-        markers.push(Marker {
-            centroid: area_centroid(&pts),
-            size,
-            vertices: pts.len(),
-        });
-    }
+            let size = (hi - lo).max();
+            (size <= max_size).then(|| Marker {
+                centroid: area_centroid(&pts),
+                size,
+                vertices: pts.len(),
+            })
+        })
+        .collect();
     markers.sort_by(|a, b| {
         a.centroid
             .partial_cmp(&b.centroid)
             .unwrap_or(std::cmp::Ordering::Equal)
     });
     markers
+}
+
+/// The closed loops of boundary edges (edges of one triangle only), as vertex indices.
+///
+/// Each boundary edge is used once, in its triangle's direction, so a hole's rim runs with the
+/// hole on its right (seen from the side the triangles face). Where two holes touch at a vertex
+/// (or a hole touches the rim), two boundary edges leave it; the loop takes the one turning
+/// furthest right, which stays on the rim of the same hole: each hole is traced on its own
+/// instead of two being joined into a figure of eight (or one of them lost).
+fn boundary_loops(mesh: &Mesh) -> Vec<Vec<u32>> {
+    let mut uses: BTreeMap<(u32, u32), u32> = BTreeMap::new();
+    // The triangle of each directed edge, for the side the surface faces there.
+    let mut owner: BTreeMap<(u32, u32), usize> = BTreeMap::new();
+    for (ti, t) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+            owner.insert((a, b), ti);
+        }
+    }
+    let mut leaving: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+    for &(a, b) in owner.keys() {
+        if uses.get(&(a.min(b), a.max(b))) == Some(&1) {
+            leaving.entry(a).or_default().push(b);
+        }
+    }
+    let at = |i: u32| mesh.vertices.get(i as usize).copied();
+    let facing = |edge: (u32, u32)| -> Option<Vector3> {
+        let t = mesh.triangles.get(*owner.get(&edge)?)?;
+        let (a, b, c) = (at(t[0])?, at(t[1])?, at(t[2])?);
+        (b - a).cross(&(c - a)).try_normalize(1e-18)
+    };
+    // How far the path u → v → w turns left about `n`, radians (negative: right).
+    let turn = |u: u32, v: u32, w: u32, n: &Vector3| -> f64 {
+        match (at(u), at(v), at(w)) {
+            (Some(a), Some(b), Some(c)) => {
+                let (i, o) = (b - a, c - b);
+                i.cross(&o).dot(n).atan2(i.dot(&o))
+            }
+            _ => 0.0,
+        }
+    };
+    let mut used = std::collections::BTreeSet::new();
+    let mut loops = Vec::new();
+    for (&start, outs) in &leaving {
+        for &second in outs {
+            let first = (start, second);
+            if used.contains(&first) {
+                continue;
+            }
+            let mut ring = Vec::new();
+            let mut edge = first;
+            let closed = loop {
+                if !used.insert(edge) {
+                    break false;
+                }
+                ring.push(edge.0);
+                let (u, v) = edge;
+                let n = facing(edge).unwrap_or_else(Vector3::z);
+                let next = leaving
+                    .get(&v)
+                    .into_iter()
+                    .flatten()
+                    .copied()
+                    .filter(|&w| (v, w) == first || !used.contains(&(v, w)))
+                    .min_by(|&a, &b| turn(u, v, a, &n).total_cmp(&turn(u, v, b, &n)));
+                match next {
+                    Some(w) if (v, w) == first => break true,
+                    Some(w) => edge = (v, w),
+                    None => break false,
+                }
+            };
+            if closed {
+                loops.push(ring);
+            }
+        }
+    }
+    loops
 }
 
 /// Area centroid of a closed 3D polygon: fan triangles from the first vertex, each weighted by
@@ -122,4 +160,51 @@ fn area_centroid(pts: &[Point3]) -> [f64; 3] {
         pts.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / pts.len() as f64
     };
     [c.x, c.y, c.z]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 6 × 6 plate of unit squares (two triangles each) without the squares in `holes`.
+    fn plate(holes: &[[usize; 2]]) -> Mesh {
+        let p = |i: usize, j: usize| Point3::new(i as f64, j as f64, 0.0);
+        let mut tris = Vec::new();
+        for j in 0..6 {
+            for i in 0..6 {
+                if holes.contains(&[i, j]) {
+                    continue;
+                }
+                tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+                tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+            }
+        }
+        Mesh::from_triangle_soup("plate", tris)
+    }
+
+    #[test]
+    fn two_holes_touching_at_a_corner_are_two_markers() {
+        // Squares (2, 2) and (3, 3) share the vertex (3, 3): each is a hole of its own.
+        let markers = find_markers(&plate(&[[2, 2], [3, 3]]), 1.5);
+        let centres: Vec<[f64; 3]> = markers.iter().map(|m| m.centroid).collect();
+        assert_eq!(
+            centres,
+            vec![[2.5, 2.5, 0.0], [3.5, 3.5, 0.0]],
+            "{markers:?}"
+        );
+        assert!(markers.iter().all(|m| m.vertices == 4 && m.size == 1.0));
+    }
+
+    #[test]
+    fn a_hole_and_the_rim_are_separate_loops() {
+        // One square hole in the middle; the plate's rim is the other, larger loop.
+        let mesh = plate(&[[2, 3]]);
+        let loops = boundary_loops(&mesh);
+        let mut sizes: Vec<usize> = loops.iter().map(Vec::len).collect();
+        sizes.sort_unstable();
+        assert_eq!(sizes, vec![4, 24]);
+        let markers = find_markers(&mesh, 1.5);
+        assert_eq!(markers.len(), 1);
+        assert_eq!(markers[0].centroid, [2.5, 3.5, 0.0]);
+    }
 }
