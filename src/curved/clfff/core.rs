@@ -24,8 +24,9 @@
 //! ([`super::sandwich::Sandwich::core_lift`], [`crate::curved::motion`]).
 
 use super::densify::densify;
+use super::lift::lift_path;
 use super::outline::ccw_region;
-use super::sandwich::{Column, Sandwich, lift_path};
+use super::sandwich::{Column, Sandwich};
 use super::shell::Shell;
 use crate::config::Config;
 use crate::curved::motion;

@@ -17,7 +17,7 @@
 //! inside the loop, clipped and ordered by
 //! [`fill_family`](crate::region::infill::lines::fill_family) and joined into zig-zags along
 //! the loop. Every path is densified ([`super::densify`]) and each point lifted to
-//! `S(x, y) + k·h`; points where the surface is missing are dropped and the path split there.
+//! `S(x, y) + k·h` ([`super::lift`]); where the surface is missing the path is cut at its edge.
 //!
 //! The local thickness of the lowest curved layer is the distance from its nozzle down to the
 //! top of the scaffold there ([`crate::curved::clfff::scaffold::Scaffold::top_at`]), so its
@@ -25,6 +25,7 @@
 //! (the cap is counted in the report). Every other curved layer is `h` thick.
 
 use super::densify::densify;
+use super::lift::{Lift, lift_path};
 use super::sections::Section;
 use super::shell::Shell;
 use crate::curved::tops::Projected;
@@ -124,6 +125,36 @@ pub fn lift_layer(
     step: f64,
     support: &dyn Fn(f64, f64) -> f64,
 ) -> LiftedLayer {
+    let max_t = MAX_THICKNESS_FACTOR * spec.height;
+    let lift = |x: f64, y: f64| -> Option<Lift> {
+        let z = shell.bottom(x, y)? + spec.offset;
+        let thickness = if spec.lowest {
+            (z - support(x, y)).max(spec.height).min(max_t)
+        } else {
+            spec.height
+        };
+        Some(Lift {
+            z,
+            thickness,
+            state: 0,
+        })
+    };
+    let dense = |xy: &[(f64, f64)], closed: bool| densify(shell, xy, closed, step);
+    lift_flat_paths(outline, spec, &dense, &lift)
+}
+
+/// A path's densification: the flat path (xy, mm) and whether it is closed → its points.
+pub type Densify<'a> = dyn Fn(&[(f64, f64)], bool) -> Vec<(f64, f64)> + 'a;
+
+/// The flat paths of `spec` over `outline` ([`flat_paths`]), each densified by `densify` and
+/// lifted by `lift` ([`lift_path`]), with the points where the surface is missing and those
+/// at the thickness cap ([`MAX_THICKNESS_FACTOR`]` · h`) counted.
+pub fn lift_flat_paths(
+    outline: &[ExPolygon],
+    spec: LayerSpec,
+    densify: &Densify<'_>,
+    lift: &dyn Fn(f64, f64) -> Option<Lift>,
+) -> LiftedLayer {
     let mut layer = LiftedLayer {
         spec,
         pieces: Vec::new(),
@@ -132,51 +163,14 @@ pub fn lift_layer(
     };
     let max_t = MAX_THICKNESS_FACTOR * spec.height;
     for (xy, closed, role, width) in flat_paths(outline, &spec) {
-        let dense = densify(shell, &xy, closed, step);
-        let mut cur = Projected {
-            points: Vec::new(),
-            thickness: Vec::new(),
-            closed: false,
-        };
-        let mut whole = true;
-        let mut pieces = Vec::new();
-        for &(x, y) in &dense {
-            match shell.bottom(x, y) {
-                Some(s) => {
-                    let z = s + spec.offset;
-                    let t = if spec.lowest {
-                        let t = (z - support(x, y)).max(spec.height);
-                        if t > max_t {
-                            layer.capped += 1;
-                        }
-                        t.min(max_t)
-                    } else {
-                        spec.height
-                    };
-                    cur.points.push(crate::geom::Point3::new(x, y, z));
-                    cur.thickness.push(t);
-                }
-                None => {
-                    layer.dropped += 1;
-                    whole = false;
-                    let done = std::mem::replace(
-                        &mut cur,
-                        Projected {
-                            points: Vec::new(),
-                            thickness: Vec::new(),
-                            closed: false,
-                        },
-                    );
-                    if done.points.len() >= 2 {
-                        pieces.push(done);
-                    }
-                }
-            }
-        }
-        if cur.points.len() >= 2 {
-            cur.closed = closed && whole;
-            pieces.push(cur);
-        }
+        let (pieces, dropped) = lift_path(&densify(&xy, closed), closed, lift);
+        layer.dropped += dropped;
+        // Points at the cap (a thickness exactly three layers counts too: rare, and harmless).
+        layer.capped += pieces
+            .iter()
+            .flat_map(|p| &p.thickness)
+            .filter(|&&t| t >= max_t - 1e-12)
+            .count();
         layer
             .pieces
             .extend(pieces.into_iter().map(|p| (p, role, width)));

@@ -19,8 +19,8 @@
 //!    nearest neighbour;
 //! 4. [`layers`]: the buffer (`curved.buffer`, nozzle on the bottom surface) and the model's
 //!    `curved.layers` layers (nozzle at surface + k·h), each an outline loop then raster lines
-//!    at `curved.angles[k mod n]`, lifted onto the surface with points at every triangle edge
-//!    and every `curved.step`; flow and z speed by [`crate::curved::motion`]; with a
+//!    at `curved.angles[k mod n]`, lifted onto the surface ([`lift`]) with points at every
+//!    triangle edge and every `curved.step`; flow and z speed by [`crate::curved::motion`]; with a
 //!    sandwich these are the bottom skin, followed by the planar [`core`] and the top skin's
 //!    `curved.top_layers` layers (nozzle at top surface − (n_t − 1 − j)·h);
 //! 5. [`travel`]: the curved paths grouped at long travels, each group lifted above the highest
@@ -35,6 +35,7 @@ pub mod collide;
 pub mod core;
 pub mod densify;
 pub mod layers;
+pub mod lift;
 pub mod outline;
 pub mod place;
 pub mod report;

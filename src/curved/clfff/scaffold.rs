@@ -22,6 +22,7 @@
 //! first) from where the previous layer ended.
 
 use super::densify::densify;
+use super::lift::bisect;
 use super::outline::Rim;
 use super::shell::Shell;
 use crate::geom::{ExPolygon, Point3};
@@ -29,9 +30,6 @@ use crate::region::infill::lines::{LineFamily, fill_family};
 
 /// Shortest scaffold line kept, in line widths.
 pub const MIN_PIECE_WIDTHS: f64 = 2.0;
-
-/// Bisection steps for a line's crossing with the limit (the interval shrinks 2⁻⁴⁰ times).
-const BISECTION_STEPS: usize = 40;
 
 /// Most scaffold layers (a guard against a limit that never stops the scaffold).
 const MAX_LAYERS: usize = 100_000;
@@ -181,12 +179,12 @@ fn cut_at_limit(pts: &[(f64, f64)], z: f64, limit: &Limit<'_>) -> (Vec<Vec<(f64,
         if ok[i] {
             if cur.is_empty() && i > 0 {
                 // Entering from a refused point: start at the crossing.
-                cur.push(bisect(pts[i], pts[i - 1], &allowed));
+                cur.push(bisect(pts[i], pts[i - 1], &allowed).0);
                 cuts += 1;
             }
             cur.push(pts[i]);
             if i + 1 < pts.len() && !ok[i + 1] {
-                cur.push(bisect(pts[i], pts[i + 1], &allowed));
+                cur.push(bisect(pts[i], pts[i + 1], &allowed).0);
                 cuts += 1;
                 runs.push(std::mem::take(&mut cur));
             }
@@ -200,24 +198,6 @@ fn cut_at_limit(pts: &[(f64, f64)], z: f64, limit: &Limit<'_>) -> (Vec<Vec<(f64,
     }
     runs.retain(|r| r.len() >= 2);
     (runs, cuts)
-}
-
-/// The point between `good` (allowed) and `bad` (refused) nearest to the crossing, on the
-/// allowed side.
-fn bisect(
-    mut good: (f64, f64),
-    mut bad: (f64, f64),
-    allowed: &impl Fn((f64, f64)) -> bool,
-) -> (f64, f64) {
-    for _ in 0..BISECTION_STEPS {
-        let mid = ((good.0 + bad.0) / 2.0, (good.1 + bad.1) / 2.0);
-        if allowed(mid) {
-            good = mid;
-        } else {
-            bad = mid;
-        }
-    }
-    good
 }
 
 /// `pieces` chained greedily: from `from`, the piece with the nearest end comes next (reversed
