@@ -182,6 +182,7 @@ pub fn lift_flat_paths(
 mod tests {
     use super::*;
     use crate::curved::clfff::outline::outline;
+    use crate::curved::tops::Projected;
     use crate::geom::Point3;
     use crate::mesh::Mesh;
 
@@ -234,5 +235,88 @@ mod tests {
         let inner = 10.0 - 2.0 * (0.225 + crate::region::spacing(0.45, 0.2));
         let want = inner * inner / crate::region::spacing(0.45, 0.2);
         assert!((length - want).abs() < 0.1 * want, "{length} vs {want}");
+    }
+
+    #[test]
+    fn paths_end_on_the_surfaces_edge_and_a_cut_loop_stays_one_piece() {
+        // A flat sheet at z = 1 over [0, 10]² of unit squares, without a notch [8, 10]² and a
+        // hole [4, 6]², under the whole square's outline: the loop runs through the notch and
+        // the raster lines through the hole.
+        let p = |x: usize, y: usize| Point3::new(x as f64, y as f64, 1.0);
+        let mut tris = Vec::new();
+        for j in 0..10 {
+            for i in 0..10 {
+                if (i >= 8 && j >= 8) || ((4..6).contains(&i) && (4..6).contains(&j)) {
+                    continue;
+                }
+                tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+                tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+            }
+        }
+        let shell = Shell::from_meshes(&[Mesh::from_triangle_soup("sheet", tris)]);
+        let corner = |x: f64, y: f64| crate::geom::Point2::from_mm(x, y);
+        let square = ExPolygon {
+            contour: crate::geom::Polygon::new(vec![
+                corner(0.0, 0.0),
+                corner(10.0, 0.0),
+                corner(10.0, 10.0),
+                corner(0.0, 10.0),
+            ]),
+            holes: Vec::new(),
+        };
+        let spec = LayerSpec {
+            section: Section::Model,
+            k: 1,
+            offset: 0.2,
+            angle_deg: 0.0,
+            height: 0.2,
+            loop_role: Role::ExternalPerimeter,
+            fill_role: Role::SolidInfill,
+            loop_width: 0.45,
+            fill_width: 0.45,
+            lowest: false,
+            surface: crate::curved::clfff::sandwich::Follows::Bottom,
+        };
+        let layer = lift_layer(&shell, &[square], spec, 0.5, &|_, _| 0.0);
+        assert!(layer.dropped > 0);
+        let loops: Vec<&Projected> = layer
+            .pieces
+            .iter()
+            .filter(|(_, r, _)| *r == Role::ExternalPerimeter)
+            .map(|(p, ..)| p)
+            .collect();
+        // The loop, cut by the notch, is one open piece from one side of it to the other.
+        assert_eq!(loops.len(), 1);
+        let (a, b) = (
+            loops[0].points[0],
+            loops[0].points[loops[0].points.len() - 1],
+        );
+        assert!(!loops[0].closed);
+        for q in [a, b] {
+            let on_edge = (q.x - 8.0).abs() < 1e-9 || (q.y - 8.0).abs() < 1e-9;
+            assert!(on_edge && q.x <= 10.0 && q.y <= 10.0, "{q}");
+        }
+        // Raster lines crossing the hole stop on its edges, x = 4 and x = 6.
+        let mut at_hole = 0;
+        for (piece, role, _) in &layer.pieces {
+            if *role != Role::SolidInfill {
+                continue;
+            }
+            for w in piece.points.windows(2) {
+                let (lo, hi) = (w[0].x.min(w[1].x), w[0].x.max(w[1].x));
+                let y = w[0].y;
+                assert!(
+                    !(lo < 5.0 && hi > 5.0 && y > 4.0 && y < 6.0),
+                    "a line crosses the hole at y = {y}"
+                );
+            }
+            for q in [piece.points[0], piece.points[piece.points.len() - 1]] {
+                if q.y > 4.0 && q.y < 6.0 && ((q.x - 4.0).abs() < 1e-9 || (q.x - 6.0).abs() < 1e-9)
+                {
+                    at_hole += 1;
+                }
+            }
+        }
+        assert!(at_hole >= 4, "{at_hole}");
     }
 }
