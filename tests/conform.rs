@@ -325,13 +325,7 @@ struct Run {
 }
 
 /// The corrections modes compared, in the order of [`Run`]'s arrays.
-const MODES: [Corrections; 5] = [
-    Corrections::Deposit,
-    Corrections::DepositPlane,
-    Corrections::Full,
-    Corrections::Slope,
-    Corrections::None,
-];
+const MODES: [Corrections; 5] = Corrections::ALL;
 
 /// Plans (with the default corrections), writes and replays `design` on `s`; asserts no
 /// contact in the replay and that no corrections mode is above no corrections by more than the

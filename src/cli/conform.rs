@@ -5,7 +5,7 @@
 
 use super::{Failure, args::ConformArgs, config::resolve};
 use anyhow::{Context, anyhow};
-use conduit::config::{Config, Mapping};
+use conduit::config::{Config, Corrections, Mapping};
 use conduit::conform::markers::{Marker, find_markers};
 use conduit::conform::orient::{self, OrientParams, OrientationReport, ToolAxis};
 use conduit::conform::register::least_squares;
@@ -182,11 +182,15 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         return warnings(&args, &report);
     }
     let replay = report.replay.as_ref().map_or(0, |r| r.printing + r.travel);
+    // The other modes on the same path, for comparison.
+    let others: Vec<String> = Corrections::ALL
+        .iter()
+        .filter(|&&m| m != params.corrections)
+        .map(|&m| format!("{} {:.3}", m.name(), report.comparison.of(m).mean_abs_error))
+        .collect();
     eprintln!(
         "{}: {} path(s), {} points, {:.1} mm on the surface ({:.1} mm in the plane), Δz {:.2} mm; \
-         deposit error {:.3} mm mean with {} corrections (deposit model on the tangent plane \
-         {:.3}, published method {:.3}, slope-only {:.3}, uncorrected {:.3}); {} nozzle \
-         contact(s) in the replay",
+         deposit error {:.3} mm mean with {} corrections ({}); {} nozzle contact(s) in the replay",
         args.out.display(),
         report.paths,
         report.points,
@@ -195,10 +199,7 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         report.geometry.delta_z,
         report.comparison.of(params.corrections).mean_abs_error,
         report.corrections,
-        report.comparison.deposit_plane.mean_abs_error,
-        report.comparison.full.mean_abs_error,
-        report.comparison.slope.mean_abs_error,
-        report.comparison.none.mean_abs_error,
+        others.join(", "),
         replay
     );
     warnings(&args, &report)

@@ -45,6 +45,15 @@ pub enum Corrections {
 }
 
 impl Corrections {
+    /// Every mode, the default first.
+    pub const ALL: [Corrections; 5] = [
+        Self::Deposit,
+        Self::DepositPlane,
+        Self::Full,
+        Self::Slope,
+        Self::None,
+    ];
+
     /// Whether the mode places the tip on the deposit model (`Deposit`, `DepositPlane`)
     /// rather than by the published method's formulas.
     pub fn on_deposit_model(self) -> bool {

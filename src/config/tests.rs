@@ -204,13 +204,7 @@ fn load_picks_the_format_by_extension() -> Result<(), Box<dyn std::error::Error>
 
 #[test]
 fn every_corrections_mode_parses_from_its_name() -> Result<(), ConfigError> {
-    for mode in [
-        Corrections::Deposit,
-        Corrections::DepositPlane,
-        Corrections::Full,
-        Corrections::Slope,
-        Corrections::None,
-    ] {
+    for mode in Corrections::ALL {
         let cfg = parse(&format!("[conform]\ncorrections = \"{}\"\n", mode.name()))?;
         assert_eq!(cfg.conform.corrections, mode);
     }
