@@ -127,15 +127,15 @@ pub fn correct(
         .map(|m| {
             let tip = m.base + m.travel * m.along;
             if m.along <= 0.0
-                || shortfall(surface, nozzle, &tip, CLEARANCE) <= 0.0
-                || shortfall(surface, nozzle, &m.base, CLEARANCE) > 0.0
+                || nozzle.shortfall(surface, &tip, CLEARANCE) <= 0.0
+                || nozzle.shortfall(surface, &m.base, CLEARANCE) > 0.0
             {
                 return tip;
             }
             let (mut free, mut hit) = (0.0, m.along);
             for _ in 0..CUT_STEPS {
                 let mid = 0.5 * (free + hit);
-                if shortfall(surface, nozzle, &(m.base + m.travel * mid), CLEARANCE) > 0.0 {
+                if nozzle.shortfall(surface, &(m.base + m.travel * mid), CLEARANCE) > 0.0 {
                     hit = mid;
                 } else {
                     free = mid;
@@ -144,13 +144,6 @@ pub fn correct(
             m.base + m.travel * free
         })
         .collect()
-}
-
-/// How far `tip` must rise for the whole nozzle to clear the surface by `margin`, mm; ≤ 0 when
-/// it does. Asked at the lowered tip so the answer is exact where it is > 0: where the surface
-/// is far, [`Nozzle::penetration`] answers with a bound of the clearance, not the clearance.
-fn shortfall(surface: &Surface, nozzle: &Nozzle, tip: &Point3, margin: f64) -> f64 {
-    nozzle.penetration(surface, &(tip - Vector3::new(0.0, 0.0, margin)))
 }
 
 /// The deposit modes' standoff over Tᵢ and shift along the travel (module docs). `trail` is
@@ -325,7 +318,7 @@ pub fn clear(surface: &Surface, nozzle: &Nozzle, path: &mut [Point3], margin: f6
     for _ in 0..CLEAR_ROUNDS {
         let mut changed = false;
         for i in 0..path.len() {
-            let need = shortfall(surface, nozzle, &path[i], margin);
+            let need = nozzle.shortfall(surface, &path[i], margin);
             if need > 0.0 {
                 path[i] = snap(path[i] + crate::geom::Vector3::new(0.0, 0.0, need));
                 lifted[i] = true;
@@ -336,14 +329,7 @@ pub fn clear(surface: &Surface, nozzle: &Nozzle, path: &mut [Point3], margin: f6
             let (a, b) = (path[i], path[i + 1]);
             let n = (((b - a).norm() / step).ceil() as usize).max(2);
             let need = (1..n)
-                .map(|k| {
-                    shortfall(
-                        surface,
-                        nozzle,
-                        &(a + (b - a) * (k as f64 / n as f64)),
-                        margin,
-                    )
-                })
+                .map(|k| nozzle.shortfall(surface, &(a + (b - a) * (k as f64 / n as f64)), margin))
                 .fold(f64::MIN, f64::max);
             if need > 0.0 {
                 let up = crate::geom::Vector3::new(0.0, 0.0, need);
@@ -553,8 +539,8 @@ mod tests {
         for (ti, tip) in t.iter().zip(&tips) {
             // The moves are horizontal: the unshifted tip is at the tip's height over Tᵢ.
             let unshifted = Point3::new(ti.x, ti.y, tip.z);
-            if shortfall(&s, &n, &unshifted, CLEARANCE) <= 0.0 {
-                assert!(shortfall(&s, &n, tip, CLEARANCE) <= 1e-9, "{ti} {tip}");
+            if n.shortfall(&s, &unshifted, CLEARANCE) <= 0.0 {
+                assert!(n.shortfall(&s, tip, CLEARANCE) <= 1e-9, "{ti} {tip}");
             }
             if tip.x - ti.x < 0.25 - 1e-9 && ti.x > 1.0 {
                 cut += 1;

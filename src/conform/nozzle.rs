@@ -172,6 +172,14 @@ impl Nozzle {
         }
         worst
     }
+
+    /// How far `tip` must rise for the whole nozzle to clear the surface by `margin`, mm; ≤ 0
+    /// when it does. Asked at the lowered tip so the answer is exact where it is > 0: where the
+    /// surface is far, [`Nozzle::penetration`] answers with a bound of the clearance, not the
+    /// clearance.
+    pub fn shortfall(&self, surface: &Surface, tip: &Point3, margin: f64) -> f64 {
+        self.penetration(surface, &Point3::new(tip.x, tip.y, tip.z - margin))
+    }
 }
 
 #[cfg(test)]
@@ -186,5 +194,32 @@ impl Nozzle {
             cone_angle_deg: 30.0,
             cone_height: 10.0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shortfall_is_exact_near_the_surface_and_none_far_above_it() {
+        // A flat plate at z = 0 over [−20, 20]².
+        let c = |x: f64, y: f64| Point3::new(x, y, 0.0);
+        let plate = Surface::from_triangles(vec![
+            [c(-20.0, -20.0), c(20.0, -20.0), c(20.0, 20.0)],
+            [c(-20.0, -20.0), c(20.0, 20.0), c(-20.0, 20.0)],
+        ]);
+        let Ok(plate) = plate else {
+            panic!("plate");
+        };
+        let n = Nozzle::for_tests();
+        // 3 µm above the plate, 5 µm wanted: 2 µm short; 1 µm below it: 6 µm short.
+        let short = n.shortfall(&plate, &Point3::new(0.0, 0.0, 0.003), 0.005);
+        assert!((short - 0.002).abs() < 1e-12, "{short}");
+        let short = n.shortfall(&plate, &Point3::new(0.0, 0.0, -0.001), 0.005);
+        assert!((short - 0.006).abs() < 1e-12, "{short}");
+        // Well above it: clear, whatever bound the coarse check answers with.
+        assert!(n.shortfall(&plate, &Point3::new(0.0, 0.0, 0.3), 0.005) <= 0.0);
+        assert!(n.shortfall(&plate, &Point3::new(0.0, 0.0, 0.0051), 0.005) <= 0.0);
     }
 }
