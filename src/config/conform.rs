@@ -97,8 +97,7 @@ pub struct ConformSettings {
     /// `"projection"`.
     pub mapping: Mapping,
     /// `"deposit"`, `"deposit-plane"`, `"full"`, `"slope"` or `"none"`: which corrections are
-    /// applied. Default
-    /// `"deposit"`.
+    /// applied. Default `"deposit"`.
     pub corrections: Corrections,
     /// Length of the straight needle above the tip (outer diameter), mm. Default 6.
     pub needle_length: f64,

@@ -7,9 +7,9 @@
 //!
 //! A boundary edge is used by one triangle only; boundary edges chain into loops, one per hole
 //! even where holes touch at a vertex. A loop whose bounding box is at most `max_size` on its
-//! longest side is a marker; the outer rim of the scan is far larger. The centroid is that of the loop's polygon area (the vector area's
-//! weighting of a fan from the loop's first vertex), which for a round hole is its centre even
-//! when its vertices are unevenly spaced.
+//! longest side is a marker; the outer rim of the scan is far larger. The centroid is that of
+//! the loop's polygon area (the vector area's weighting of a fan from the loop's first
+//! vertex), which for a round hole is its centre even when its vertices are unevenly spaced.
 
 use crate::geom::{Point3, Vector3};
 use crate::mesh::Mesh;

@@ -286,14 +286,7 @@ pub fn corrections_compared(
     let mut counts = correct::CorrectionCounts::default();
     let method = corrected(surface, params, params.corrections, geometry, &mut counts);
     let mut scratch = correct::CorrectionCounts::default();
-    let [none, slope, full, deposit_plane, deposit] = [
-        Corrections::None,
-        Corrections::Slope,
-        Corrections::Full,
-        Corrections::DepositPlane,
-        Corrections::Deposit,
-    ]
-    .map(|mode| {
+    let [deposit, deposit_plane, full, slope, none] = Corrections::ALL.map(|mode| {
         let paths = if mode == params.corrections {
             method.clone()
         } else {
