@@ -12,6 +12,7 @@ mod conformance;
 mod curved;
 mod electronics;
 mod electronics_corpus;
+mod golden;
 mod jet;
 mod postprocess;
 mod postprocess_e2e;
