@@ -82,7 +82,7 @@ for design in spiral hilbert_loop lines; do
 done
 for dialect in urscript krl rapid poses-csv gcode-5axis; do
     run "conform_$dialect" conform --surface samples/conform/wrinkled_film.xyz \
-        --design samples/conform/monopole.svg --tool-axis normal --output "$dialect" \
+        --design samples/conform/monopole.svg --tool-axis normal --dialect "$dialect" \
         -o "out/monopole_$dialect.out" --report "out/monopole_$dialect.json"
 done
 

@@ -1,48 +1,69 @@
 //! conduit turns 3D models and circuit designs into machine programs for printed electronics and
 //! non-planar printing.
 //!
-//! The pipeline runs one way:
+//! Every command is one walk along one line; nothing downstream reaches back upstream
+//! (`ARCHITECTURE.md` is the map):
 //!
 //! ```text
-//! files ──read──► Scene (meshes, transforms) ──slice──► Layers ──► Program ──emit──► G-code, reports
+//! files ──read──► Scene, Circuit, Placement, Surface, Design ──stages──► Program ──emit──► files
 //! ```
 //!
-//! - [`geom`]: the shared geometry vocabulary (scaled-integer 2D points, f64 3D points, transforms,
-//!   tolerances).
+//! **Vocabulary** — the data every stage speaks:
+//! - [`geom`]: scaled-integer 2D points (1 nm), f64 3D points, polygons with holes, transforms,
+//!   tolerances, tool frames.
 //! - [`mesh`]: the indexed triangle mesh with validation and repair.
-//! - [`scene`]: reading every supported file into a [`scene::Scene`] (or a circuit, a point cloud,
-//!   a G-code listing) and writing meshes back out.
-//! - [`config`]: the one TOML configuration (printer, tools, slicing), PrusaSlicer `.ini` import.
-//! - [`slice`]: meshes cut into layers of polygons with holes.
-//! - [`conform`]: conformal printing — 2D designs laid onto scanned surfaces (registration,
-//!   projection, nozzle-aware corrections, deposit report).
-//! - [`curved`]: non-planar top surfaces — top solid layers of gentle top surfaces projected onto
-//!   the mesh, with head collision checks (`--curved tops`).
-//! - [`region`]: perimeters, top/bottom skins, infill patterns and skirt per layer.
+//! - [`scene`]: every supported file read into a [`scene::Scene`] (or a circuit, a point cloud,
+//!   a G-code listing), and meshes written back out.
 //! - [`program`]: toolpaths and events in print order — what every writer consumes.
-//! - [`emit`]: G-code (Marlin, RepRapFirmware, Klipper) from a program.
-//! - [`check`]: replaying any G-code to find problems and measure it.
-//! - [`jet`]: aerosol-jet toolpaths from 2D designs — corner fillets, shutter gaps, direction
-//!   blocks, the corner accumulation model (`conduit jet`).
-//! - [`pipeline`]: the stages above as one walk, scene to G-code.
-//! - [`postprocess`]: slicer plugin mode — another slicer's G-code read into layers (z, widths,
-//!   extrusions, printed regions) to be edited in place.
+//! - [`config`]: the one TOML configuration (and PrusaSlicer `.ini` import) that the walks turn
+//!   into each stage's parameters.
 //!
-//! The `conduit` binary (`src/main.rs`, `src/cli/`) turns command lines into calls of these modules.
+//! **Stages** — each a function from its parameters and inputs to data:
+//! - [`slice`]: meshes cut into layers of polygons with holes.
+//! - [`region`]: perimeters, gap fill, skins, bridges, infill patterns, skirt and cavities per
+//!   layer.
+//! - [`circuit`]: the circuit model (EAGLE circuits, placements, rubberbands) and the
+//!   electronics stage (parts placed, cavities carved, wires routed, pick-and-place records).
+//! - [`route`]: weighted A* trace routing on per-layer perimeter graphs.
+//! - [`curved`]: non-planar top surfaces over a planar core; `clfff`: curved-layer FFF.
+//! - [`conform`]: 2D designs laid onto scanned surfaces — registration, projection,
+//!   nozzle-aware corrections, tool orientation, deposit report.
+//! - [`robot`]: robot set-up and calibration — tool centre point, frame registration, gap
+//!   compensation, calibration patterns.
+//! - [`jet`]: aerosol-jet toolpaths — corner fillets, shutter gaps, direction blocks, the
+//!   corner accumulation model.
+//! - [`emit`]: writers — G-code (Marlin, RepRapFirmware, Klipper), robot programs, previews,
+//!   routing views.
+//! - [`check`]: replaying any G-code to find problems and measure it.
+//!
+//! **Walks** — one library call per command:
+//! - [`pipeline`]: scene to G-code (planar, curved tops, curved-layer FFF) and scene to routing
+//!   view.
+//! - [`postprocess`]: slicer plugin mode — another slicer's G-code read into layers, the circuit
+//!   built into it, the file edited in place.
+//!
+//! The `conduit` binary (`src/main.rs`, `src/cli/`, behind the default `cli` feature) parses
+//! command lines, calls one walk, writes files and prints.
 
-pub mod check;
-pub mod circuit;
-pub mod config;
-pub mod conform;
-pub mod curved;
-pub mod emit;
+// Vocabulary.
 pub mod geom;
-pub mod jet;
 pub mod mesh;
+pub mod scene;
+pub mod program;
+pub mod config;
+
+// Stages.
+pub mod slice;
+pub mod region;
+pub mod circuit;
+pub mod route;
+pub mod curved;
+pub mod conform;
+pub mod robot;
+pub mod jet;
+pub mod emit;
+pub mod check;
+
+// Walks.
 pub mod pipeline;
 pub mod postprocess;
-pub mod program;
-pub mod region;
-pub mod route;
-pub mod scene;
-pub mod slice;

@@ -8,10 +8,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use conduit::conform::frames::{self, Measured, OutlierRule, PairKind};
-use conduit::conform::kinematics::Arm;
-use conduit::conform::tcp::{self, PoseSource, TcpError};
 use conduit::geom::{Point3, Vector3};
+use conduit::robot::frames::{self, Measured, OutlierRule, PairKind};
+use conduit::robot::kinematics::Arm;
+use conduit::robot::tcp::{self, PoseSource, TcpError};
 use conduit_poses::{Pose, write_poses};
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion};
 use serde_json::Value;

@@ -9,11 +9,11 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
-use conduit::conform::compensate::frame;
-use conduit::conform::compensate::simulate::{self, ErrorModel};
-use conduit::conform::compensate::substrate::{Analytic, Substrate, Waviness};
-use conduit::conform::compensate::{Params, Path as PosePath};
-use conduit::conform::pattern::{self, PatternParams, Shape};
+use conduit::robot::compensate::frame;
+use conduit::robot::compensate::simulate::{self, ErrorModel};
+use conduit::robot::compensate::substrate::{Analytic, Substrate, Waviness};
+use conduit::robot::compensate::{Params, Path as PosePath};
+use conduit::robot::pattern::{self, PatternParams, Shape};
 use conduit_poses::{Pose, read_poses};
 use serde_json::Value;
 

@@ -529,7 +529,7 @@ fn a_millimetre_circle_on_a_sphere_keeps_the_tool_on_the_normal() {
                 "normal",
                 "--max-tilt",
                 "90",
-                "--output",
+                "--dialect",
                 "poses-csv",
             ],
         );
@@ -593,7 +593,7 @@ fn max_tilt_is_respected_and_a_fixed_axis_is_kept_everywhere() {
             "normal",
             "--max-tilt",
             "20",
-            "--output",
+            "--dialect",
             "poses-csv",
         ],
     );
@@ -629,7 +629,7 @@ fn max_tilt_is_respected_and_a_fixed_axis_is_kept_everywhere() {
             "fixed:0,1,2",
             "--max-tilt",
             "30",
-            "--output",
+            "--dialect",
             "krl",
         ],
     );
@@ -662,7 +662,7 @@ fn vertical_is_todays_three_axis_output() {
             "2,1",
             "--tool-axis",
             "vertical",
-            "--output",
+            "--dialect",
             "gcode",
         ],
     );
@@ -725,10 +725,10 @@ fn bad_input_fails_with_a_clear_message_and_writes_nothing() {
         assert!(!out.exists(), "{args:?} wrote {}", out.display());
         (o.status.code(), stderr(&o))
     };
-    let (code, err) = run_fail(&good, &["--output", "fanuc"]);
+    let (code, err) = run_fail(&good, &["--dialect", "fanuc"]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("fanuc") && err.contains("urscript"), "{err}");
-    let (code, err) = run_fail(&good, &["--output", "krl", "--tool-axis", "fixed:0,0,0"]);
+    let (code, err) = run_fail(&good, &["--dialect", "krl", "--tool-axis", "fixed:0,0,0"]);
     assert_eq!(code, Some(2), "{err}");
     assert!(
         err.contains("fixed:0,0,0") && err.contains("non-zero"),
@@ -740,7 +740,7 @@ fn bad_input_fails_with_a_clear_message_and_writes_nothing() {
     let (code, err) = run_fail(
         &good,
         &[
-            "--output",
+            "--dialect",
             "rapid",
             "--tool-axis",
             "normal",
@@ -753,7 +753,7 @@ fn bad_input_fails_with_a_clear_message_and_writes_nothing() {
     let (code, err) = run_fail(
         &good,
         &[
-            "--output",
+            "--dialect",
             "krl",
             "--tool-axis",
             "fixed:1,0,1",
@@ -765,16 +765,48 @@ fn bad_input_fails_with_a_clear_message_and_writes_nothing() {
     assert!(err.contains("45.0°"), "{err}");
     // Frames: a short one, a non-finite one.
     let short = config(dir.path(), "[robot]\nworkpiece_frame = [1, 2, 3]\n");
-    let (code, err) = run_fail(&short, &["--output", "urscript"]);
+    let (code, err) = run_fail(&short, &["--dialect", "urscript"]);
     assert_eq!(code, Some(1), "{err}");
     assert!(
         err.contains("robot.toml:5") && err.contains("length 6"),
         "{err}"
     );
     let nan = config(dir.path(), "[robot]\ntool_frame = [0, 0, 100, 0, nan, 0]\n");
-    let (code, err) = run_fail(&nan, &["--output", "urscript"]);
+    let (code, err) = run_fail(&nan, &["--dialect", "urscript"]);
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("robot.tool_frame[4]"), "{err}");
+}
+
+#[test]
+fn the_old_output_spelling_of_the_dialect_still_works_and_warns() {
+    let dir = temp_dir();
+    let stl = dir.path().join("sphere.stl");
+    write_stl(&stl, &sphere(R, 20));
+    let svg = circle_svg(dir.path(), 3.0);
+    let cfg = config(dir.path(), "");
+    let (new, old) = (dir.path().join("new.script"), dir.path().join("old.script"));
+    let o = conform_command(&stl, &svg, &cfg, &new, &["--dialect", "urscript"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    let o = conform_command(&stl, &svg, &cfg, &old, &["--output", "urscript"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("`--output urscript` is now spelled `--dialect urscript`"),
+        "{}",
+        stderr(&o)
+    );
+    let program = std::fs::read(&new).expect("program");
+    assert!(program.starts_with(b"def "), "not URScript");
+    assert_eq!(program, std::fs::read(&old).expect("program"));
+    // Both spellings at once are a usage error.
+    let o = conform_command(
+        &stl,
+        &svg,
+        &cfg,
+        &old,
+        &["--output", "krl", "--dialect", "urscript"],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
 #[test]

@@ -3,6 +3,7 @@
 //! Tests that need the shared corpus (`../shared/corpus` beside the checkout) print
 //! `skipped: corpus not found` and pass when it is absent.
 
+mod architecture;
 mod calibrate;
 mod clfff;
 mod cli;

@@ -15,6 +15,7 @@
 mod placed;
 mod placement;
 mod rubberband;
+pub mod stage;
 mod three_de;
 
 use std::collections::BTreeMap;
@@ -26,6 +27,7 @@ pub use placement::{
     PlacingMethod, Problem, Waypoint,
 };
 pub use rubberband::{Rubberband, Rubberbands, rubberbands};
+pub use stage::{Electronics, ElectronicsError, ElectronicsReport};
 
 /// The copper shape of a pad, in the pad's own frame (before the pad rotation).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -4,6 +4,16 @@ use clap::{Args, Parser, Subcommand};
 use conduit::scene::MeshFormat;
 use std::path::PathBuf;
 
+/// What `conduit conform --dialect` writes.
+const DIALECTS: [&str; 6] = [
+    "gcode",
+    "urscript",
+    "krl",
+    "rapid",
+    "poses-csv",
+    "gcode-5axis",
+];
+
 /// conduit: slicer plugin and file-format converter for printed electronics and non-planar printing.
 #[derive(Debug, Parser)]
 #[command(name = "conduit", version, about, long_about = None, propagate_version = true)]
@@ -196,7 +206,7 @@ pub struct ConformArgs {
     /// Settings (`[conform]`, `[robot]`, tools, printer).
     #[command(flatten)]
     pub config: ConfigSource,
-    /// The file to write: G-code, or the program of `--output`.
+    /// The file to write: G-code, or the program of `--dialect`.
     #[arg(short = 'o', long = "out", value_name = "OUT")]
     pub out: PathBuf,
     /// What to write: `gcode` (3-axis, the printer's flavour), `urscript`, `krl` (KUKA .src),
@@ -204,17 +214,26 @@ pub struct ConformArgs {
     /// (`robot.five_axis`: I J K tool vectors, or a head or table with rotary axes). The
     /// `[robot]` section sets frames, clearance, speeds and the dispense output.
     #[arg(
-        long = "output",
+        long,
         value_name = "DIALECT",
         default_value = "gcode",
-        value_parser = ["gcode", "urscript", "krl", "rapid", "poses-csv", "gcode-5axis"]
+        value_parser = DIALECTS
     )]
-    pub output: String,
+    pub dialect: String,
+    /// The older spelling of `--dialect`: still taken, with a warning.
+    #[arg(
+        long = "output",
+        value_name = "DIALECT",
+        hide = true,
+        conflicts_with = "dialect",
+        value_parser = DIALECTS
+    )]
+    pub output_dialect: Option<String>,
     /// Tool axis per point: `vertical` (3-axis planning with its corrections, the default),
     /// `normal` (along the surface normal, smoothed along the path over
     /// `robot.axis_smoothing`, tilt limited by `--max-tilt`; standoff along the axis) or
     /// `fixed:i,j,k` (that direction, from the tip up toward the tool). A tilted tool needs a
-    /// multi-axis `--output`.
+    /// multi-axis `--dialect`.
     #[arg(
         long,
         value_name = "normal|vertical|fixed:i,j,k",

@@ -1,13 +1,13 @@
 //! `conduit calibrate`: tool-centre-point (pivot) calibration (`tcp`, see
-//! [`conduit::conform::tcp`]) and the rigid transform between two frames (`register`, see
-//! [`conduit::conform::frames`]). Results and residuals go to stdout, `--report` writes
+//! [`conduit::robot::tcp`]) and the rigid transform between two frames (`register`, see
+//! [`conduit::robot::frames`]). Results and residuals go to stdout, `--report` writes
 //! them as JSON.
 
 use super::args::ConfigSource;
 use super::{Failure, config::resolve};
 use anyhow::{Context, anyhow};
-use conduit::conform::frames::{self, FrameFit, OutlierRule, PairKind};
-use conduit::conform::tcp::{self, Pivot, PoseSource};
+use conduit::robot::frames::{self, FrameFit, OutlierRule, PairKind};
+use conduit::robot::tcp::{self, Pivot, PoseSource};
 use conduit::scene::write_atomically;
 use serde::Serialize;
 use std::io::Write;

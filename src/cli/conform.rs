@@ -30,7 +30,14 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         None => {}
     }
     let params = ConformParams::from_settings(&cfg.conform).context("invalid configuration")?;
-    let dialect = Dialect::from_name(&args.output);
+    let dialect_name = match &args.output_dialect {
+        Some(name) => {
+            eprintln!("warning: `--output {name}` is now spelled `--dialect {name}`");
+            name.clone()
+        }
+        None => args.dialect.clone(),
+    };
+    let dialect = Dialect::from_name(&dialect_name);
     let axis = args
         .tool_axis
         .as_deref()
@@ -40,7 +47,7 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         .unwrap_or(ToolAxis::Vertical);
     if dialect.is_none() && axis != ToolAxis::Vertical {
         return Err(Failure::Usage(format!(
-            "--tool-axis {} tilts the tool, which 3-axis G-code cannot do: choose --output \
+            "--tool-axis {} tilts the tool, which 3-axis G-code cannot do: choose --dialect \
              urscript, krl, rapid, poses-csv or gcode-5axis",
             args.tool_axis.as_deref().unwrap_or_default()
         )));
@@ -162,7 +169,7 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
              axis {}: largest tilt {:.1}°, largest angle to the surface normal {:.1}°{}; {} \
              nozzle contact(s)",
             args.out.display(),
-            args.output,
+            dialect_name,
             report.paths,
             report.points,
             report.geometry.length_3d,

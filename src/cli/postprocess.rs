@@ -5,9 +5,9 @@
 
 use super::{Failure, args::ConfigSource, args::PostprocessArgs, config::resolve};
 use anyhow::Context;
+use conduit::circuit::Electronics;
 use conduit::circuit::{Circuit, Placement};
 use conduit::config::Config;
-use conduit::pipeline::Electronics;
 use conduit::postprocess::rewrite::SUMMARY_PREFIX;
 use conduit::postprocess::{
     Edit, HostPrint, HostSettings, LayerParams, PostprocessReport, detect_host, edit, edit_circuit,

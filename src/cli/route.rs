@@ -3,9 +3,10 @@
 
 use super::{Failure, args::RouteArgs, config::resolve};
 use anyhow::Context;
+use conduit::circuit::Electronics;
 use conduit::circuit::{Circuit, Placement};
 use conduit::emit::route_svg::{layer_svg, view_box};
-use conduit::pipeline::{Electronics, route_scene};
+use conduit::pipeline::route_scene;
 use conduit::scene::write_atomically;
 use std::io::Write;
 

@@ -2,9 +2,10 @@
 
 use super::{Failure, args::SliceArgs, config::resolve};
 use anyhow::Context;
+use conduit::circuit::Electronics;
+use conduit::circuit::stage::pnp_records;
 use conduit::circuit::{Circuit, Placement};
-use conduit::pipeline::electronics::pnp_records;
-use conduit::pipeline::{Electronics, Stage, slice_clfff, slice_scene_with};
+use conduit::pipeline::{Stage, slice_clfff, slice_scene_with};
 use conduit::scene::{LoadOptions, Scene, load_scene, write_atomically};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{IsTerminal, Write};
@@ -169,7 +170,7 @@ fn run_clfff(args: &SliceArgs, cfg: &conduit::config::Config) -> Result<(), Fail
 
 /// The routing summary line (after `lead`), the report's warnings and one line per wire that
 /// could not be routed, on stderr.
-pub(crate) fn print_routing(r: &conduit::pipeline::ElectronicsReport, lead: &str) {
+pub(crate) fn print_routing(r: &conduit::circuit::ElectronicsReport, lead: &str) {
     eprintln!(
         "{lead}{} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
         r.parts.len(),

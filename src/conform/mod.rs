@@ -22,24 +22,19 @@
 //! registers two frames from points or poses; [`compensate`] moves a robot path along its tool
 //! axis by measured (or simulated) gaps, and [`pattern`] draws calibration patterns on a surface.
 
-pub mod compensate;
 pub mod correct;
 pub mod deposit;
 pub mod design;
-pub mod frames;
 pub mod geodesic;
-pub mod kinematics;
 pub mod markers;
 pub mod nozzle;
 pub mod orient;
-pub mod pattern;
 pub mod project;
 pub mod register;
 pub mod replay;
 pub mod report;
 pub mod spline;
 pub mod surface;
-pub mod tcp;
 
 pub use design::Placement;
 pub use nozzle::Nozzle;

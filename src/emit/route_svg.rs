@@ -1,14 +1,31 @@
 //! One layer of the routing view (`conduit route`) as SVG: the material left after cavities and
 //! channels in grey, cavities outlined in orange, channels in light blue, traces in dark blue.
 //!
-//! Place in the pipeline: emit stage, drawing a [`crate::pipeline::RouteView`] layer; millimetre
+//! Place in the pipeline: emit stage, drawing one [`RouteViewLayer`] that the route walk assembles; millimetre
 //! user units, Y flipped so +Y is up, the same view box on every layer.
 
 use std::fmt::Write;
 
 use super::preview::svg::{escape, num};
-use crate::geom::{ExPolygon, Polygon, unscaled};
-use crate::pipeline::RouteViewLayer;
+use crate::geom::{ExPolygon, Point3, Polygon, unscaled};
+
+/// One layer as `conduit route` draws it, bed coordinates: what the electronics stage made of
+/// the layer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RouteViewLayer {
+    /// Top of the layer, mm.
+    pub z: f64,
+    /// The material left after cavities and channels, all objects.
+    pub islands: Vec<ExPolygon>,
+    /// Part cavities cut from this layer.
+    pub cavities: Vec<ExPolygon>,
+    /// Wire channels cut from this layer.
+    pub channels: Vec<ExPolygon>,
+    /// Conductive paths printed on this layer (traces and drops).
+    pub traces: Vec<Vec<Point3>>,
+    /// Pads seated on this layer's top: `PART.PAD` and the copper outline.
+    pub pads: Vec<(String, Polygon)>,
+}
 
 /// Margin around the drawing, mm.
 const MARGIN: f64 = 2.0;

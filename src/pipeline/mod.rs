@@ -5,13 +5,12 @@
 //! returns the G-code bytes with a [`SliceSummary`] for the report; [`slice_scene_with`] adds a
 //! circuit ([`electronics`]).
 
-pub mod electronics;
-
-pub use electronics::{Electronics, ElectronicsReport};
+pub use crate::circuit::stage::{self as electronics, Electronics, ElectronicsReport};
+pub use crate::emit::route_svg::RouteViewLayer;
 
 use crate::config::{Config, CurvedMode};
 use crate::emit::gcode::{GcodeStats, write_gcode};
-use crate::geom::{BoundingBox, ExPolygon, Point3, Transform, scaled};
+use crate::geom::{BoundingBox, ExPolygon, Transform, scaled};
 use crate::mesh::Mesh;
 use crate::program::{LayerExtras, ObjectLayers, Program, ProgramParams, build_program_with};
 use crate::region::{RegionError, make_regions_with_heights};
@@ -304,23 +303,6 @@ fn front(
     }
     out.sliced = sliced;
     Ok(out)
-}
-
-/// One layer of [`RouteView`], bed coordinates.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RouteViewLayer {
-    /// Top of the layer, mm.
-    pub z: f64,
-    /// The material left after cavities and channels, all objects.
-    pub islands: Vec<ExPolygon>,
-    /// Part cavities cut from this layer.
-    pub cavities: Vec<ExPolygon>,
-    /// Wire channels cut from this layer.
-    pub channels: Vec<ExPolygon>,
-    /// Conductive paths printed on this layer (traces and drops).
-    pub traces: Vec<Vec<Point3>>,
-    /// Pads seated on this layer's top: `PART.PAD` and the copper outline.
-    pub pads: Vec<(String, crate::geom::Polygon)>,
 }
 
 /// What `conduit route` shows: the layers with what the electronics stage made of them.

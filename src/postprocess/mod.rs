@@ -62,10 +62,9 @@ use std::path::{Path, PathBuf};
 
 use conduit_gcode::{Gcode, GcodeError};
 
+use crate::circuit::{Electronics, ElectronicsError};
 use crate::config::{Config, ConfigError};
 use crate::emit::gcode::EmitError;
-use crate::pipeline::Electronics;
-use crate::pipeline::electronics::ElectronicsError;
 
 /// Why a host file cannot be post-processed.
 #[derive(Debug, thiserror::Error)]

@@ -26,11 +26,11 @@
 //! perimeter to tell, and get every hole filled.
 
 use crate::circuit::PlacedPart;
+use crate::circuit::stage::{ObjectCuts, object_stage, place_circuit};
+use crate::circuit::{Electronics, ElectronicsReport};
 use crate::config::Config;
 use crate::geom::{BoundingBox, ExPolygon, FillRule, polygons_to_expolygons};
 use crate::geom::{difference, intersection, scaled, union};
-use crate::pipeline::electronics::{ObjectCuts, object_stage, place_circuit};
-use crate::pipeline::{Electronics, ElectronicsReport};
 use crate::program::{Event, LayerExtras, Role, Toolpath};
 use crate::region::cavity::Cavity;
 use crate::slice::LayerZ;

@@ -13,7 +13,7 @@ use super::layers::{EMode, HostLayer, LayerMethod, RetractionStyle, ZSource};
 use super::rewrite::RewriteStats;
 use super::settings::SettingSource;
 use super::{Host, HostPrint};
-use crate::pipeline::electronics::ElectronicsReport;
+use crate::circuit::ElectronicsReport;
 
 /// The report of one post-processing run.
 #[derive(Debug, Clone, PartialEq, Serialize)]

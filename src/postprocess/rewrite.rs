@@ -541,8 +541,8 @@ fn block(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::circuit::ElectronicsReport;
     use crate::geom::{BoundingBox, ExPolygon, Point2, Polygon};
-    use crate::pipeline::ElectronicsReport;
     use crate::postprocess::plan::LayerPlan;
 
     fn square(x0: f64, x1: f64) -> ExPolygon {

@@ -25,9 +25,9 @@ use super::plan::plan_circuit;
 use super::rewrite::{END_MARK, PARTS_MARK, SUMMARY_PREFIX, TRACES_MARK};
 use super::{HostPrint, HostSettings, LayerParams, PostprocessError, detect_host};
 use crate::check::{CheckParams, Replay, check};
+use crate::circuit::Electronics;
 use crate::config::Config;
 use crate::geom::{Join, offset};
-use crate::pipeline::Electronics;
 
 /// How closely [`verify`] looks.
 #[derive(Debug, Clone, Copy, PartialEq)]

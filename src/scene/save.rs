@@ -7,14 +7,15 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 /// Mesh formats conduit writes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum MeshFormat {
     /// Binary STL (all objects merged; STL has no objects).
     Stl,
     /// ASCII STL.
     StlAscii,
     /// 3MF with one object and build item per scene object.
-    #[value(name = "3mf")]
+    #[cfg_attr(feature = "cli", value(name = "3mf"))]
     ThreeMf,
     /// Wavefront OBJ with one `o` group per object.
     Obj,

@@ -2,13 +2,13 @@
 //! a (wavy) plane, or a scanned mesh, with one query — where a ray first meets the surface.
 //!
 //! Place in the pipeline: the simulation mode of the gap compensation ([`super::simulate`])
-//! measures gaps along the tool axis with it, and the patterns ([`crate::conform::pattern`])
+//! measures gaps along the tool axis with it, and the patterns ([`crate::robot::pattern`])
 //! drop planar points onto it. Analytic surfaces live in their own frame: a sphere `sphere:R`
 //! centred at the origin (its top at z = R), a cylinder `cylinder:R` with its axis along y
 //! through the origin (its top line at z = R), a plane `plane` at z = 0, optionally wavy
 //! (`plane:waviness:A,P`: z = A·sin(2πx/P)). Their normals point out of the solid.
 
-use super::super::surface::Surface;
+use crate::conform::Surface;
 use crate::geom::{Point3, Vector3};
 use std::f64::consts::PI;
 use std::path::PathBuf;

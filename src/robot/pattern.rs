@@ -59,7 +59,8 @@ pub enum PatternError {
 const MAX_POINTS: usize = 2_000_000;
 
 /// A pattern shape.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Shape {
     /// A closed circle.
     Circle,

@@ -2,7 +2,7 @@
 //! from a tool axis.
 //!
 //! Place in the pipeline: shared by the gap compensation ([`super`]) and the calibration
-//! patterns ([`crate::conform::pattern`]). Convention: the tool frame's z axis points out of
+//! patterns ([`crate::robot::pattern`]). Convention: the tool frame's z axis points out of
 //! the tool into the work (the opposite of `Toolpath::tool_axis`); its x axis is the base +X
 //! projected onto the plane across z, or +Y where +X is (nearly) along z.
 
