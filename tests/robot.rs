@@ -699,7 +699,8 @@ fn vertical_is_todays_three_axis_output() {
         &cfg.conform,
         s.max().z + cfg.conform.travel_clearance,
     );
-    let machine = conduit::conform::machine_config(&cfg, &s, lowest).expect("machine");
+    let machine = conduit::conform::machine_params(cfg.gcode_params(), &cfg.conform, &s, lowest)
+        .expect("machine");
     let mut want = Vec::new();
     conduit::emit::gcode::write_gcode(&program, &machine, &mut want).expect("G-code");
     assert_eq!(bytes, want);

@@ -315,8 +315,15 @@ fn write_program(job: &Job, poses: &[Pose]) -> Result<(), Failure> {
         &job.cfg.conform,
         top + job.cfg.conform.travel_clearance,
     );
-    let cfg = conduit::conform::pressure_config(&job.cfg).context("[conform]")?;
-    super::robot_out::write_robot_file(out, dialect, &program, &cfg)?;
+    let writer = conduit::conform::pressure_params(job.cfg.gcode_params(), &job.cfg.conform)
+        .context("[conform]")?;
+    super::robot_out::write_robot_file(
+        out,
+        dialect,
+        &program,
+        &job.cfg.robot,
+        (&writer, job.cfg.conform.tool),
+    )?;
     Ok(())
 }
 

@@ -11,6 +11,7 @@ use conduit::conform::orient::{self, OrientParams, OrientationReport, ToolAxis};
 use conduit::conform::register::least_squares;
 use conduit::conform::surface::CloudInfo;
 use conduit::conform::{self, ConformParams, ConformReport, Placement, Registration, Surface};
+use conduit::emit::gcode::GcodeParams;
 use conduit::emit::robot::Dialect;
 use conduit::geom::{Point3, Vector3};
 use conduit::mesh::Mesh;
@@ -132,7 +133,8 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         .map(|p| p.z)
         .fold(f64::MAX, f64::min);
     let safe_z = hi.z + cfg.conform.travel_clearance;
-    let machine_cfg = conform::machine_config(&cfg, &surface, lowest).context("[conform]")?;
+    let writer = conform::machine_params(cfg.gcode_params(), &cfg.conform, &surface, lowest)
+        .context("[conform]")?;
     let moves = match dialect {
         None => {
             // 3-axis G-code, replayed against the surface.
@@ -149,7 +151,7 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
             dialect,
             (&planned.paths, &planned.axes),
             &cfg,
-            &machine_cfg,
+            &writer,
             safe_z,
         )?),
     };
@@ -218,11 +220,17 @@ fn write_program(
     dialect: Dialect,
     (paths, axes): (&[Vec<Point3>], &[Vec<Vector3>]),
     cfg: &Config,
-    machine_cfg: &Config,
+    writer: &GcodeParams,
     safe_z: f64,
 ) -> anyhow::Result<usize> {
     let program = orient::program(paths, axes, &cfg.conform, safe_z);
-    super::robot_out::write_robot_file(&args.out, dialect, &program, machine_cfg)
+    super::robot_out::write_robot_file(
+        &args.out,
+        dialect,
+        &program,
+        &cfg.robot,
+        (writer, cfg.conform.tool),
+    )
 }
 
 /// The conform report with the orientation section.

@@ -1,27 +1,35 @@
 //! Writing conform paths with tool axes as a robot or five-axis program file: shared by
-//! `conduit conform --output DIALECT` and `conduit compensate --program`.
+//! `conduit conform --dialect DIALECT` and `conduit compensate --program`.
 
 use anyhow::Context;
-use conduit::config::Config;
+use conduit::config::{ConfigError, RobotSettings};
+use conduit::emit::gcode::{GcodeParams, UnknownPlaceholder};
 use conduit::emit::robot::{Dialect, RobotJob, write_robot};
 use conduit::program::Program;
 use conduit::scene::write_atomically;
 use std::io::Write;
 use std::path::Path;
 
-/// Writes `program` in `dialect` to `out` (all or nothing); returns the moves written. `cfg`
-/// holds the dispensing tool's paste snippets (used by `gcode-5axis`), already adjusted by
-/// `conduit::conform::pressure_config`.
+/// Writes `program` in `dialect` to `out` (all or nothing); returns the moves written.
+/// `writer` holds the dispensing tool `tool`'s paste snippets (used by `gcode-5axis`), already
+/// adjusted by `conduit::conform::pressure_params`.
 pub(crate) fn write_robot_file(
     out: &Path,
     dialect: Dialect,
     program: &Program,
-    cfg: &Config,
+    robot: &RobotSettings,
+    (writer, tool): (&GcodeParams, usize),
 ) -> anyhow::Result<usize> {
-    let tool = cfg.conform.tool;
     let snippet = |key: &str, pick: fn(&conduit::config::Tool) -> &String| {
-        let text = cfg.tools.get(tool).map(pick).cloned().unwrap_or_default();
-        cfg.render_template(&text, tool, &[])
+        let text = writer
+            .tools
+            .get(tool)
+            .map(pick)
+            .cloned()
+            .unwrap_or_default();
+        writer
+            .render_template(&text, tool, &[])
+            .map_err(|UnknownPlaceholder(placeholder)| ConfigError::Template { placeholder })
             .with_context(|| format!("tools.{tool}.{key}"))
     };
     let on = snippet("paste_on_gcode", |t| &t.paste_on_gcode)?;
@@ -31,7 +39,7 @@ pub(crate) fn write_robot_file(
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let job = RobotJob {
-        settings: &cfg.robot,
+        settings: robot,
         name: &name,
         dispense_on_gcode: &on,
         dispense_off_gcode: &off,

@@ -1,5 +1,6 @@
-//! The electronics sections of the configuration: `[route]` (cavities, channels and trace
-//! routing) and `[pnp]` (what the machine does to place a part).
+//! The electronics section of the configuration: `[route]` (cavities, channels and trace
+//! routing); `[pnp]` (what the machine does to place a part) is
+//! [`crate::program::machine::PnpSettings`].
 //!
 //! Place in the pipeline: read with the rest of [`super::Config`]; the pipeline hands `[route]`
 //! to the cavity and routing stages and `[pnp]` to the G-code writer's part events.
@@ -127,36 +128,5 @@ impl RouteSettings {
             out.push(format!("route.perimeter_weights must all be > 0, got {w}"));
         }
         out
-    }
-}
-
-/// What the machine does to place a part (`[pnp]`).
-///
-/// Before either snippet the writer retracts and lifts the nozzle `lift` mm above the layer
-/// about to be printed; after it, it re-selects the active tool and comes back down only once it
-/// is over the next path.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct PnpSettings {
-    /// G-code for a part placed by the vacuum tool (`method = "auto"`). Placeholders: `{id}`
-    /// (1-based part number in placement order), `{part}`, `{x}`, `{y}`, `{z}` (seating plane),
-    /// `{rotation}`. Default `M361 P{id}`, the command OctoPNP answers.
-    pub auto_gcode: String,
-    /// G-code after the `M117 Insert <part>` message of a part inserted by hand
-    /// (`method = "manual"`). Placeholders as in `auto_gcode`, plus `{pause}`: the firmware's
-    /// pause with the message (`M0` on Marlin, `M291` on RepRapFirmware, `PAUSE` on Klipper).
-    /// Default `{pause}`.
-    pub manual_gcode: String,
-    /// How far the nozzle lifts above the layer before a part is placed, mm. Default 10.
-    pub lift: f64,
-}
-
-impl Default for PnpSettings {
-    fn default() -> Self {
-        Self {
-            auto_gcode: "M361 P{id}".to_owned(),
-            manual_gcode: "{pause}".to_owned(),
-            lift: 10.0,
-        }
     }
 }

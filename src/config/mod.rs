@@ -48,13 +48,12 @@ mod electronics;
 mod jet;
 pub mod prusa_ini;
 mod robot;
-mod template;
 
 pub use compensate::CompensateSettings;
 pub use conform::{ConformSettings, Corrections, Mapping};
 pub use curved::{CurvedMode, CurvedSettings};
 pub use defaults::defaults_toml;
-pub use electronics::{PnpSettings, RouteSettings};
+pub use electronics::RouteSettings;
 pub use jet::{JetFill, JetSettings};
 pub use prusa_ini::from_prusa_pairs;
 pub use robot::{FiveAxis, RobotSettings, RotaryAxes};
@@ -66,6 +65,10 @@ use std::path::{Path, PathBuf};
 use serde::de::{self, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
+use crate::emit::gcode::{GcodeParams, UnknownPlaceholder};
+pub use crate::program::machine::{
+    DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, PnpSettings, Printer, Tool, ToolKind,
+};
 use crate::region::RegionParams;
 
 /// Everything a conduit run is configured with. See the [module docs](self) for the file format.
@@ -93,143 +96,6 @@ pub struct Config {
     pub robot: RobotSettings,
     /// Gap compensation of robot paths (`[compensate]`).
     pub compensate: CompensateSettings,
-}
-
-/// G-code dialect of the printer's firmware.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Flavor {
-    /// Marlin 1.x / 2.x (also Prusa firmware).
-    #[default]
-    Marlin,
-    /// RepRapFirmware (Duet).
-    #[serde(rename = "reprapfirmware")]
-    RepRapFirmware,
-    /// Klipper.
-    Klipper,
-}
-
-/// The printer (`[printer]`): bed, firmware, custom G-code, retraction, travel and fan.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Printer {
-    /// G-code dialect: `"marlin"`, `"reprapfirmware"` or `"klipper"`. Default `"marlin"`.
-    pub flavor: Flavor,
-    /// Printable bed size [X, Y], mm. Default [250, 250].
-    pub bed_size: [f64; 2],
-    /// Coordinates of the bed's front-left corner [X, Y], mm: [0, 0] when the origin is at that
-    /// corner, [-125, -125] for a 250 mm bed with the origin in its centre. Default [0, 0].
-    pub bed_origin: [f64; 2],
-    /// Highest printable Z, mm. Default 250.
-    pub max_height: f64,
-    /// Bed temperature after the first layer, °C (0 = bed heater off). Default 60.
-    pub bed_temperature: f64,
-    /// Bed temperature for the first layer, °C. Default 60.
-    pub first_layer_bed_temperature: f64,
-    /// G-code template written before the print: heats, homes and primes. `{placeholders}` are
-    /// filled from this config (see [`Config::render_template`]).
-    pub start_gcode: String,
-    /// G-code template written after the print: heaters and fan off, lift, home X/Y, motors off.
-    pub end_gcode: String,
-    /// G-code template written before every tool change (`{previous_tool}` and `{next_tool}`
-    /// are available); when it has a `T{next_tool}` line, that line selects the tool and no
-    /// other `T` is written. PrusaSlicer's `toolchange_gcode` imports here. Default empty.
-    pub before_tool_change_gcode: String,
-    /// G-code template written after every tool change (`{previous_tool}` and `{next_tool}` are
-    /// available). Default empty.
-    pub after_tool_change_gcode: String,
-    /// Filament pulled back before travels, mm (a tool's own `retract_length` overrides it).
-    /// Default 0.8.
-    pub retract_length: f64,
-    /// Speed of the retraction, mm/s of filament. Default 35.
-    pub retract_speed: f64,
-    /// Speed of the un-retraction, mm/s of filament; 0 = the same as `retract_speed`. Default 0.
-    pub deretract_speed: f64,
-    /// Travels shorter than this do not retract, mm. Default 2.
-    pub retract_before_travel: f64,
-    /// Z lift (z-hop) during retracted travels, mm; 0 = none. Default 0.
-    pub retract_lift: f64,
-    /// Speed of non-printing moves, mm/s. Default 130.
-    pub travel_speed: f64,
-    /// Acceleration of the machine, mm/s², used by time estimates. Default 1000.
-    pub max_acceleration: f64,
-    /// Highest speed of any printing move, mm/s; faster role speeds are clamped to it.
-    /// Default 200.
-    pub max_print_speed: f64,
-    /// Write E as relative distances (`M83`) instead of absolute positions (`M82`).
-    /// Default false.
-    pub use_relative_e_distances: bool,
-    /// Lowest part-cooling fan speed when the fan is on, percent. Default 35.
-    pub fan_min_speed: f64,
-    /// Highest part-cooling fan speed, percent. Default 100.
-    pub fan_max_speed: f64,
-    /// Number of bottom layers printed with the fan off. Default 1.
-    pub disable_fan_first_layers: usize,
-    /// Retract with the firmware's `G10`/`G11` instead of E moves. Default false.
-    pub use_firmware_retraction: bool,
-}
-
-/// What a tool deposits and therefore how it is driven.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ToolKind {
-    /// A filament extruder: flow is E distance, computed from the cross-section of the
-    /// extrusion and the filament diameter.
-    #[default]
-    Filament,
-    /// A paste dispenser (pneumatic or screw): switched on and off by G-code snippets, flow is
-    /// time-based (`paste_flow_mm3_s`).
-    Paste,
-}
-
-/// One tool (`[tools.N]`). Keys left out take the default of the tool's `kind`:
-/// [`Tool::filament`] or [`Tool::paste`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Tool {
-    /// Name shown in comments and reports. Default `"PLA"` (filament) / `"conductive paste"`.
-    pub name: String,
-    /// `"filament"` or `"paste"`. Default `"filament"`.
-    pub kind: ToolKind,
-    /// Nozzle (or needle) inner diameter, mm. Default 0.4.
-    pub nozzle_diameter: f64,
-    /// Filament diameter, mm (filament tools). Default 1.75.
-    pub filament_diameter: f64,
-    /// Density of the material, g/cm³, for the weight estimate. Default 1.24 (PLA) / 3.0
-    /// (silver-filled paste).
-    pub filament_density: f64,
-    /// Nozzle temperature after the first layer, °C; 0 = not heated. Default 210 (filament) /
-    /// 0 (paste).
-    pub temperature: f64,
-    /// Nozzle temperature for the first layer, °C; 0 = not heated. Default 210 / 0.
-    pub first_layer_temperature: f64,
-    /// Temperature while the tool is parked during another tool's work, °C; absent = keep
-    /// `temperature`. Default absent.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub standby_temperature: Option<f64>,
-    /// Offset of this tool's nozzle from tool 0's [X, Y], mm, when the firmware does not apply
-    /// it. Default [0, 0].
-    pub offset: [f64; 2],
-    /// Factor on the computed flow. Default 1.0.
-    pub extrusion_multiplier: f64,
-    /// G-code that starts the paste flow (pressure valve or screw on), paste tools. Default
-    /// `M42 P6 S255` (drive output pin 6 high: wire the dispenser's trigger to a free output
-    /// and set its pin here).
-    pub paste_on_gcode: String,
-    /// G-code that stops the paste flow, paste tools. Default `M42 P6 S0`.
-    pub paste_off_gcode: String,
-    /// Volume dispensed per second while the paste flow is on, mm³/s (paste tools; filament
-    /// tools 0). Default 0.5.
-    pub paste_flow_mm3_s: f64,
-    /// This tool's retraction length, mm, overriding `printer.retract_length`; absent = use the
-    /// printer's. Default absent.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub retract_length: Option<f64>,
-    /// Z lift during this tool's travels longer than `printer.retract_before_travel`, mm,
-    /// overriding `printer.retract_lift`; absent = use the printer's. The paste tool's default
-    /// is 0.5: a dispensing nozzle dragged from one trace to the next at the layer's top would
-    /// smear the paste it just laid. Filament default absent.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub travel_lift: Option<f64>,
 }
 
 /// Pattern of solid (top and bottom) infill.
@@ -291,126 +157,6 @@ pub struct SliceSettings {
     /// Tool of each scene object: object `i` prints with tool `object_tools[i]`; objects past the
     /// end of the list use tool 0. Default [] (everything with tool 0).
     pub object_tools: Vec<usize>,
-}
-
-impl Default for Printer {
-    fn default() -> Self {
-        Self {
-            flavor: Flavor::Marlin,
-            bed_size: [250.0, 250.0],
-            bed_origin: [0.0, 0.0],
-            max_height: 250.0,
-            bed_temperature: 60.0,
-            first_layer_bed_temperature: 60.0,
-            start_gcode: DEFAULT_START_GCODE.to_owned(),
-            end_gcode: DEFAULT_END_GCODE.to_owned(),
-            before_tool_change_gcode: String::new(),
-            after_tool_change_gcode: String::new(),
-            retract_length: 0.8,
-            retract_speed: 35.0,
-            deretract_speed: 0.0,
-            retract_before_travel: 2.0,
-            retract_lift: 0.0,
-            travel_speed: 130.0,
-            max_acceleration: 1000.0,
-            max_print_speed: 200.0,
-            use_relative_e_distances: false,
-            fan_min_speed: 35.0,
-            fan_max_speed: 100.0,
-            disable_fan_first_layers: 1,
-            use_firmware_retraction: false,
-        }
-    }
-}
-
-/// Default `printer.start_gcode`: heat bed and tool 0, home, wait, prime a line along the front
-/// edge of the bed.
-pub const DEFAULT_START_GCODE: &str = "\
-M140 S{first_layer_bed_temperature} ; bed heating
-M104 T0 S{first_layer_temperature[0]} ; tool 0 heating
-G28 ; home all axes
-M190 S{first_layer_bed_temperature} ; wait for the bed
-M109 T0 S{first_layer_temperature[0]} ; wait for tool 0
-G92 E0
-G1 Z{first_layer_height} F720
-G1 X5 Y5 F6000
-G1 X60 Y5 E9 F1000 ; prime line
-G92 E0
-";
-
-/// Default `printer.end_gcode`: heaters and fan off, lift by 10 mm, home X/Y, motors off.
-pub const DEFAULT_END_GCODE: &str = "\
-M104 T0 S0 ; tool 0 heater off
-M140 S0 ; bed heater off
-M107 ; fan off
-G91
-G1 Z10 F600 ; lift
-G90
-G28 X Y
-M84 ; motors off
-";
-
-/// Z lift of the paste tool's travels by default, mm (see [`Tool::travel_lift`]).
-const PASTE_TRAVEL_LIFT_MM: f64 = 0.5;
-
-impl Tool {
-    /// The default filament tool: PLA, 1.75 mm, 0.4 mm nozzle, 210 °C.
-    pub fn filament() -> Self {
-        Self {
-            name: "PLA".to_owned(),
-            kind: ToolKind::Filament,
-            nozzle_diameter: 0.4,
-            filament_diameter: 1.75,
-            filament_density: 1.24,
-            temperature: 210.0,
-            first_layer_temperature: 210.0,
-            standby_temperature: None,
-            offset: [0.0, 0.0],
-            extrusion_multiplier: 1.0,
-            paste_on_gcode: String::new(),
-            paste_off_gcode: String::new(),
-            paste_flow_mm3_s: 0.0,
-            retract_length: None,
-            travel_lift: None,
-        }
-    }
-
-    /// The default paste tool: an unheated conductive-paste dispenser with a 0.4 mm needle,
-    /// switched by output pin 6 (`M42 P6 S255` / `M42 P6 S0`), 0.5 mm³/s.
-    pub fn paste() -> Self {
-        Self {
-            name: "conductive paste".to_owned(),
-            kind: ToolKind::Paste,
-            filament_density: 3.0,
-            temperature: 0.0,
-            first_layer_temperature: 0.0,
-            paste_on_gcode: "M42 P6 S255 ; paste on".to_owned(),
-            paste_off_gcode: "M42 P6 S0 ; paste off".to_owned(),
-            paste_flow_mm3_s: 0.5,
-            travel_lift: Some(PASTE_TRAVEL_LIFT_MM),
-            ..Self::filament()
-        }
-    }
-
-    /// The default tool of a kind: [`Tool::filament`] or [`Tool::paste`].
-    pub fn of_kind(kind: ToolKind) -> Self {
-        match kind {
-            ToolKind::Filament => Self::filament(),
-            ToolKind::Paste => Self::paste(),
-        }
-    }
-
-    /// Cross-section area of the filament, mm² (π·d²/4).
-    pub fn filament_area(&self) -> f64 {
-        std::f64::consts::PI * self.filament_diameter * self.filament_diameter / 4.0
-    }
-}
-
-impl Default for Tool {
-    /// [`Tool::filament`].
-    fn default() -> Self {
-        Self::filament()
-    }
 }
 
 impl Default for SliceSettings {
@@ -741,30 +487,40 @@ impl Config {
         self.slice.object_tools.get(object).copied().unwrap_or(0)
     }
 
-    /// The z lift of tool `tool`'s long travels, mm: its own `travel_lift` or the printer's
-    /// `retract_lift`.
-    pub fn travel_lift(&self, tool: usize) -> f64 {
-        self.tools
-            .get(tool)
-            .and_then(|t| t.travel_lift)
-            .unwrap_or(self.printer.retract_lift)
-    }
-
-    /// The retraction length of tool `tool`, mm: its own override or the printer's.
-    pub fn retract_length(&self, tool: usize) -> f64 {
-        self.tools
-            .get(tool)
-            .and_then(|t| t.retract_length)
-            .unwrap_or(self.printer.retract_length)
-    }
-
-    /// Un-retraction speed, mm/s: `deretract_speed`, or `retract_speed` when that is 0.
-    pub fn deretract_speed(&self) -> f64 {
-        if self.printer.deretract_speed > 0.0 {
-            self.printer.deretract_speed
-        } else {
-            self.printer.retract_speed
+    /// The G-code writer's parameters: the printer, the tools, the part-placement commands and,
+    /// for the custom G-code templates, the `[slice]` keys.
+    pub fn gcode_params(&self) -> GcodeParams {
+        let template_keys = match toml::Value::try_from(&self.slice) {
+            Ok(toml::Value::Table(t)) => t,
+            _ => toml::Table::new(),
+        };
+        GcodeParams {
+            printer: self.printer.clone(),
+            tools: self.tools.clone(),
+            pnp: self.pnp.clone(),
+            template_keys,
         }
+    }
+
+    /// Fills the `{placeholders}` of `template` for tool `tool` as the G-code writer does
+    /// ([`GcodeParams::render_template`]), with the caller's extra variables `vars` (such as
+    /// `previous_tool`, `next_tool`, `layer_z`) taking precedence over config keys.
+    ///
+    /// ```
+    /// let cfg = conduit::config::Config::default();
+    /// let g = cfg.render_template("M190 S{first_layer_bed_temperature}\nM109 S[temperature]", 0, &[])?;
+    /// assert_eq!(g, "M190 S60\nM109 S210");
+    /// # Ok::<(), conduit::config::ConfigError>(())
+    /// ```
+    pub fn render_template(
+        &self,
+        template: &str,
+        tool: usize,
+        vars: &[(&str, String)],
+    ) -> Result<String, ConfigError> {
+        self.gcode_params()
+            .render_template(template, tool, vars)
+            .map_err(|UnknownPlaceholder(placeholder)| ConfigError::Template { placeholder })
     }
 
     /// Applies one `KEY=VALUE` override, as given to `--set`: `KEY` is a dotted path into the
@@ -825,16 +581,6 @@ impl Config {
             .map_err(|e: toml::de::Error| set_err(e.message().trim().to_owned()))?;
         *self = new;
         Ok(())
-    }
-}
-
-impl fmt::Display for Flavor {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Flavor::Marlin => "marlin",
-            Flavor::RepRapFirmware => "reprapfirmware",
-            Flavor::Klipper => "klipper",
-        })
     }
 }
 

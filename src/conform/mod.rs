@@ -43,6 +43,7 @@ pub use report::ConformReport;
 pub use surface::Surface;
 
 use crate::config::{Config, ConformSettings, Corrections, Mapping};
+use crate::emit::gcode::GcodeParams;
 use crate::geom::Point3;
 use crate::program::{Layer, LayerItem, Program, Role, Toolpath};
 use deposit::Thresholds;
@@ -379,42 +380,42 @@ pub fn program(paths: &[Vec<Point3>], settings: &ConformSettings, safe_z: f64) -
     }
 }
 
-/// `cfg` with the pressure snippets of `[conform]` (when set) as the dispensing tool's paste
-/// snippets: what every conform program (G-code or robot) switches the dispenser with.
-pub fn pressure_config(cfg: &Config) -> Result<Config, ConformError> {
-    let c = &cfg.conform;
-    let mut out = cfg.clone();
-    let Some(tool) = out.tools.get_mut(c.tool) else {
+/// The G-code writer's `params` with the pressure snippets of `[conform]` (when set) as the
+/// dispensing tool's paste snippets: what every conform program (G-code or robot) switches the
+/// dispenser with.
+pub fn pressure_params(
+    mut params: GcodeParams,
+    settings: &ConformSettings,
+) -> Result<GcodeParams, ConformError> {
+    let tools = params.tools.len();
+    let Some(tool) = params.tools.get_mut(settings.tool) else {
         return Err(ConformError::Setting {
             key: "tool",
-            message: format!(
-                "tool {} is not defined ({} tool(s))",
-                c.tool,
-                cfg.tools.len()
-            ),
+            message: format!("tool {} is not defined ({tools} tool(s))", settings.tool),
         });
     };
-    if !c.pressure_on_gcode.is_empty() {
-        tool.paste_on_gcode = c.pressure_on_gcode.clone();
+    if !settings.pressure_on_gcode.is_empty() {
+        tool.paste_on_gcode = settings.pressure_on_gcode.clone();
     }
-    if !c.pressure_off_gcode.is_empty() {
-        tool.paste_off_gcode = c.pressure_off_gcode.clone();
+    if !settings.pressure_off_gcode.is_empty() {
+        tool.paste_off_gcode = settings.pressure_off_gcode.clone();
     }
-    Ok(out)
+    Ok(params)
 }
 
-/// `cfg` adjusted for writing a conform program over `surface`: the pressure snippets
-/// ([`pressure_config`]), and every travel lifted over the surface's top by
+/// The G-code writer's `params` for a conform program over `surface`: the pressure snippets
+/// ([`pressure_params`]), and every travel lifted over the surface's top by
 /// `travel_clearance` (a hop on every travel, however short).
-pub fn machine_config(
-    cfg: &Config,
+pub fn machine_params(
+    params: GcodeParams,
+    settings: &ConformSettings,
     surface: &Surface,
     lowest_tip: f64,
-) -> Result<Config, ConformError> {
-    let mut out = pressure_config(cfg)?;
-    let clearance = cfg.conform.travel_clearance;
-    if let Some(tool) = out.tools.get_mut(cfg.conform.tool) {
-        tool.travel_lift = Some((surface.max().z - lowest_tip).max(0.0) + clearance);
+) -> Result<GcodeParams, ConformError> {
+    let mut out = pressure_params(params, settings)?;
+    if let Some(tool) = out.tools.get_mut(settings.tool) {
+        tool.travel_lift =
+            Some((surface.max().z - lowest_tip).max(0.0) + settings.travel_clearance);
     }
     out.printer.retract_before_travel = 0.0;
     Ok(out)
@@ -432,9 +433,9 @@ pub fn write_and_replay(
     let lowest = paths.iter().flatten().map(|p| p.z).fold(f64::MAX, f64::min);
     let safe_z = surface.max().z + cfg.conform.travel_clearance;
     let program = program(paths, &cfg.conform, safe_z);
-    let machine_cfg = machine_config(cfg, surface, lowest)?;
+    let writer = machine_params(cfg.gcode_params(), &cfg.conform, surface, lowest)?;
     let mut gcode = Vec::new();
-    crate::emit::gcode::write_gcode(&program, &machine_cfg, &mut gcode)?;
+    crate::emit::gcode::write_gcode(&program, &writer, &mut gcode)?;
     let parsed = conduit_gcode::parse(&gcode)?;
     let contacts = replay::replay(
         &parsed,

@@ -441,7 +441,7 @@ pub fn slice_scene_with(
 
     progress(Stage::Emit);
     let mut gcode = Vec::new();
-    let stats = write_gcode(&program, cfg, &mut gcode)?;
+    let stats = write_gcode(&program, &cfg.gcode_params(), &mut gcode)?;
     laps.lap(Stage::Emit);
 
     let summary = SliceSummary {
@@ -611,11 +611,11 @@ pub fn slice_clfff(
     laps.lap(Stage::Program);
 
     progress(Stage::Emit);
-    let wcfg = clfff::sections::writer_config(cfg);
+    let writer = clfff::sections::writer_params(cfg.gcode_params());
     let mut files = Vec::with_capacity(programs.len());
     for (sections, program) in programs {
         let mut gcode = Vec::new();
-        let stats = write_gcode(&program, &wcfg, &mut gcode)?;
+        let stats = write_gcode(&program, &writer, &mut gcode)?;
         files.push(ClfffFile {
             sections,
             gcode,

@@ -475,7 +475,7 @@ fn block(
     };
     let tool = state.replay.tool();
     // The block retracts, heats and resumes the host's tool the way the host does.
-    let mut cfg = cfg.clone();
+    let mut cfg = cfg.gcode_params();
     match layer.retraction.or(fallback_style) {
         Some(RetractionStyle::Firmware) => cfg.printer.use_firmware_retraction = true,
         Some(RetractionStyle::Extruder { length, speed }) => {

@@ -13,6 +13,7 @@
 
 pub mod build;
 pub mod extrusion;
+pub mod machine;
 pub mod order;
 pub mod toolpath;
 

@@ -3,14 +3,14 @@
 //!
 //! Place in the pipeline: the last step of [`super::plan`] joins or keeps apart the sections'
 //! Program layers; the pipeline writes each resulting Program with
-//! [`writer_config`] and names split files with [`Section::file_name`]. Users change material
+//! [`writer_params`] and names split files with [`Section::file_name`]. Users change material
 //! between the sections, so `--split-sections` gives each its own file with its own start and
 //! end G-code.
 
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-use crate::config::Config;
+use crate::emit::gcode::GcodeParams;
 use crate::program::{Layer, Program};
 
 /// The smallest z-hop used on the long travels of a curved-layer print, mm.
@@ -96,22 +96,22 @@ pub fn programs(sections: &[SectionLayers], split: bool) -> Vec<(Vec<Section>, P
     }
 }
 
-/// The configuration the G-code writer gets for a curved-layer print: `cfg` with every
-/// travel lift at least [`MIN_TRAVEL_HOP_MM`].
-pub fn writer_config(cfg: &Config) -> Config {
-    let mut c = cfg.clone();
-    c.printer.retract_lift = c.printer.retract_lift.max(MIN_TRAVEL_HOP_MM);
-    for t in &mut c.tools {
+/// The G-code writer's parameters for a curved-layer print: `params` with every travel lift at
+/// least [`MIN_TRAVEL_HOP_MM`].
+pub fn writer_params(mut params: GcodeParams) -> GcodeParams {
+    params.printer.retract_lift = params.printer.retract_lift.max(MIN_TRAVEL_HOP_MM);
+    for t in &mut params.tools {
         if let Some(lift) = &mut t.travel_lift {
             *lift = lift.max(MIN_TRAVEL_HOP_MM);
         }
     }
-    c
+    params
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::program::machine::Tool;
 
     #[test]
     fn split_files_are_named_after_the_output() {
@@ -128,9 +128,12 @@ mod tests {
 
     #[test]
     fn every_travel_lifts_at_least_the_minimum() {
-        let mut cfg = Config::default();
-        cfg.tools[0].travel_lift = Some(0.0);
-        let w = writer_config(&cfg);
+        let mut params = GcodeParams {
+            tools: vec![Tool::filament(), Tool::paste()],
+            ..GcodeParams::default()
+        };
+        params.tools[0].travel_lift = Some(0.0);
+        let w = writer_params(params);
         assert_eq!(w.travel_lift(0), MIN_TRAVEL_HOP_MM);
         assert_eq!(w.travel_lift(1), w.travel_lift(1).max(MIN_TRAVEL_HOP_MM));
         assert!(w.printer.retract_lift >= MIN_TRAVEL_HOP_MM);

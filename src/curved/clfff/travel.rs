@@ -9,7 +9,7 @@
 //! The G-code writer starts every Program layer by retracting (when the way to the layer's
 //! first path is long) and moving z alone to the layer's z, then travels to the first path,
 //! hopping when the travel is long and coming down vertically after it (with the minimum hop
-//! of [`super::sections::writer_config`]), and un-retracts. So the curved paths are cut into
+//! of [`super::sections::writer_params`]), and un-retracts. So the curved paths are cut into
 //! groups wherever the travel from one path to the next is longer than
 //! `printer.retract_before_travel` (3D), and each group becomes a Program layer whose z is the
 //! group's safe travel height: the highest material under the straight xy line of the travel

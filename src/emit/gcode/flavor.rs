@@ -18,7 +18,7 @@
 
 use conduit_gcode::fmt_f;
 
-use crate::config::Flavor;
+use crate::program::machine::Flavor;
 
 /// Commands of one flavour.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -2,8 +2,8 @@
 //! replayed (positions, E, tool) to check what the machine would do.
 
 use super::*;
-use crate::config::{Flavor, Tool};
 use crate::geom::Point3;
+use crate::program::machine::{Flavor, Printer, Tool};
 use crate::program::{Event, Layer, LayerItem, Role, Toolpath, e_per_mm};
 
 /// One replayed G0/G1 move.
@@ -126,15 +126,29 @@ fn one_layer_program() -> Program {
     }
 }
 
-fn test_config() -> Config {
-    let mut cfg = Config::default();
+/// The default two-tool machine (a PLA extruder and a paste dispenser), with the `[slice]`
+/// keys the default start G-code names.
+fn default_params() -> GcodeParams {
+    let mut template_keys = toml::Table::new();
+    template_keys.insert("first_layer_height".to_owned(), toml::Value::Float(0.2));
+    template_keys.insert("layer_height".to_owned(), toml::Value::Float(0.2));
+    GcodeParams {
+        printer: Printer::default(),
+        tools: vec![Tool::filament(), Tool::paste()],
+        template_keys,
+        ..GcodeParams::default()
+    }
+}
+
+fn test_config() -> GcodeParams {
+    let mut cfg = default_params();
     cfg.printer.retract_length = 0.8;
     cfg.printer.retract_before_travel = 2.0;
     cfg.printer.retract_lift = 0.4;
     cfg
 }
 
-fn write(program: &Program, cfg: &Config) -> (String, GcodeStats) {
+fn write(program: &Program, cfg: &GcodeParams) -> (String, GcodeStats) {
     let mut out = Vec::new();
     match write_gcode(program, cfg, &mut out) {
         Ok(stats) => (String::from_utf8_lossy(&out).into_owned(), stats),
@@ -236,7 +250,7 @@ fn one_layer_square_header_markers_extrusion_retraction_and_zhop() {
 }
 
 /// Two filament tools; tool 0 has a standby temperature, tool 1 an offset.
-fn two_tool_config() -> Config {
+fn two_tool_config() -> GcodeParams {
     let mut cfg = test_config();
     cfg.tools = vec![
         Tool {
@@ -658,7 +672,10 @@ fn built_program_round_trips_through_the_writer() {
         layers: zs.into_iter().zip(regions).collect(),
     };
     let cfg = test_config();
-    let program = build_program(&[obj], &ProgramParams::from_config(&cfg));
+    let program = build_program(
+        &[obj],
+        &ProgramParams::from_config(&crate::config::Config::default()),
+    );
     let (text, stats) = write(&program, &cfg);
     assert_eq!(stats.layers, 10);
     assert_eq!(text.matches(";LAYER_CHANGE\n").count(), 10);

@@ -2,12 +2,13 @@
 
 use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
 
+use super::GcodeParams;
 use super::estimate::move_time;
 use super::flavor::{Dialect, fan, set_bed, wait_bed};
 use super::sink::{GcodeSink, Motion, MotionKind};
 use super::{EmitError, GcodeStats, Resume, ToolStats};
-use crate::config::{Config, ConfigError, ToolKind};
 use crate::geom::Point3;
+use crate::program::machine::{Flavor, ToolKind};
 use crate::program::{Event, Feed, Layer, LayerItem, Program, Toolpath};
 
 /// Layers printed faster than this (s) get the fan at `fan_max_speed` (PrusaSlicer's default
@@ -39,7 +40,7 @@ struct ToolState {
 
 /// Renders `template` for `tool`, naming the template in errors.
 fn render(
-    cfg: &Config,
+    cfg: &GcodeParams,
     name: &str,
     template: &str,
     tool: usize,
@@ -50,13 +51,9 @@ fn render(
     }
     match cfg.render_template(template, tool, vars) {
         Ok(text) => Ok(text.lines().map(str::to_owned).collect()),
-        Err(ConfigError::Template { placeholder }) => Err(EmitError::Template {
+        Err(super::UnknownPlaceholder(placeholder)) => Err(EmitError::Template {
             template: name.to_owned(),
             placeholder,
-        }),
-        Err(error) => Err(EmitError::Config {
-            template: name.to_owned(),
-            error: Box::new(error),
         }),
     }
 }
@@ -75,7 +72,7 @@ fn one_line(text: &str) -> String {
 }
 
 pub(super) struct Writer<'a, S: GcodeSink> {
-    cfg: &'a Config,
+    cfg: &'a GcodeParams,
     sink: &'a mut S,
     dialect: Dialect,
     relative_e: bool,
@@ -103,7 +100,7 @@ pub(super) struct Writer<'a, S: GcodeSink> {
 }
 
 impl<'a, S: GcodeSink> Writer<'a, S> {
-    pub fn new(cfg: &'a Config, sink: &'a mut S) -> Result<Self, EmitError> {
+    pub fn new(cfg: &'a GcodeParams, sink: &'a mut S) -> Result<Self, EmitError> {
         let mut tools = Vec::with_capacity(cfg.tools.len());
         for (i, t) in cfg.tools.iter().enumerate() {
             let (feed, paste_on, paste_off) = match t.kind {
@@ -543,7 +540,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         let used = used_tools(program);
         self.used = used.clone();
         let scan = scan_start_gcode(&start);
-        let rrf = cfg.printer.flavor == crate::config::Flavor::RepRapFirmware;
+        let rrf = cfg.printer.flavor == Flavor::RepRapFirmware;
         self.line("M107");
         self.fan = Some("M107".to_owned());
         if !scan.bed && cfg.printer.first_layer_bed_temperature > 0.0 {
@@ -646,7 +643,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             }
             // Marlin and Klipper: the active tool now; the others get their temperature from
             // the wait at their next tool change. RepRapFirmware: every tool's active value.
-            let tools = if cfg.printer.flavor == crate::config::Flavor::RepRapFirmware {
+            let tools = if cfg.printer.flavor == Flavor::RepRapFirmware {
                 self.used.clone()
             } else {
                 self.tool.into_iter().collect()

@@ -1,5 +1,5 @@
-//! Filling `{placeholders}` in the custom G-code templates of [`Printer`](super::Printer) and
-//! [`Tool`](super::Tool), in the style of PrusaSlicer's.
+//! Filling `{placeholders}` in the custom G-code templates of the printer and the tools, in
+//! the style of PrusaSlicer's.
 //!
 //! Syntax: `{key}` or `{key[N]}`. A key is looked up, in order, in the caller's variables, in
 //! `[printer]`, in `[slice]` and in the tools: `{temperature[1]}` is tool 1's temperature,
@@ -8,29 +8,38 @@
 //! brackets also appear in ordinary comments). Numbers are written as Rust's shortest
 //! round-trip form (`60`, `0.2`), booleans as `1` / `0`. PrusaSlicer's macro language (`{if}`,
 //! expressions) is not supported: such a placeholder is an unknown-placeholder error.
+//!
+//! Place in the pipeline: inside the G-code writer, which fills every template it writes; the
+//! `[slice]` keys come from [`GcodeParams::template_keys`].
 
-use super::{Config, ConfigError};
+use super::GcodeParams;
 
-impl Config {
+/// A `{placeholder}` that is neither a variable of the caller nor a key of the printer, the
+/// other settings or the tools (the placeholder without braces).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownPlaceholder(pub String);
+
+impl GcodeParams {
     /// Fills the placeholders of `template` (see the syntax above) for tool `tool`, with the
     /// caller's extra variables `vars` (such as `previous_tool`, `next_tool`, `layer_z`) taking
     /// precedence over config keys.
     ///
     /// ```
-    /// let cfg = conduit::config::Config::default();
-    /// let g = cfg.render_template("M190 S{first_layer_bed_temperature}\nM109 S[temperature]", 0, &[])?;
+    /// let params = conduit::config::Config::default().gcode_params();
+    /// let g = params
+    ///     .render_template("M190 S{first_layer_bed_temperature}\nM109 S[temperature]", 0, &[])
+    ///     .expect("known placeholders");
     /// assert_eq!(g, "M190 S60\nM109 S210");
-    /// # Ok::<(), conduit::config::ConfigError>(())
     /// ```
     pub fn render_template(
         &self,
         template: &str,
         tool: usize,
         vars: &[(&str, String)],
-    ) -> Result<String, ConfigError> {
-        let tree = toml::Value::try_from(self).ok();
+    ) -> Result<String, UnknownPlaceholder> {
+        let printer = toml::Value::try_from(&self.printer).ok();
         let lookup =
-            |name: &str| -> Option<String> { self.lookup(tree.as_ref()?, name, tool, vars) };
+            |name: &str| -> Option<String> { self.lookup(printer.as_ref()?, name, tool, vars) };
         let mut out = String::with_capacity(template.len());
         let mut rest = template;
         while let Some(pos) = rest.find(['{', '[']) {
@@ -51,9 +60,7 @@ impl Config {
                     match lookup(name.trim()) {
                         Some(v) => out.push_str(&v),
                         None if open == b'{' => {
-                            return Err(ConfigError::Template {
-                                placeholder: name.to_owned(),
-                            });
+                            return Err(UnknownPlaceholder(name.to_owned()));
                         }
                         None => {
                             out.push('[');
@@ -64,9 +71,9 @@ impl Config {
                     rest = &after[end + 1..];
                 }
                 None if open == b'{' => {
-                    return Err(ConfigError::Template {
-                        placeholder: after.lines().next().unwrap_or_default().to_owned(),
-                    });
+                    return Err(UnknownPlaceholder(
+                        after.lines().next().unwrap_or_default().to_owned(),
+                    ));
                 }
                 None => {
                     out.push('[');
@@ -78,9 +85,11 @@ impl Config {
         Ok(out)
     }
 
+    /// The value `name` stands for: a variable, a printer key (`printer` is the printer as a
+    /// TOML table), a further key, or a tool key (of tool `tool`, or of the indexed tool).
     fn lookup(
         &self,
-        tree: &toml::Value,
+        printer: &toml::Value,
         name: &str,
         tool: usize,
         vars: &[(&str, String)],
@@ -95,19 +104,19 @@ impl Config {
         if key.is_empty() || !key.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
             return None;
         }
-        for section in ["printer", "slice"] {
-            if let Some(v) = tree.get(section).and_then(|s| s.get(key)) {
-                return match (v, index) {
-                    (toml::Value::Array(a), Some(i)) => a.get(i).and_then(scalar),
-                    (v, None) => scalar(v),
-                    _ => None,
-                };
-            }
+        for v in [printer.get(key), self.template_keys.get(key)]
+            .into_iter()
+            .flatten()
+        {
+            return match (v, index) {
+                (toml::Value::Array(a), Some(i)) => a.get(i).and_then(scalar),
+                (v, None) => scalar(v),
+                _ => None,
+            };
         }
-        let tools = tree.get("tools")?;
         let t = index.unwrap_or(tool);
-        let v = tools.get(t.to_string())?.get(key)?;
-        scalar(v)
+        let tool = toml::Value::try_from(self.tools.get(t)?).ok()?;
+        scalar(tool.get(key)?)
     }
 }
 
@@ -125,9 +134,24 @@ fn scalar(v: &toml::Value) -> Option<String> {
 mod tests {
     use super::*;
 
+    use crate::program::machine::{Printer, Tool};
+
+    /// The default two-tool machine with the `[slice]` key `layer_height` = 0.2.
+    fn params() -> GcodeParams {
+        let mut template_keys = toml::Table::new();
+        template_keys.insert("layer_height".to_owned(), toml::Value::Float(0.2));
+        template_keys.insert("first_layer_height".to_owned(), toml::Value::Float(0.2));
+        GcodeParams {
+            printer: Printer::default(),
+            tools: vec![Tool::filament(), Tool::paste()],
+            template_keys,
+            ..GcodeParams::default()
+        }
+    }
+
     #[test]
-    fn placeholders_are_filled_from_every_section() -> Result<(), ConfigError> {
-        let cfg = Config::default();
+    fn placeholders_are_filled_from_every_section() -> Result<(), UnknownPlaceholder> {
+        let cfg = params();
         let t = "M140 S{first_layer_bed_temperature}\nM104 T1 S{first_layer_temperature[1]}\n\
                  ; {name} {layer_height} [temperature] {bed_size[0]} {next_tool} [unknown] a[0]";
         let out = cfg.render_template(t, 0, &[("next_tool", "1".to_owned())])?;
@@ -135,17 +159,17 @@ mod tests {
             out,
             "M140 S60\nM104 T1 S0\n; PLA 0.2 210 250 1 [unknown] a[0]"
         );
-        assert!(matches!(
+        assert_eq!(
             cfg.render_template("{if x}", 0, &[]),
-            Err(ConfigError::Template { placeholder }) if placeholder == "if x"
-        ));
+            Err(UnknownPlaceholder("if x".to_owned()))
+        );
         assert!(cfg.render_template("{temperature[7]}", 0, &[]).is_err());
         Ok(())
     }
 
     #[test]
-    fn default_start_and_end_gcode_render() -> Result<(), ConfigError> {
-        let cfg = Config::default();
+    fn default_start_and_end_gcode_render() -> Result<(), UnknownPlaceholder> {
+        let cfg = params();
         let start = cfg.render_template(&cfg.printer.start_gcode, 0, &[])?;
         assert!(start.contains("M109 T0 S210"), "{start}");
         assert!(start.contains("M190 S60"), "{start}");

@@ -1,0 +1,310 @@
+//! The machine a program runs on: the printer (bed, firmware flavour, custom G-code,
+//! retraction, travel, fan), its tools (filament extruders and paste dispensers) and the
+//! commands that place parts.
+//!
+//! Place in the pipeline: vocabulary beside the [`Program`](super::Program). The config's
+//! `[printer]`, `[tools.N]` and `[pnp]` sections are these types; the G-code writer
+//! (`emit::gcode`), the replay (`check`) and the walks read them from here, so no stage needs
+//! the whole configuration to know what machine it drives.
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+/// G-code dialect of the printer's firmware.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Flavor {
+    /// Marlin 1.x / 2.x (also Prusa firmware).
+    #[default]
+    Marlin,
+    /// RepRapFirmware (Duet).
+    #[serde(rename = "reprapfirmware")]
+    RepRapFirmware,
+    /// Klipper.
+    Klipper,
+}
+
+/// The printer (`[printer]`): bed, firmware, custom G-code, retraction, travel and fan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Printer {
+    /// G-code dialect: `"marlin"`, `"reprapfirmware"` or `"klipper"`. Default `"marlin"`.
+    pub flavor: Flavor,
+    /// Printable bed size [X, Y], mm. Default [250, 250].
+    pub bed_size: [f64; 2],
+    /// Coordinates of the bed's front-left corner [X, Y], mm: [0, 0] when the origin is at that
+    /// corner, [-125, -125] for a 250 mm bed with the origin in its centre. Default [0, 0].
+    pub bed_origin: [f64; 2],
+    /// Highest printable Z, mm. Default 250.
+    pub max_height: f64,
+    /// Bed temperature after the first layer, °C (0 = bed heater off). Default 60.
+    pub bed_temperature: f64,
+    /// Bed temperature for the first layer, °C. Default 60.
+    pub first_layer_bed_temperature: f64,
+    /// G-code template written before the print: heats, homes and primes. `{placeholders}` are
+    /// filled from this config (see [`Config::render_template`]).
+    pub start_gcode: String,
+    /// G-code template written after the print: heaters and fan off, lift, home X/Y, motors off.
+    pub end_gcode: String,
+    /// G-code template written before every tool change (`{previous_tool}` and `{next_tool}`
+    /// are available); when it has a `T{next_tool}` line, that line selects the tool and no
+    /// other `T` is written. PrusaSlicer's `toolchange_gcode` imports here. Default empty.
+    pub before_tool_change_gcode: String,
+    /// G-code template written after every tool change (`{previous_tool}` and `{next_tool}` are
+    /// available). Default empty.
+    pub after_tool_change_gcode: String,
+    /// Filament pulled back before travels, mm (a tool's own `retract_length` overrides it).
+    /// Default 0.8.
+    pub retract_length: f64,
+    /// Speed of the retraction, mm/s of filament. Default 35.
+    pub retract_speed: f64,
+    /// Speed of the un-retraction, mm/s of filament; 0 = the same as `retract_speed`. Default 0.
+    pub deretract_speed: f64,
+    /// Travels shorter than this do not retract, mm. Default 2.
+    pub retract_before_travel: f64,
+    /// Z lift (z-hop) during retracted travels, mm; 0 = none. Default 0.
+    pub retract_lift: f64,
+    /// Speed of non-printing moves, mm/s. Default 130.
+    pub travel_speed: f64,
+    /// Acceleration of the machine, mm/s², used by time estimates. Default 1000.
+    pub max_acceleration: f64,
+    /// Highest speed of any printing move, mm/s; faster role speeds are clamped to it.
+    /// Default 200.
+    pub max_print_speed: f64,
+    /// Write E as relative distances (`M83`) instead of absolute positions (`M82`).
+    /// Default false.
+    pub use_relative_e_distances: bool,
+    /// Lowest part-cooling fan speed when the fan is on, percent. Default 35.
+    pub fan_min_speed: f64,
+    /// Highest part-cooling fan speed, percent. Default 100.
+    pub fan_max_speed: f64,
+    /// Number of bottom layers printed with the fan off. Default 1.
+    pub disable_fan_first_layers: usize,
+    /// Retract with the firmware's `G10`/`G11` instead of E moves. Default false.
+    pub use_firmware_retraction: bool,
+}
+
+/// What a tool deposits and therefore how it is driven.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ToolKind {
+    /// A filament extruder: flow is E distance, computed from the cross-section of the
+    /// extrusion and the filament diameter.
+    #[default]
+    Filament,
+    /// A paste dispenser (pneumatic or screw): switched on and off by G-code snippets, flow is
+    /// time-based (`paste_flow_mm3_s`).
+    Paste,
+}
+
+/// One tool (`[tools.N]`). Keys left out take the default of the tool's `kind`:
+/// [`Tool::filament`] or [`Tool::paste`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Tool {
+    /// Name shown in comments and reports. Default `"PLA"` (filament) / `"conductive paste"`.
+    pub name: String,
+    /// `"filament"` or `"paste"`. Default `"filament"`.
+    pub kind: ToolKind,
+    /// Nozzle (or needle) inner diameter, mm. Default 0.4.
+    pub nozzle_diameter: f64,
+    /// Filament diameter, mm (filament tools). Default 1.75.
+    pub filament_diameter: f64,
+    /// Density of the material, g/cm³, for the weight estimate. Default 1.24 (PLA) / 3.0
+    /// (silver-filled paste).
+    pub filament_density: f64,
+    /// Nozzle temperature after the first layer, °C; 0 = not heated. Default 210 (filament) /
+    /// 0 (paste).
+    pub temperature: f64,
+    /// Nozzle temperature for the first layer, °C; 0 = not heated. Default 210 / 0.
+    pub first_layer_temperature: f64,
+    /// Temperature while the tool is parked during another tool's work, °C; absent = keep
+    /// `temperature`. Default absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub standby_temperature: Option<f64>,
+    /// Offset of this tool's nozzle from tool 0's [X, Y], mm, when the firmware does not apply
+    /// it. Default [0, 0].
+    pub offset: [f64; 2],
+    /// Factor on the computed flow. Default 1.0.
+    pub extrusion_multiplier: f64,
+    /// G-code that starts the paste flow (pressure valve or screw on), paste tools. Default
+    /// `M42 P6 S255` (drive output pin 6 high: wire the dispenser's trigger to a free output
+    /// and set its pin here).
+    pub paste_on_gcode: String,
+    /// G-code that stops the paste flow, paste tools. Default `M42 P6 S0`.
+    pub paste_off_gcode: String,
+    /// Volume dispensed per second while the paste flow is on, mm³/s (paste tools; filament
+    /// tools 0). Default 0.5.
+    pub paste_flow_mm3_s: f64,
+    /// This tool's retraction length, mm, overriding `printer.retract_length`; absent = use the
+    /// printer's. Default absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub retract_length: Option<f64>,
+    /// Z lift during this tool's travels longer than `printer.retract_before_travel`, mm,
+    /// overriding `printer.retract_lift`; absent = use the printer's. The paste tool's default
+    /// is 0.5: a dispensing nozzle dragged from one trace to the next at the layer's top would
+    /// smear the paste it just laid. Filament default absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub travel_lift: Option<f64>,
+}
+
+impl Default for Printer {
+    fn default() -> Self {
+        Self {
+            flavor: Flavor::Marlin,
+            bed_size: [250.0, 250.0],
+            bed_origin: [0.0, 0.0],
+            max_height: 250.0,
+            bed_temperature: 60.0,
+            first_layer_bed_temperature: 60.0,
+            start_gcode: DEFAULT_START_GCODE.to_owned(),
+            end_gcode: DEFAULT_END_GCODE.to_owned(),
+            before_tool_change_gcode: String::new(),
+            after_tool_change_gcode: String::new(),
+            retract_length: 0.8,
+            retract_speed: 35.0,
+            deretract_speed: 0.0,
+            retract_before_travel: 2.0,
+            retract_lift: 0.0,
+            travel_speed: 130.0,
+            max_acceleration: 1000.0,
+            max_print_speed: 200.0,
+            use_relative_e_distances: false,
+            fan_min_speed: 35.0,
+            fan_max_speed: 100.0,
+            disable_fan_first_layers: 1,
+            use_firmware_retraction: false,
+        }
+    }
+}
+
+/// Default `printer.start_gcode`: heat bed and tool 0, home, wait, prime a line along the front
+/// edge of the bed.
+pub const DEFAULT_START_GCODE: &str = "\
+M140 S{first_layer_bed_temperature} ; bed heating
+M104 T0 S{first_layer_temperature[0]} ; tool 0 heating
+G28 ; home all axes
+M190 S{first_layer_bed_temperature} ; wait for the bed
+M109 T0 S{first_layer_temperature[0]} ; wait for tool 0
+G92 E0
+G1 Z{first_layer_height} F720
+G1 X5 Y5 F6000
+G1 X60 Y5 E9 F1000 ; prime line
+G92 E0
+";
+
+/// Default `printer.end_gcode`: heaters and fan off, lift by 10 mm, home X/Y, motors off.
+pub const DEFAULT_END_GCODE: &str = "\
+M104 T0 S0 ; tool 0 heater off
+M140 S0 ; bed heater off
+M107 ; fan off
+G91
+G1 Z10 F600 ; lift
+G90
+G28 X Y
+M84 ; motors off
+";
+
+/// Z lift of the paste tool's travels by default, mm (see [`Tool::travel_lift`]).
+const PASTE_TRAVEL_LIFT_MM: f64 = 0.5;
+
+impl Tool {
+    /// The default filament tool: PLA, 1.75 mm, 0.4 mm nozzle, 210 °C.
+    pub fn filament() -> Self {
+        Self {
+            name: "PLA".to_owned(),
+            kind: ToolKind::Filament,
+            nozzle_diameter: 0.4,
+            filament_diameter: 1.75,
+            filament_density: 1.24,
+            temperature: 210.0,
+            first_layer_temperature: 210.0,
+            standby_temperature: None,
+            offset: [0.0, 0.0],
+            extrusion_multiplier: 1.0,
+            paste_on_gcode: String::new(),
+            paste_off_gcode: String::new(),
+            paste_flow_mm3_s: 0.0,
+            retract_length: None,
+            travel_lift: None,
+        }
+    }
+
+    /// The default paste tool: an unheated conductive-paste dispenser with a 0.4 mm needle,
+    /// switched by output pin 6 (`M42 P6 S255` / `M42 P6 S0`), 0.5 mm³/s.
+    pub fn paste() -> Self {
+        Self {
+            name: "conductive paste".to_owned(),
+            kind: ToolKind::Paste,
+            filament_density: 3.0,
+            temperature: 0.0,
+            first_layer_temperature: 0.0,
+            paste_on_gcode: "M42 P6 S255 ; paste on".to_owned(),
+            paste_off_gcode: "M42 P6 S0 ; paste off".to_owned(),
+            paste_flow_mm3_s: 0.5,
+            travel_lift: Some(PASTE_TRAVEL_LIFT_MM),
+            ..Self::filament()
+        }
+    }
+
+    /// The default tool of a kind: [`Tool::filament`] or [`Tool::paste`].
+    pub fn of_kind(kind: ToolKind) -> Self {
+        match kind {
+            ToolKind::Filament => Self::filament(),
+            ToolKind::Paste => Self::paste(),
+        }
+    }
+
+    /// Cross-section area of the filament, mm² (π·d²/4).
+    pub fn filament_area(&self) -> f64 {
+        std::f64::consts::PI * self.filament_diameter * self.filament_diameter / 4.0
+    }
+}
+
+impl Default for Tool {
+    /// [`Tool::filament`].
+    fn default() -> Self {
+        Self::filament()
+    }
+}
+
+impl fmt::Display for Flavor {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Flavor::Marlin => "marlin",
+            Flavor::RepRapFirmware => "reprapfirmware",
+            Flavor::Klipper => "klipper",
+        })
+    }
+}
+
+/// What the machine does to place a part (`[pnp]`).
+///
+/// Before either snippet the writer retracts and lifts the nozzle `lift` mm above the layer
+/// about to be printed; after it, it re-selects the active tool and comes back down only once it
+/// is over the next path.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PnpSettings {
+    /// G-code for a part placed by the vacuum tool (`method = "auto"`). Placeholders: `{id}`
+    /// (1-based part number in placement order), `{part}`, `{x}`, `{y}`, `{z}` (seating plane),
+    /// `{rotation}`. Default `M361 P{id}`, the command OctoPNP answers.
+    pub auto_gcode: String,
+    /// G-code after the `M117 Insert <part>` message of a part inserted by hand
+    /// (`method = "manual"`). Placeholders as in `auto_gcode`, plus `{pause}`: the firmware's
+    /// pause with the message (`M0` on Marlin, `M291` on RepRapFirmware, `PAUSE` on Klipper).
+    /// Default `{pause}`.
+    pub manual_gcode: String,
+    /// How far the nozzle lifts above the layer before a part is placed, mm. Default 10.
+    pub lift: f64,
+}
+
+impl Default for PnpSettings {
+    fn default() -> Self {
+        Self {
+            auto_gcode: "M361 P{id}".to_owned(),
+            manual_gcode: "{pause}".to_owned(),
+            lift: 10.0,
+        }
+    }
+}
