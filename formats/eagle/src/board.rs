@@ -2,11 +2,11 @@
 
 use std::collections::BTreeSet;
 
+use crate::doc::{Doc, Node};
 use crate::error::EagleError;
 use crate::library::{LAYER_DIMENSION, Libraries, Package, lookup};
 use crate::netlist::{Net, Netlist, to_netlist};
 use crate::rotation::Rotation;
-use crate::xml::{Doc, Node};
 
 /// A part placed on the board.
 #[derive(Debug, Clone, PartialEq)]

@@ -177,3 +177,26 @@ pub enum EagleError {
         module: String,
     },
 }
+
+impl EagleError {
+    /// The error for a failure of the shared XML tree, with lines and columns in `src`.
+    pub(crate) fn from_xml(src: &[u8], e: conduit_xml::XmlError) -> Self {
+        use conduit_xml::{XmlError, column_of, line_of};
+        match e {
+            XmlError::NotUtf8 { offset } => Self::NotUtf8 {
+                line: line_of(src, offset),
+                column: column_of(src, offset),
+            },
+            XmlError::Syntax { offset, source } => Self::Xml {
+                line: line_of(src, offset),
+                column: column_of(src, offset),
+                source,
+            },
+            XmlError::TooDeep { offset, limit, .. } => Self::TooDeep {
+                line: line_of(src, offset),
+                limit,
+            },
+            XmlError::UnexpectedEof { element } => Self::UnexpectedEof { element },
+        }
+    }
+}

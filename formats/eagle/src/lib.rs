@@ -52,12 +52,12 @@
 //! ```
 
 mod board;
+mod doc;
 mod error;
 mod library;
 mod netlist;
 mod rotation;
 mod schematic;
-mod xml;
 
 pub use board::{Board, Element, OutlineSegment};
 pub use error::EagleError;
@@ -93,7 +93,7 @@ pub fn read(bytes: &[u8]) -> Result<Document, EagleError> {
     if is_binary_eagle(bytes) {
         return Err(EagleError::BinaryFormat);
     }
-    let doc = xml::parse(bytes)?;
+    let doc = doc::parse(bytes)?;
     let root = &doc.root;
     if root.name != "eagle" {
         return Err(EagleError::NotEagle {

@@ -2,9 +2,9 @@
 
 use std::collections::BTreeMap;
 
+use crate::doc::{Doc, Node};
 use crate::error::EagleError;
 use crate::rotation::Rotation;
-use crate::xml::{Doc, Node};
 
 /// EAGLE layer number of the top copper layer.
 pub const LAYER_TOP: u32 = 1;

@@ -2,10 +2,10 @@
 
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
+use crate::doc::{Doc, Node};
 use crate::error::EagleError;
 use crate::library::{DeviceSet, Libraries, Library, Package, lookup};
 use crate::netlist::{Net, Netlist, to_netlist};
-use crate::xml::{Doc, Node};
 
 /// A schematic part, resolved through its library to a device and package.
 #[derive(Debug, Clone, PartialEq)]

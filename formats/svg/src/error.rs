@@ -112,3 +112,32 @@ pub struct AttributeError {
     /// Its 1-based line.
     pub line: usize,
 }
+
+impl SvgError {
+    /// The error for a failure of the shared XML tree, with lines in `src`.
+    pub(crate) fn from_xml(src: &[u8], e: conduit_xml::XmlError) -> Self {
+        use conduit_xml::{XmlError, line_of};
+        match e {
+            XmlError::NotUtf8 { offset } => Self::NotUtf8 {
+                offset,
+                line: line_of(src, offset),
+            },
+            XmlError::Syntax { offset, source } => Self::Xml {
+                offset,
+                line: line_of(src, offset),
+                source,
+            },
+            XmlError::TooDeep {
+                element,
+                offset,
+                limit,
+            } => Self::TooDeep {
+                element,
+                offset,
+                line: line_of(src, offset),
+                limit,
+            },
+            XmlError::UnexpectedEof { element } => Self::UnexpectedEof { element },
+        }
+    }
+}

@@ -75,7 +75,6 @@
 mod error;
 mod flatten;
 mod reader;
-mod xml;
 
 pub use error::{AttributeError, SvgError};
 
@@ -89,8 +88,8 @@ pub const MIN_TOLERANCE_MM: f64 = 1e-6;
 /// [`SvgError::TooManyPoints`] instead of exhausting memory.
 pub const MAX_POINTS: usize = 10_000_000;
 
-/// Deepest element nesting accepted.
-pub const MAX_DEPTH: usize = xml::MAX_DEPTH;
+/// Deepest element nesting accepted; keeps recursion on hostile input off the stack limit.
+pub const MAX_DEPTH: usize = 256;
 
 /// Deepest chain of `<use>` references followed (a `use` that reaches itself is a cycle).
 pub const MAX_USE_DEPTH: usize = 32;
@@ -129,8 +128,31 @@ pub fn read(bytes: &[u8], tolerance_mm: f64) -> Result<Design, SvgError> {
     if !(tolerance_mm.is_finite() && tolerance_mm >= MIN_TOLERANCE_MM) {
         return Err(SvgError::InvalidTolerance { tolerance_mm });
     }
-    let root = xml::parse(bytes)?;
+    let root = parse(bytes)?;
     reader::read(bytes, &root, tolerance_mm)
+}
+
+/// How SVG files are parsed: names without their namespace prefix (`svg:path` is `path`),
+/// attribute values that do not decode kept as written (Illustrator's `&ns_svg;`), and an
+/// element's attributes read before the depth limit is checked.
+const XML_OPTIONS: conduit_xml::Options = conduit_xml::Options {
+    names: conduit_xml::Names::Local,
+    entities: conduit_xml::Entities::KeepRaw,
+    depth_check: conduit_xml::DepthCheck::AfterAttributes,
+    max_depth: MAX_DEPTH,
+};
+
+/// Parses `bytes` (UTF-8, optional BOM) into its root element, which must be `<svg>`.
+fn parse(bytes: &[u8]) -> Result<conduit_xml::Node, SvgError> {
+    let root = conduit_xml::parse(bytes, &XML_OPTIONS)
+        .map_err(|e| SvgError::from_xml(bytes, e))?
+        .ok_or(SvgError::NotSvg {
+            root: String::new(),
+        })?;
+    if root.name != "svg" {
+        return Err(SvgError::NotSvg { root: root.name });
+    }
+    Ok(root)
 }
 
 #[cfg(test)]

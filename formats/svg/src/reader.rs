@@ -7,8 +7,8 @@ use kurbo::{Affine, CubicBez, Point, QuadBez, Vec2};
 use svgtypes::{Align, AspectRatio, Length, LengthUnit, PathParser, PathSegment, ViewBox};
 
 use crate::flatten::{self, Ellipse, Out, Overflow};
-use crate::xml::{Node, line_of};
 use crate::{AttributeError, Design, DesignPath, MAX_POINTS, MAX_USE_DEPTH, MM_PER_PX, SvgError};
+use conduit_xml::{Node, line_of};
 
 /// Elements never drawn, with everything inside them.
 const SKIPPED: [&str; 14] = [
