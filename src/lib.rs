@@ -37,8 +37,8 @@
 //! - [`check`]: replaying any G-code to find problems and measure it.
 //!
 //! **Walks** — one library call per command:
-//! - [`pipeline`]: scene to G-code (planar, curved tops, curved-layer FFF) and scene to routing
-//!   view.
+//! - [`pipeline`]: scene to G-code (planar, curved tops, curved-layer FFF), scene to routing
+//!   view, scan and design to a conformal program ([`pipeline::conform`]).
 //! - [`postprocess`]: slicer plugin mode — another slicer's G-code read into layers, the circuit
 //!   built into it, the file edited in place.
 //!

@@ -6,16 +6,15 @@ use super::args::ConfigSource;
 use super::{Failure, config::resolve};
 use anyhow::{Context, anyhow};
 use conduit::config::{CompensateSettings, Config};
-use conduit::conform::Surface;
 use conduit::conform::orient;
+use conduit::conform::scan::load_scan;
 use conduit::emit::robot::Dialect;
-use conduit::geom::Point3;
-use conduit::mesh::Mesh;
+use conduit::pipeline::conform::robot_program;
 use conduit::robot::compensate::simulate::{self, ErrorModel};
 use conduit::robot::compensate::substrate::{self, Substrate, SurfaceSpec};
 use conduit::robot::compensate::{self as comp, GapStats, Params, Path as PosePath, gaps};
 use conduit::robot::pattern::{self, PatternParams, Shape};
-use conduit::scene::{Content, LoadOptions, load, placed_meshes, write_atomically};
+use conduit::scene::write_atomically;
 use conduit_poses::Pose;
 use serde::Serialize;
 use std::io::Write;
@@ -317,13 +316,14 @@ fn write_program(job: &Job, poses: &[Pose]) -> Result<(), Failure> {
     );
     let writer = conduit::conform::pressure_params(job.cfg.gcode_params(), &job.cfg.conform)
         .context("[conform]")?;
-    super::robot_out::write_robot_file(
-        out,
-        dialect,
-        &program,
-        &job.cfg.robot,
-        (&writer, job.cfg.conform.tool),
-    )?;
+    let name = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let (text, _) =
+        robot_program(&program, dialect, &job.cfg, &writer, &name).map_err(anyhow::Error::from)?;
+    write_atomically(out, |f| f.write_all(&text))
+        .with_context(|| format!("{}: cannot write the program", out.display()))?;
     Ok(())
 }
 
@@ -523,45 +523,11 @@ fn load_substrate(spec: &str, cfg: &Config) -> Result<Substrate, Failure> {
         SurfaceSpec::Analytic(a) => return Ok(Substrate::Analytic(a)),
         SurfaceSpec::File(f) => f,
     };
-    let loaded = load(&file, &LoadOptions::default()).map_err(anyhow::Error::from)?;
-    for w in &loaded.warnings {
+    let scan = load_scan(&file, false, cfg.conform.fold_gap).map_err(anyhow::Error::from)?;
+    for w in &scan.warnings {
         eprintln!("warning: {}: {w}", file.display());
     }
-    let named = |e: conduit::conform::surface::SurfaceError| anyhow!("{}: {e}", file.display());
-    let surface = match loaded.content {
-        Content::Mesh { scene, .. } => {
-            let mut mesh = Mesh::default();
-            for m in placed_meshes(&scene) {
-                mesh.append(&m);
-            }
-            Surface::from_mesh(&mesh).map_err(named)?
-        }
-        Content::PointCloud(cloud) if !cloud.triangles.is_empty() => {
-            let mesh = Mesh {
-                name: String::new(),
-                vertices: cloud
-                    .points
-                    .iter()
-                    .map(|p| Point3::new(p[0], p[1], p[2]))
-                    .collect(),
-                triangles: cloud.triangles.clone(),
-            };
-            Surface::from_mesh(&mesh).map_err(named)?
-        }
-        Content::PointCloud(cloud) => {
-            Surface::from_cloud(&cloud.points, cfg.conform.fold_gap)
-                .map_err(named)?
-                .0
-        }
-        _ => {
-            return Err(anyhow!(
-                "{}: holds no surface (a mesh or a point cloud is needed)",
-                file.display()
-            )
-            .into());
-        }
-    };
-    Ok(Substrate::Mesh(Box::new(surface)))
+    Ok(Substrate::Mesh(Box::new(scan.surface)))
 }
 
 fn run_pattern(args: PatternArgs) -> Result<(), Failure> {

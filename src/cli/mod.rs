@@ -13,7 +13,6 @@ mod jet;
 mod postprocess;
 mod preview;
 mod progress;
-mod robot_out;
 mod route;
 mod slice;
 

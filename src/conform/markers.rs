@@ -161,6 +161,91 @@ fn area_centroid(pts: &[Point3]) -> [f64; 3] {
     [c.x, c.y, c.z]
 }
 
+/// Most markers tried in every assignment to the machine points (8·7·6 = 336 for three).
+pub const MAX_MARKERS: usize = 8;
+
+/// Why the markers could not be registered to the machine points.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MarkerError {
+    /// Fewer markers than machine points.
+    ///
+    /// How to fix: raise `conform.marker_max_size` if the holes are larger.
+    #[error(
+        "found {found} marker hole(s), {needed} needed (raise conform.marker_max_size if the \
+         holes are larger)"
+    )]
+    TooFew {
+        /// Markers found.
+        found: usize,
+        /// Machine points given.
+        needed: usize,
+    },
+    /// More small holes than [`MAX_MARKERS`]: the assignment would take too long.
+    ///
+    /// How to fix: lower `conform.marker_max_size` or repair the scan's other holes.
+    #[error(
+        "found {found} small holes, more than {MAX_MARKERS}: lower conform.marker_max_size or \
+         repair the scan's other holes"
+    )]
+    TooMany {
+        /// Holes found.
+        found: usize,
+    },
+    /// No choice of markers gives a registration.
+    #[error("the markers are collinear")]
+    Collinear,
+}
+
+/// The registration of `markers` to the `machine` points in the assignment with the smallest
+/// residual (every ordered choice of markers is tried).
+pub fn auto_register(
+    markers: &[Marker],
+    machine: &[Point3],
+) -> Result<super::Registration, MarkerError> {
+    let n = machine.len();
+    if markers.len() < n {
+        return Err(MarkerError::TooFew {
+            found: markers.len(),
+            needed: n,
+        });
+    }
+    if markers.len() > MAX_MARKERS {
+        return Err(MarkerError::TooMany {
+            found: markers.len(),
+        });
+    }
+    let pts: Vec<Point3> = markers
+        .iter()
+        .map(|m| Point3::new(m.centroid[0], m.centroid[1], m.centroid[2]))
+        .collect();
+    let mut best: Option<super::Registration> = None;
+    let mut chosen = Vec::with_capacity(n);
+    permute(pts.len(), n, &mut chosen, &mut |idx| {
+        let scan: Vec<Point3> = idx.iter().map(|&i| pts[i]).collect();
+        if let Ok(r) = super::register::least_squares(&scan, machine)
+            && best.as_ref().is_none_or(|b| r.rms < b.rms)
+        {
+            best = Some(r);
+        }
+    });
+    best.ok_or(MarkerError::Collinear)
+}
+
+/// Calls `f` with every ordered choice of `k` of `0..n`, in lexicographic order.
+fn permute(n: usize, k: usize, chosen: &mut Vec<usize>, f: &mut impl FnMut(&[usize])) {
+    if chosen.len() == k {
+        f(chosen);
+        return;
+    }
+    for i in 0..n {
+        if !chosen.contains(&i) {
+            chosen.push(i);
+            permute(n, k, chosen, f);
+            chosen.pop();
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

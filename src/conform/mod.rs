@@ -33,6 +33,7 @@ pub mod project;
 pub mod register;
 pub mod replay;
 pub mod report;
+pub mod scan;
 pub mod spline;
 pub mod surface;
 
@@ -42,7 +43,7 @@ pub use register::{Registration, register};
 pub use report::ConformReport;
 pub use surface::Surface;
 
-use crate::config::{Config, ConformSettings, Corrections, Mapping};
+use crate::config::{ConformSettings, Corrections, Mapping};
 use crate::emit::gcode::GcodeParams;
 use crate::geom::Point3;
 use crate::program::{Layer, LayerItem, Program, Role, Toolpath};
@@ -419,31 +420,4 @@ pub fn machine_params(
     }
     out.printer.retract_before_travel = 0.0;
     Ok(out)
-}
-
-/// The G-code of `paths` for `cfg` over `surface`, and its replay: every move of the written
-/// file checked against the surface with the whole nozzle. The program's first travel arrives at
-/// the surface's top plus `conform.travel_clearance`.
-pub fn write_and_replay(
-    paths: &[Vec<Point3>],
-    cfg: &Config,
-    surface: &Surface,
-    params: &ConformParams,
-) -> Result<(Vec<u8>, replay::ReplayContacts), ConformError> {
-    let lowest = paths.iter().flatten().map(|p| p.z).fold(f64::MAX, f64::min);
-    let safe_z = surface.max().z + cfg.conform.travel_clearance;
-    let program = program(paths, &cfg.conform, safe_z);
-    let writer = machine_params(cfg.gcode_params(), &cfg.conform, surface, lowest)?;
-    let mut gcode = Vec::new();
-    crate::emit::gcode::write_gcode(&program, &writer, &mut gcode)?;
-    let parsed = conduit_gcode::parse(&gcode)?;
-    let contacts = replay::replay(
-        &parsed,
-        cfg.printer.flavor,
-        surface,
-        &params.nozzle,
-        cfg.conform.feed,
-        replay::body_lines(&String::from_utf8_lossy(&gcode)),
-    );
-    Ok((gcode, contacts))
 }

@@ -5,6 +5,8 @@
 //! returns the G-code bytes with a [`SliceSummary`] for the report; [`slice_scene_with`] adds a
 //! circuit ([`electronics`]).
 
+pub mod conform;
+
 pub use crate::circuit::stage::{self as electronics, Electronics, ElectronicsReport};
 pub use crate::emit::route_svg::RouteViewLayer;
 
@@ -188,20 +190,20 @@ pub fn slice_scene(
 }
 
 /// Stage timings: each lap records the time since the previous one.
-struct Laps {
-    times: Vec<(Stage, f64)>,
+pub(crate) struct Laps<S = Stage> {
+    pub(crate) times: Vec<(S, f64)>,
     clock: Instant,
 }
 
-impl Laps {
-    fn new() -> Self {
+impl<S> Laps<S> {
+    pub(crate) fn new() -> Self {
         Self {
             times: Vec::new(),
             clock: Instant::now(),
         }
     }
 
-    fn lap(&mut self, stage: Stage) {
+    pub(crate) fn lap(&mut self, stage: S) {
         self.times.push((stage, self.clock.elapsed().as_secs_f64()));
         self.clock = Instant::now();
     }

@@ -63,6 +63,14 @@ impl Dialect {
             .find(|(n, _)| *n == name)
             .map(|(_, d)| *d)
     }
+
+    /// The dialect's command-line name.
+    pub fn name(self) -> &'static str {
+        Self::NAMES
+            .iter()
+            .find(|(_, d)| *d == self)
+            .map_or("robot", |(n, _)| n)
+    }
 }
 
 /// Why a robot program could not be written.
