@@ -5,6 +5,7 @@ use super::args::{JetArgs, JetCommand, JetModelArgs};
 use super::{Failure, config::resolve};
 use anyhow::Context;
 use conduit::jet::{self, JetParams, ModelInput, accumulation};
+use conduit::pipeline::jet::{self as walk, JetOutput};
 use conduit::scene::write_atomically;
 use std::io::Write;
 
@@ -31,7 +32,7 @@ pub(crate) fn run(args: JetArgs) -> Result<(), Failure> {
         layer_height: height / UM,
         layers: layers as usize,
     };
-    jet::validate(&params, &cfg).map_err(anyhow::Error::from)?;
+    jet::validate(&params, &cfg.jet, &cfg.tools).map_err(anyhow::Error::from)?;
     let mut outlines = Vec::new();
     for path in &args.designs {
         let loaded = jet::design::load(path, cfg.jet.arc_tolerance).map_err(anyhow::Error::from)?;
@@ -40,22 +41,18 @@ pub(crate) fn run(args: JetArgs) -> Result<(), Failure> {
         }
         outlines.extend(loaded.outlines);
     }
-    let job = jet::plan(&outlines, &params, &cfg).map_err(anyhow::Error::from)?;
-    let mut gcode: Vec<u8> = Vec::new();
-    let stats = jet::write_jet(&job.layers, params.width, &cfg, &mut gcode);
+    let names = args
+        .designs
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let JetOutput {
+        gcode,
+        stats,
+        report,
+    } = walk::run(&outlines, names, &params, &cfg).map_err(anyhow::Error::from)?;
     write_atomically(&output, |f| f.write_all(&gcode))
         .with_context(|| format!("{}: cannot write G-code", output.display()))?;
-    let report = jet::report::report(
-        args.designs
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect(),
-        &job.structures,
-        &job.layers,
-        &params,
-        &cfg.jet,
-        stats,
-    );
     if let Some(path) = &args.report {
         let json = serde_json::to_vec_pretty(&report).context("serialising the report")?;
         write_atomically(path, |f| f.write_all(&json))

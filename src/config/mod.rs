@@ -41,22 +41,19 @@
 //! fan speeds in percent, densities in g/cm³, volumetric flows in mm³/s.
 
 mod compensate;
-mod conform;
-mod curved;
 mod defaults;
 mod electronics;
-mod jet;
 pub mod prusa_ini;
 mod robot;
 
-pub use compensate::CompensateSettings;
-pub use conform::{ConformSettings, Corrections, Mapping};
-pub use curved::{CurvedMode, CurvedSettings};
+pub use crate::conform::{ConformSettings, Corrections, Mapping};
+pub use crate::curved::{CurvedMode, CurvedSettings};
+pub use crate::emit::robot::{FiveAxis, RobotSettings, RotaryAxes};
+pub use crate::jet::{JetFill, JetSettings};
+pub use crate::robot::compensate::CompensateSettings;
 pub use defaults::defaults_toml;
 pub use electronics::RouteSettings;
-pub use jet::{JetFill, JetSettings};
 pub use prusa_ini::from_prusa_pairs;
-pub use robot::{FiveAxis, RobotSettings, RotaryAxes};
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -50,10 +50,10 @@
 //!   back to the largest shift that keeps it (the clearance pass handles points already in
 //!   contact).
 
+use super::Corrections;
 use super::nozzle::Nozzle;
 use super::spline::Local;
 use super::surface::Surface;
-use crate::config::Corrections;
 use crate::geom::{Point3, Vector3};
 
 /// Rounds of the clearance pass (lifting a point can bring its segments into contact).

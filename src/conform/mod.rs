@@ -34,6 +34,7 @@ pub mod register;
 pub mod replay;
 pub mod report;
 pub mod scan;
+pub mod settings;
 pub mod spline;
 pub mod surface;
 
@@ -41,9 +42,9 @@ pub use design::Placement;
 pub use nozzle::Nozzle;
 pub use register::{Registration, register};
 pub use report::ConformReport;
+pub use settings::{ConformSettings, Corrections, Mapping};
 pub use surface::Surface;
 
-use crate::config::{ConformSettings, Corrections, Mapping};
 use crate::emit::gcode::GcodeParams;
 use crate::geom::Point3;
 use crate::program::{Layer, LayerItem, Program, Role, Toolpath};

@@ -8,8 +8,8 @@
 use super::nozzle::Nozzle;
 use super::surface::Surface;
 use crate::check::moves;
-use crate::config::Flavor;
 use crate::geom::Point3;
+use crate::program::machine::Flavor;
 use serde::Serialize;
 
 /// The 1-based line range of a conduit G-code file's body: from its first `;LAYER_CHANGE` to

@@ -5,6 +5,7 @@
 //! adds the registration, the markers and the replay of the written G-code.
 
 use super::ConformParams;
+use super::Corrections;
 use super::correct::CorrectionCounts;
 use super::deposit::DepositStats;
 use super::design::PlanarPath;
@@ -14,7 +15,6 @@ use super::register::Registration;
 use super::replay::ReplayContacts;
 use super::spline::Local;
 use super::surface::{CloudInfo, Surface};
-use crate::config::Corrections;
 use crate::geom::Point3;
 use serde::Serialize;
 

@@ -28,10 +28,12 @@ pub mod clfff;
 pub mod collision;
 pub mod motion;
 pub mod report;
+pub mod settings;
 pub mod surface;
 pub mod tops;
 
 pub use report::{CurvedLayerReport, CurvedReport, RegionReport, Rejection};
+pub use settings::{CurvedMode, CurvedSettings};
 pub use surface::{HeightField, SurfaceHit};
 
 use crate::config::Config;

@@ -5,7 +5,7 @@
 //! The angle θ of a corner is the angle between its two segments (180° = straight, 0° = the
 //! path turns back on itself).
 
-use crate::config::JetSettings;
+use super::JetSettings;
 
 /// What a corner needs.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -9,7 +9,7 @@
 //! spacings. The offsets and clipping are the project's exact integer-grid operations
 //! ([`crate::geom`]); sharp corners stay sharp (mitred) so the corner rules see them.
 
-use crate::config::JetFill;
+use super::JetFill;
 use crate::geom::{
     ExPolygon, FillRule, Join, Point2, Polygon, Polyline, clip_polylines, offset,
     polygons_to_expolygons,

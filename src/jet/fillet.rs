@@ -228,7 +228,7 @@ pub fn fillet(points: &[[f64; 2]], closed: bool, width: f64, rules: &CornerRules
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::JetSettings;
+    use crate::jet::JetSettings;
 
     fn rules() -> CornerRules {
         CornerRules::new(&JetSettings::default())

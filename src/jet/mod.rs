@@ -29,15 +29,17 @@ pub mod model;
 pub mod path;
 pub mod report;
 pub mod schedule;
+pub mod settings;
 pub mod shutter;
 
 pub use design::{DesignError, Outline};
 pub use model::{ModelInput, ModelResult, accumulation};
 pub use report::JetReport;
 pub use schedule::{JetLayer, JetParams, Structure};
+pub use settings::{JetFill, JetSettings};
 pub use shutter::{JetStats, write_jet};
 
-use crate::config::{Config, ToolKind};
+use crate::program::machine::{Tool, ToolKind};
 
 /// Why a jet job cannot run.
 #[derive(Debug, thiserror::Error)]
@@ -72,8 +74,12 @@ pub struct JetJob {
     pub layers: Vec<JetLayer>,
 }
 
-/// Checks the parameters and the jet tool.
-pub fn validate(params: &JetParams, cfg: &Config) -> Result<(), JetError> {
+/// Checks the parameters and the jet tool (`settings.tool`, one of `tools`).
+pub fn validate(
+    params: &JetParams,
+    settings: &JetSettings,
+    tools: &[Tool],
+) -> Result<(), JetError> {
     if !(params.width.is_finite() && params.width > 0.0) {
         return Err(JetError::Params(format!(
             "line width must be > 0, got {} mm",
@@ -89,11 +95,11 @@ pub fn validate(params: &JetParams, cfg: &Config) -> Result<(), JetError> {
     if params.layers == 0 {
         return Err(JetError::Params("at least one layer is needed".to_owned()));
     }
-    let tool = cfg.jet.tool;
-    match cfg.tools.get(tool) {
+    let tool = settings.tool;
+    match tools.get(tool) {
         None => Err(JetError::Tool {
             tool,
-            message: format!("the config defines only {} tool(s)", cfg.tools.len()),
+            message: format!("the config defines only {} tool(s)", tools.len()),
         }),
         Some(t) if t.kind != ToolKind::Paste => Err(JetError::Tool {
             tool,
@@ -105,9 +111,14 @@ pub fn validate(params: &JetParams, cfg: &Config) -> Result<(), JetError> {
 }
 
 /// Plans a job: outlines → structures → layers.
-pub fn plan(outlines: &[Outline], params: &JetParams, cfg: &Config) -> Result<JetJob, JetError> {
-    validate(params, cfg)?;
-    let structures = schedule::prepare(outlines, params, &cfg.jet);
-    let layers = schedule::schedule(&structures, params, &cfg.jet);
+pub fn plan(
+    outlines: &[Outline],
+    params: &JetParams,
+    settings: &JetSettings,
+    tools: &[Tool],
+) -> Result<JetJob, JetError> {
+    validate(params, settings, tools)?;
+    let structures = schedule::prepare(outlines, params, settings);
+    let layers = schedule::schedule(&structures, params, settings);
     Ok(JetJob { structures, layers })
 }

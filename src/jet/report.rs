@@ -6,11 +6,11 @@
 
 use serde::Serialize;
 
+use super::JetSettings;
 use super::fillet::{Corner, CornerAction};
 use super::model::{ModelInput, accumulation};
 use super::schedule::{JetLayer, JetParams, Structure};
 use super::shutter::JetStats;
-use crate::config::JetSettings;
 
 /// One corner in the report.
 #[derive(Debug, Clone, PartialEq, Serialize)]

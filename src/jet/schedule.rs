@@ -12,13 +12,13 @@
 //! - A closed contour of layer `k` is opened at its gap place `k mod n`
 //!   ([`super::contour`]).
 
+use super::JetSettings;
 use super::contour::{GapPlaces, gap_places, open_at};
 use super::corners::CornerRules;
 use super::design::Outline;
 use super::fill::lines;
 use super::fillet::{Corner, fillet};
 use super::path::Chain;
-use crate::config::JetSettings;
 
 /// Line width, layer height and layer count of a job, mm.
 #[derive(Debug, Clone, Copy, PartialEq)]

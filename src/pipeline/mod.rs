@@ -6,6 +6,7 @@
 //! circuit ([`electronics`]).
 
 pub mod conform;
+pub mod jet;
 
 pub use crate::circuit::stage::{self as electronics, Electronics, ElectronicsReport};
 pub use crate::emit::route_svg::RouteViewLayer;

@@ -3,7 +3,7 @@
 //!
 //! Place in the pipeline: robot calibration ([`super::tcp`]) turns logged joint angles into
 //! flange poses with it, so a pivot calibration can start from what the controller shows. The
-//! table comes from `[robot] dh` ([`crate::config::RobotSettings::dh`]).
+//! table comes from `[robot] dh` ([`crate::emit::robot::RobotSettings::dh`]).
 //!
 //! Standard convention: joint i contributes Aᵢ = Rot_z(θᵢ + offsetᵢ)·Trans_z(dᵢ)·Trans_x(aᵢ)·
 //! Rot_x(αᵢ), and the flange pose is A₁·A₂·…·Aₙ (lengths in mm, angles in degrees).

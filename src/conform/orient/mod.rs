@@ -28,12 +28,12 @@
 pub mod collide;
 pub mod normals;
 
+use super::ConformSettings;
 use super::correct::CorrectionCounts;
 use super::deposit;
 use super::design::Placement;
 use super::report::{self, ConformReport, Contact};
 use super::{ConformError, ConformParams, Planned};
-use crate::config::ConformSettings;
 use crate::geom::{Point3, Vector3};
 use crate::program::{LayerItem, Program};
 use serde::Serialize;

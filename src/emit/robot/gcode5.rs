@@ -19,8 +19,8 @@
 //! followed by `;DISPENSE:ON` / `;DISPENSE:OFF`, as the 3-axis writer does.
 
 use super::motion::Step;
+use super::{FiveAxis, RotaryAxes};
 use super::{RobotError, RobotJob, banner};
-use crate::config::{FiveAxis, RotaryAxes};
 use crate::geom::{Point3, Vector3};
 use conduit_gcode::{fmt_f, fmt_fixed, fmt_xyz};
 use nalgebra::Rotation3;

@@ -9,10 +9,10 @@
 //! early. The first motion is a `PTP $AXIS_ACT` (the block-coincidence run KRL needs before a
 //! `LIN`).
 
+use super::RobotSettings;
 use super::frames::{fixed, zyx_degrees};
 use super::motion::Step;
 use super::{RobotError, banner};
-use crate::config::RobotSettings;
 use nalgebra::Rotation3;
 use std::io::Write;
 

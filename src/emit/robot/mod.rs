@@ -24,11 +24,12 @@ mod krl;
 pub mod motion;
 mod poses_csv;
 mod rapid;
+pub mod settings;
 mod urscript;
 
-use crate::config::RobotSettings;
 use crate::program::Program;
 use motion::{MotionParams, Step};
+pub use settings::{FiveAxis, RobotSettings, RotaryAxes};
 use std::io::Write;
 
 /// A program dialect of [`write_robot`].

@@ -6,10 +6,10 @@
 //! first) is the tool frame's (z into the work). `dispense` is 1 on the rows reached while
 //! dispensing. `conduit compensate` and any CSV reader take the file as it is.
 
+use super::RobotSettings;
 use super::frames::quaternion;
 use super::motion::Step;
 use super::{RobotError, banner, frame_text};
-use crate::config::RobotSettings;
 use conduit_poses::{Pose, write_poses};
 use std::io::Write;
 

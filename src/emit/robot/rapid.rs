@@ -9,10 +9,10 @@
 //! others `fine`. The dispenser is `SetDO robot.dispense_signal, 1/0`. The tool's load data is
 //! a placeholder (1 kg at the flange) to be replaced by the real tool's.
 
+use super::RobotSettings;
 use super::frames::{fixed, frame, quaternion};
 use super::motion::Step;
 use super::{RobotError, banner};
-use crate::config::RobotSettings;
 use nalgebra::Rotation3;
 use std::io::Write;
 

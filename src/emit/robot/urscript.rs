@@ -8,10 +8,10 @@
 //! `set_digital_out(robot.dispense_output, True/False)`; a move before a switch has no blend,
 //! so the switch happens at the point.
 
+use super::RobotSettings;
 use super::frames::{fixed, frame, rotation_vector};
 use super::motion::Step;
 use super::{RobotError, banner, frame_text};
-use crate::config::RobotSettings;
 use nalgebra::{Isometry3, UnitQuaternion};
 use std::io::Write;
 

@@ -17,14 +17,15 @@
 
 pub mod frame;
 pub mod gaps;
+pub mod settings;
 pub mod simulate;
 pub mod smooth;
 pub mod substrate;
 
-use crate::config::CompensateSettings;
 use crate::geom::{Point3, Vector3};
 use conduit_poses::{Pose, TableError};
 use serde::Serialize;
+pub use settings::CompensateSettings;
 
 /// Why a compensation failed.
 #[derive(Debug, thiserror::Error, PartialEq)]

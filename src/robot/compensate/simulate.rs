@@ -17,9 +17,9 @@
 //! reading is that gap over cos α plus Gaussian noise from a seeded generator, so the same
 //! seed gives the same readings byte for byte.
 
+use super::CompensateSettings;
 use super::substrate::Substrate;
 use super::{CompensateError, CorrectionStats, GapStats, Params, Path, compensate_pass};
-use crate::config::CompensateSettings;
 use crate::geom::{Point3, Vector3};
 use conduit_poses::Pose;
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion};

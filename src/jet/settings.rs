@@ -1,8 +1,9 @@
-//! The `[jet]` section of the configuration: aerosol-jet toolpaths for free-standing
-//! micro-walls (corner rule table, shutter gap, layer blocks, shutter snippets, fill, model).
+//! The jet stage's settings, the `[jet]` section of the configuration: aerosol-jet toolpaths
+//! for free-standing micro-walls (corner rule table, shutter gap, layer blocks, shutter
+//! snippets, fill, model).
 //!
-//! Place in the pipeline: read with the rest of [`super::Config`]; `conduit jet` hands it to
-//! [`crate::jet`], which turns a 2D design into layers of jet paths and writes them.
+//! Place in the pipeline: read with the rest of the config (`crate::config::Config::jet`);
+//! the jet walk hands it to every step of [`crate::jet`].
 //!
 //! Lengths are millimetres like every other section (the `conduit jet` command line takes
 //! micrometres and converts), angles degrees, speeds mm/s, times seconds.

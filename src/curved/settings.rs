@@ -1,8 +1,8 @@
-//! The `[curved]` section of the configuration: non-planar top surfaces (`mode = "tops"`) and
-//! curved-layer FFF of thin shells (`mode = "clfff"`).
+//! The curved stages' settings, the `[curved]` section of the configuration: non-planar top
+//! surfaces (`mode = "tops"`) and curved-layer FFF of thin shells (`mode = "clfff"`).
 //!
-//! Place in the pipeline: read with the rest of [`super::Config`]; the pipeline hands it to
-//! [`crate::curved`], which runs between slicing and the regions stage and adds the curved
+//! Place in the pipeline: read with the rest of the config (`crate::config::Config::curved`);
+//! the pipeline hands it to [`crate::curved`], which runs between slicing and the regions stage and adds the curved
 //! layers to the Program (tops), or to [`crate::curved::clfff`], which replaces the planar
 //! pipeline with scaffold, buffer and curved layers (clfff).
 

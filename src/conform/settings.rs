@@ -1,8 +1,9 @@
-//! The `[conform]` section of the configuration: conformal printing of 2D designs onto scanned
-//! surfaces with a micro-extrusion nozzle (`conduit conform`).
+//! The conform stage's settings, the `[conform]` section of the configuration: conformal
+//! printing of 2D designs onto scanned surfaces with a micro-extrusion nozzle
+//! (`conduit conform`), and its enums ([`Mapping`], [`Corrections`]).
 //!
-//! Place in the pipeline: read with the rest of [`super::Config`]; the CLI turns it into
-//! [`crate::conform::ConformParams`] before any work runs. Lengths in mm, speeds in mm/s,
+//! Place in the pipeline: read with the rest of the config (`crate::config::Config::conform`);
+//! the walk turns it into [`crate::conform::ConformParams`] before any work runs. Lengths in mm, speeds in mm/s,
 //! angles in degrees.
 
 use serde::{Deserialize, Serialize};
