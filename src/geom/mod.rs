@@ -8,6 +8,7 @@
 mod clip;
 mod point;
 mod polygon;
+mod segment;
 mod tolerances;
 mod tool_frame;
 mod transform;
@@ -18,6 +19,7 @@ pub use clip::{
 };
 pub use point::{Coord, Point2, Point3, Vector3, scaled, unscaled};
 pub use polygon::{ExPolygon, Polygon, Polyline};
+pub use segment::{segment_distance, segment_distance2, segment_param};
 pub use tolerances::{Tolerance, Tolerances};
 pub use tool_frame::tool_frame;
 pub use transform::{BoundingBox, Transform};

@@ -36,7 +36,7 @@ use super::extrusion::BeadShape;
 use super::order::{Group, OrderParams, order_groups};
 use super::toolpath::{Event, Layer, LayerItem, Program, Role, Toolpath};
 use crate::config::{Config, ToolKind};
-use crate::geom::{Point2, Point3, Polygon, scaled, unscaled};
+use crate::geom::{Point2, Point3, Polygon, scaled, segment_distance2, unscaled};
 use crate::region::gapfill::split_by_width;
 use crate::region::{LayerRegions, SolidRole};
 use crate::slice::LayerZ;
@@ -224,20 +224,6 @@ pub fn simplify(points: &[Point2], tolerance: i64, closed: bool) -> Vec<Point2> 
     } else {
         out
     }
-}
-
-/// Squared distance (nm²) from `p` to the segment `a`–`b`.
-fn segment_distance2(p: Point2, a: Point2, b: Point2) -> f64 {
-    let (dx, dy) = ((b.x - a.x) as f64, (b.y - a.y) as f64);
-    let (px, py) = ((p.x - a.x) as f64, (p.y - a.y) as f64);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        ((px * dx + py * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let (ex, ey) = (px - t * dx, py - t * dy);
-    ex * ex + ey * ey
 }
 
 impl ProgramParams {

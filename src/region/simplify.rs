@@ -11,7 +11,7 @@
 //! regions stage's offsets by more than ten times, while no point moves further than the
 //! tolerance.
 
-use crate::geom::{ExPolygon, Point2, Polygon, scaled, union};
+use crate::geom::{ExPolygon, Point2, Polygon, scaled, segment_distance2, union};
 
 /// Largest distance (mm) a simplified contour may stray from the sliced one: PrusaSlicer's
 /// default `gcode_resolution`.
@@ -25,22 +25,6 @@ pub const RESOLUTION_MM: f64 = 0.0125;
 /// the next offset made it about ten times slower; dropping them at 1 µm changes no region by a
 /// printable amount.
 pub const CLEANUP_MM: f64 = 0.001;
-
-/// Squared distance (nm², as f64) from `p` to the segment `a`–`b`.
-fn segment_distance2(p: Point2, a: Point2, b: Point2) -> f64 {
-    let (dx, dy) = ((b.x - a.x) as f64, (b.y - a.y) as f64);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        (((p.x - a.x) as f64 * dx + (p.y - a.y) as f64 * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let (ex, ey) = (
-        a.x as f64 + t * dx - p.x as f64,
-        a.y as f64 + t * dy - p.y as f64,
-    );
-    ex * ex + ey * ey
-}
 
 /// The points of the open chain `points` that Douglas–Peucker keeps at `tolerance` (nm): both
 /// ends, and recursively the point farthest from the chord while it is farther than `tolerance`.

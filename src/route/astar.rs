@@ -24,10 +24,10 @@
 //!   maps are only looked up, never iterated.
 
 use super::graph::{self, Ends, Graph, LayerInput, PENALTY_FACTOR, PreparedLayer, VertexId, Zone};
-use super::index::{dist, lerp, point_segment_distance, project_param};
+use super::index::{dist, lerp};
 use super::interlayer::{Parent, piece_fits, polyline_length, walk_back};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, layer_of, trace};
-use crate::geom::{Point2, scaled, unscaled};
+use crate::geom::{Point2, scaled, segment_distance, segment_param, unscaled};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::ops::RangeInclusive;
@@ -416,7 +416,7 @@ impl Search {
             dist(p, self.graph.pos(self.target)),
         );
         let h = self.taps.iter().fold(to_pad, |h, t| {
-            h.min(self.bound(l, t.layer, point_segment_distance(p, t.a, t.b)))
+            h.min(self.bound(l, t.layer, segment_distance(p, t.a, t.b)))
         });
         self.h[v as usize] = h;
         h
@@ -435,7 +435,7 @@ impl Search {
             .iter()
             .filter(|t| t.layer == l)
             .map(|t| {
-                let q = lerp(t.a, t.b, project_param(p, t.a, t.b));
+                let q = lerp(t.a, t.b, segment_param(p, t.a, t.b));
                 (dist(p, q), q, t.wire)
             })
             .filter(|(d, _, _)| *d <= reach)

@@ -12,8 +12,10 @@
 //! `half / cos(π/16)` (≈ 1.02 · half) from the centreline.
 
 use super::RouteParams;
-use super::index::{dist, point_segment_distance};
-use crate::geom::{ExPolygon, Join, Point2, Point3, Polygon, offset, scaled, union};
+use super::index::dist;
+use crate::geom::{
+    ExPolygon, Join, Point2, Point3, Polygon, offset, scaled, segment_distance, union,
+};
 use std::f64::consts::PI;
 
 /// Sides of the polygons standing for round joints and pads.
@@ -100,7 +102,7 @@ fn simplify(points: &[Point2]) -> Vec<Point2> {
     while let Some((i, j)) = stack.pop() {
         let mut far = (0.0, 0);
         for (k, &p) in pts.iter().enumerate().take(j).skip(i + 1) {
-            let d = point_segment_distance(p, pts[i], pts[j]);
+            let d = segment_distance(p, pts[i], pts[j]);
             if d > far.0 {
                 far = (d, k);
             }

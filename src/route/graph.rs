@@ -28,8 +28,11 @@
 //! inter-layer edges then join vertices of exactly the same xy.
 
 use super::RouteParams;
-use super::index::{Hit, RegionIndex, dist, lerp, point_segment_distance, project_param};
-use crate::geom::{ExPolygon, Join, Point2, intersection, offset, scaled, unscaled};
+use super::index::{Hit, RegionIndex, dist, lerp};
+use crate::geom::{
+    ExPolygon, Join, Point2, intersection, offset, scaled, segment_distance, segment_param,
+    unscaled,
+};
 use std::collections::{BTreeMap, HashMap};
 use std::hash::{BuildHasherDefault, Hasher};
 
@@ -683,9 +686,9 @@ fn nearest_on_ring(ring: &[Point2], p: Point2, reach: i64) -> Option<Insert> {
     let mut best: Option<(f64, Insert)> = None;
     for k in 0..ring.len() {
         let (a, b) = (ring[k], ring[(k + 1) % ring.len()]);
-        let d = point_segment_distance(p, a, b);
+        let d = segment_distance(p, a, b);
         if d <= reach as f64 && best.as_ref().is_none_or(|(bd, _)| d < *bd) {
-            let u = project_param(p, a, b);
+            let u = segment_param(p, a, b);
             best = Some((
                 d,
                 Insert {

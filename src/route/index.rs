@@ -11,7 +11,7 @@
 //! Orientation tests are exact (`i128` cross products of nanometre coordinates); only the
 //! parameters of intersection points are `f64`.
 
-use crate::geom::{ExPolygon, Point2};
+use crate::geom::{ExPolygon, Point2, segment_distance};
 use std::cell::Cell;
 
 /// Height of one band of edges, in scaled units (1 mm).
@@ -184,30 +184,6 @@ fn proper_crossing(a: Point2, b: Point2, e: Edge) -> bool {
     sign(d1) * sign(d2) < 0 && sign(d3) * sign(d4) < 0
 }
 
-/// Distance (scaled units, as `f64`) from `p` to the segment `a`–`b`.
-pub(crate) fn point_segment_distance(p: Point2, a: Point2, b: Point2) -> f64 {
-    let (dx, dy) = ((b.x - a.x) as f64, (b.y - a.y) as f64);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        (((p.x - a.x) as f64 * dx + (p.y - a.y) as f64 * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let (qx, qy) = (a.x as f64 + t * dx, a.y as f64 + t * dy);
-    ((qx - p.x as f64).powi(2) + (qy - p.y as f64).powi(2)).sqrt()
-}
-
-/// Parameter (0..=1) of the point of `a`–`b` nearest to `p`.
-pub(crate) fn project_param(p: Point2, a: Point2, b: Point2) -> f64 {
-    let (dx, dy) = ((b.x - a.x) as f64, (b.y - a.y) as f64);
-    let len2 = dx * dx + dy * dy;
-    if len2 > 0.0 {
-        (((p.x - a.x) as f64 * dx + (p.y - a.y) as f64 * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    }
-}
-
 /// The point at parameter `t` of `a`–`b`, rounded to the nanometre.
 pub(crate) fn lerp(a: Point2, b: Point2, t: f64) -> Point2 {
     Point2::new(
@@ -366,7 +342,7 @@ impl RegionIndex {
         self.edges_between(p.y - tol, p.y + tol).any(|e| {
             e.a.x.min(e.b.x) - tol <= p.x
                 && e.a.x.max(e.b.x) + tol >= p.x
-                && point_segment_distance(p, e.a, e.b) <= tol as f64
+                && segment_distance(p, e.a, e.b) <= tol as f64
         })
     }
 
@@ -396,7 +372,7 @@ impl RegionIndex {
         }
         let mut groups: Vec<u32> = parity.into_iter().filter(|g| g.1).map(|g| g.0).collect();
         for e in self.edges_between(p.y - tol, p.y + tol) {
-            if point_segment_distance(p, e.a, e.b) <= tol as f64 {
+            if segment_distance(p, e.a, e.b) <= tol as f64 {
                 groups.push(e.group);
             }
         }

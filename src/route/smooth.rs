@@ -16,8 +16,8 @@
 //! their neighbours (supersampled straight sections) are dropped, so a straight run is one move.
 
 use super::graph::PreparedLayer;
-use super::index::{RegionIndex, dist, point_segment_distance, project_param};
-use crate::geom::Point2;
+use super::index::{RegionIndex, dist};
+use crate::geom::{Point2, segment_distance, segment_param};
 
 /// Farthest a shortcut looks ahead, in route points: bounds the work per point on long runs.
 const LOOKAHEAD: usize = 64;
@@ -83,9 +83,9 @@ fn drop_collinear(points: Vec<(Point2, bool)>) -> Vec<Point2> {
         let on_line = !fixed
             && kept.last().is_some_and(|&(prev, _)| {
                 points.get(k + 1).is_some_and(|&(next, _)| {
-                    point_segment_distance(p, prev, next) < COLLINEAR_NM
-                        && project_param(p, prev, next) > 0.0
-                        && project_param(p, prev, next) < 1.0
+                    segment_distance(p, prev, next) < COLLINEAR_NM
+                        && segment_param(p, prev, next) > 0.0
+                        && segment_param(p, prev, next) < 1.0
                 })
             });
         if !on_line {

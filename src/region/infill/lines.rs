@@ -19,7 +19,7 @@
 //! boundary). Connectors run along the boundary, so they are printed where the infill meets
 //! the innermost perimeter; they add about one boundary length per family to the extruded length.
 
-use crate::geom::{ExPolygon, Point2, Polygon, Polyline, clip_polylines, scaled};
+use crate::geom::{ExPolygon, Point2, Polygon, Polyline, clip_polylines, scaled, segment_distance};
 
 /// Longest connector, in line spacings (a boundary meeting the lines at 20° needs ~2.9).
 pub const CONNECT_LIMIT: f64 = 3.0;
@@ -181,18 +181,6 @@ fn rings(area: &[ExPolygon]) -> impl Iterator<Item = &Polygon> {
         .flat_map(|e| std::iter::once(&e.contour).chain(&e.holes))
 }
 
-/// Distance (nm) from `p` to the segment `a`–`b`.
-fn distance_to_segment(p: Point2, a: Point2, b: Point2) -> f64 {
-    let (dx, dy) = ((b.x - a.x) as f64, (b.y - a.y) as f64);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        (((p.x - a.x) as f64 * dx + (p.y - a.y) as f64 * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    ((a.x as f64 + t * dx - p.x as f64).powi(2) + (a.y as f64 + t * dy - p.y as f64).powi(2)).sqrt()
-}
-
 /// Whether `p` is inside `area` (even–odd over all rings) or within [`INSIDE_TOLERANCE_NM`] of
 /// its boundary.
 pub fn contains(area: &[ExPolygon], p: Point2) -> bool {
@@ -201,7 +189,7 @@ pub fn contains(area: &[ExPolygon], p: Point2) -> bool {
         let pts = &ring.points;
         for i in 0..pts.len() {
             let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
-            if distance_to_segment(p, a, b) <= INSIDE_TOLERANCE_NM {
+            if segment_distance(p, a, b) <= INSIDE_TOLERANCE_NM {
                 return true;
             }
             if (a.y > p.y) != (b.y > p.y) {
