@@ -4,15 +4,13 @@
 
 use super::args::ConfigSource;
 use super::{Failure, config::resolve};
-use anyhow::{Context, anyhow};
+use anyhow::Context;
 use conduit::config::{CompensateSettings, Config};
-use conduit::conform::orient;
 use conduit::conform::scan::load_scan;
 use conduit::emit::robot::Dialect;
-use conduit::pipeline::conform::robot_program;
-use conduit::robot::compensate::simulate::{self, ErrorModel};
+use conduit::pipeline::compensate as walk;
 use conduit::robot::compensate::substrate::{self, Substrate, SurfaceSpec};
-use conduit::robot::compensate::{self as comp, GapStats, Params, Path as PosePath, gaps};
+use conduit::robot::compensate::{Params, Path as PosePath, gaps};
 use conduit::robot::pattern::{self, PatternParams, Shape};
 use conduit::scene::write_atomically;
 use conduit_poses::Pose;
@@ -291,7 +289,7 @@ fn write_table(path: &Path, comments: &[String], poses: &[Pose]) -> anyhow::Resu
 }
 
 /// With `--program`, writes the compensated `poses` (their dispensing runs) as a robot or
-/// five-axis program; travels clear the highest tip by `conform.travel_clearance`.
+/// five-axis program.
 fn write_program(job: &Job, poses: &[Pose]) -> Result<(), Failure> {
     let (Some(out), Some(name)) = (&job.args.program, &job.args.dialect) else {
         return Ok(());
@@ -299,29 +297,17 @@ fn write_program(job: &Job, poses: &[Pose]) -> Result<(), Failure> {
     let Some(dialect) = Dialect::from_name(name) else {
         return Err(Failure::Usage(format!("unknown program dialect {name:?}")));
     };
-    let (paths, axes) = comp::runs(poses);
-    if paths.is_empty() {
-        return Err(anyhow!(
-            "{}: no dispensing run of two or more poses",
-            job.path.display()
-        )
-        .into());
-    }
-    let top = paths.iter().flatten().map(|p| p.z).fold(f64::MIN, f64::max);
-    let program = orient::program(
-        &paths,
-        &axes,
-        &job.cfg.conform,
-        top + job.cfg.conform.travel_clearance,
-    );
-    let writer = conduit::conform::pressure_params(job.cfg.gcode_params(), &job.cfg.conform)
-        .context("[conform]")?;
-    let name = out
+    let stem = out
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let (text, _) =
-        robot_program(&program, dialect, &job.cfg, &writer, &name).map_err(anyhow::Error::from)?;
+    let text = walk::program(
+        poses,
+        &job.path.display().to_string(),
+        (dialect, &stem),
+        &job.cfg,
+    )
+    .map_err(anyhow::Error::from)?;
     write_atomically(out, |f| f.write_all(&text))
         .with_context(|| format!("{}: cannot write the program", out.display()))?;
     Ok(())
@@ -332,23 +318,6 @@ fn write_report(path: &Path, report: &impl Serialize) -> anyhow::Result<()> {
     let json = serde_json::to_vec_pretty(report).context("serialising the report")?;
     write_atomically(path, |f| f.write_all(&json))
         .with_context(|| format!("{}: cannot write report", path.display()))
-}
-
-/// The report of a pass over measured gaps.
-#[derive(Serialize)]
-struct MeasuredReport {
-    path: String,
-    gaps: String,
-    poses: usize,
-    closed: bool,
-    target_mm: f64,
-    sensor_angle_deg: f64,
-    smoothing_mm: f64,
-    placed_by: gaps::Key,
-    readings: usize,
-    poses_outside_measurement: usize,
-    before_mm: GapStats,
-    correction_mm: comp::CorrectionStats,
 }
 
 /// One pass over measured gaps.
@@ -373,65 +342,31 @@ fn measured(job: &Job, gaps_path: &Path) -> Result<(), Failure> {
             on.outside
         );
     }
-    let pass = comp::compensate_pass(poses, &on.readings, params);
-    let mut comments = header.to_vec();
-    comments.push(format!(
-        "# compensated by conduit compensate: gaps {}, target {} mm, sensor angle {} deg, smoothing {} mm",
-        gaps_path.display(),
-        params.target,
-        params.sensor_angle,
-        params.smoothing
-    ));
-    let report = MeasuredReport {
-        path: path.display().to_string(),
-        gaps: gaps_path.display().to_string(),
-        poses: poses.poses.len(),
-        closed: poses.is_closed(),
-        target_mm: params.target,
-        sensor_angle_deg: params.sensor_angle,
-        smoothing_mm: params.smoothing,
-        placed_by: on.key,
-        readings: on.rows,
-        poses_outside_measurement: on.outside,
-        before_mm: pass.before,
-        correction_mm: pass.correction,
-    };
-    write_table(output, &comments, &pass.poses)?;
-    write_program(job, &pass.poses)?;
+    let done = walk::measured(
+        (poses, &path.display().to_string(), header),
+        (&on, &gaps_path.display().to_string()),
+        params,
+    );
+    write_table(output, &done.comments, &done.poses)?;
+    write_program(job, &done.poses)?;
     if let Some(r) = &args.report {
-        write_report(r, &report)?;
+        write_report(r, &done.report)?;
     }
-    let b = pass.before;
+    let (b, c) = (done.report.before_mm, done.report.correction_mm);
     eprintln!(
         "{}: {} poses; gap before {:.4}..{:.4} mm (variation {:.1} µm, RMS {:.1} µm about {:.1} µm); \
          correction {:.4}..{:.4} mm",
         output.display(),
-        pass.poses.len(),
+        done.poses.len(),
         b.min,
         b.max,
         b.variation * UM,
         b.rms_about_target * UM,
         params.target * UM,
-        pass.correction.min,
-        pass.correction.max
+        c.min,
+        c.max
     );
     Ok(())
-}
-
-/// The report of a simulation.
-#[derive(Serialize)]
-struct SimulatedReport {
-    path: String,
-    surface: String,
-    error_model: ErrorModel,
-    pivot: [f64; 3],
-    poses: usize,
-    target_mm: f64,
-    sensor_angle_deg: f64,
-    smoothing_mm: f64,
-    uncompensated_mm: GapStats,
-    passes: Vec<simulate::PassFigures>,
-    variation_um: Vec<f64>,
 }
 
 /// The measure → compensate loop on simulated gaps.
@@ -446,56 +381,26 @@ fn simulated(job: &Job, spec: &str) -> Result<(), Failure> {
         output,
     } = job;
     let substrate = load_substrate(spec, cfg)?;
-    let model = ErrorModel::from_settings(&cfg.compensate).map_err(anyhow::Error::from)?;
-    let passes = cfg.compensate.passes as usize;
-    let sim = simulate::run(poses, &substrate, &model, params, passes)
-        .with_context(|| path.display().to_string())?;
-    let mut variation = vec![sim.uncompensated.variation * UM];
-    variation.extend(sim.passes.iter().map(|p| p.after.variation * UM));
-    let report = SimulatedReport {
-        path: path.display().to_string(),
-        surface: spec.to_owned(),
-        error_model: model,
-        pivot: [sim.pivot.x, sim.pivot.y, sim.pivot.z],
-        poses: poses.poses.len(),
-        target_mm: params.target,
-        sensor_angle_deg: params.sensor_angle,
-        smoothing_mm: params.smoothing,
-        uncompensated_mm: sim.uncompensated,
-        passes: sim.passes.clone(),
-        variation_um: variation.clone(),
-    };
-    let mut readings = Vec::new();
-    if args.readings_out.is_some() {
-        let s = poses.arc_lengths();
-        let rows: Vec<Vec<f64>> = sim
-            .first_readings
-            .iter()
-            .enumerate()
-            .map(|(i, r)| vec![i as f64, s[i], *r])
-            .collect();
-        readings.push("# simulated gap readings, mm".to_owned());
-        let mut buf = Vec::new();
-        conduit_poses::write_table(&["index", "s", "reading"], &rows, 6, &mut buf)
-            .context("gap readings")?;
-        readings.push(String::from_utf8_lossy(&buf).into_owned());
-    }
-    let mut comments = header.to_vec();
-    comments.push(format!(
-        "# compensated by conduit compensate: {passes} simulated pass(es) on {spec}, target {} mm",
-        params.target
-    ));
-    write_table(output, &comments, &sim.poses)?;
-    write_program(job, &sim.poses)?;
+    let sim = walk::simulated(
+        (poses, &path.display().to_string(), header),
+        (&substrate, spec),
+        params,
+        cfg,
+    )
+    .map_err(anyhow::Error::from)?;
+    let done = &sim.path;
+    write_table(output, &done.comments, &done.poses)?;
+    write_program(job, &done.poses)?;
     if let Some(r) = &args.readings_out {
-        let text = readings.join("\n");
-        write_atomically(r, |f| f.write_all(text.as_bytes()))
+        write_atomically(r, |f| f.write_all(sim.readings.as_bytes()))
             .with_context(|| format!("{}: cannot write", r.display()))?;
     }
     if let Some(r) = &args.report {
-        write_report(r, &report)?;
+        write_report(r, &done.report)?;
     }
-    let figures: Vec<String> = variation
+    let figures: Vec<String> = done
+        .report
+        .variation_um
         .iter()
         .enumerate()
         .map(|(k, v)| {

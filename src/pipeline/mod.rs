@@ -5,6 +5,7 @@
 //! returns the G-code bytes with a [`SliceSummary`] for the report; [`slice_scene_with`] adds a
 //! circuit ([`electronics`]).
 
+pub mod compensate;
 pub mod conform;
 pub mod jet;
 

@@ -307,6 +307,14 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_spacing_model_is_the_rounded_rectangle_bead() {
+        // A gap of thickness t takes t·h: the spacing model's width t + h·(1 − π/4).
+        let w = crate::program::BeadShape::RoundedRectangle.width_for_area(0.3 * 0.2, 0.2);
+        assert!((w - spacing(w, 0.2) - 0.2 * (1.0 - PI / 4.0)).abs() < 1e-15);
+        assert!((spacing(w, 0.2) - 0.3).abs() < 1e-12);
+    }
+
+    #[test]
     fn spacing_follows_the_rounded_rectangle_model() {
         // 0.45 − 0.2·(1 − π/4) = 0.45 − 0.0429204 = 0.4070796
         assert!((spacing(0.45, 0.2) - 0.407_079_6).abs() < 1e-7);
