@@ -687,9 +687,12 @@ mod tests {
     use super::*;
     use crate::parse;
 
-    fn run(machine: &mut Machine, src: &str) -> Vec<Move> {
+    /// The moves of `src` on a Marlin machine, and the machine after them.
+    fn run(src: &str) -> (Machine, Vec<Move>) {
         let g = parse(src.as_bytes()).expect("test G-code parses");
-        g.lines.iter().filter_map(|l| machine.step(l)).collect()
+        let mut machine = Machine::new(Firmware::Marlin, 25.0);
+        let moves = g.lines.iter().filter_map(|l| machine.step(l)).collect();
+        (machine, moves)
     }
 
     fn e_modes(firmware: Firmware) -> Vec<bool> {
@@ -713,18 +716,14 @@ mod tests {
 
     #[test]
     fn positions_are_unknown_until_homed_set_or_moved_to() {
-        let mut m = Machine::new(Firmware::Marlin, 25.0);
-        let mv = run(
-            &mut m,
-            "G91\nG1 X1\nG90\nG1 Y2\nG28 Z0\nG92 X5\nG1 X6 F600\n",
-        );
+        let (_, mv) = run("G91\nG1 X1\nG90\nG1 Y2\nG28 Z0\nG92 X5\nG1 X6 F600\n");
         assert_eq!(mv[0].to, [None; 3]);
         assert_eq!(mv[0].length, 0.0);
         assert_eq!(mv[1].to, [None, Some(2.0), None]);
         assert_eq!(mv[2].from, [Some(5.0), Some(2.0), Some(0.0)]);
         assert_eq!((mv[2].length, mv[2].feed), (1.0, 10.0));
         // Inches scale positions, E and F.
-        let mv = run(&mut m, "G20\nG1 X1 E1 F60\n");
+        let (m, mv) = run("G28\nG20\nG1 X1 E1 F60\n");
         assert_eq!(mv[0].to[0], Some(25.4));
         assert_eq!((mv[0].e, mv[0].feed), (25.4, 25.4));
         assert!(m.is_inches() && !m.is_relative());
@@ -732,11 +731,7 @@ mod tests {
 
     #[test]
     fn arcs_are_sampled_and_measured() {
-        let mut m = Machine::new(Firmware::Marlin, 25.0);
-        let mv = run(
-            &mut m,
-            "G28\nG1 X10 Y0\nG3 X0 Y10 I-10 J0 E1\nG2 X10 Y0 R-10\nG2 X0 Y0 R1\n",
-        );
+        let (_, mv) = run("G28\nG1 X10 Y0\nG3 X0 Y10 I-10 J0 E1\nG2 X10 Y0 R-10\nG2 X0 Y0 R1\n");
         assert!(mv[1].arc && mv[1].extruding);
         assert!((mv[1].length - 5.0 * PI).abs() < 1e-9);
         assert_eq!(mv[1].path.len(), 10);
@@ -793,8 +788,7 @@ mod tests {
         assert!(survey.e_is_relative());
 
         // The firmware reading: first command only, `G92` alone does nothing, first X wins.
-        let mut firmware = Machine::new(Firmware::Marlin, 25.0);
-        run(&mut firmware, src);
+        let (firmware, _) = run(src);
         assert_eq!(firmware.position(), [Some(25.4), Some(25.4), None]);
         assert_eq!((firmware.tool(), firmware.e()), (1, 0.0));
         assert!(!firmware.e_is_relative());
