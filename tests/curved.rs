@@ -12,9 +12,10 @@ use conduit::curved::{HeightField, LAYER_COMMENT};
 use conduit::geom::Point3;
 use conduit::pipeline::place_on_bed;
 use conduit::scene::{LoadOptions, load_scene};
+use conduit_gcode::{Firmware, Machine};
 use serde_json::Value;
 
-use crate::support::{corpus, stderr, temp_dir};
+use crate::support::{corpus, stderr, temp_dir, xyz};
 
 type Tri = [[f64; 3]; 3];
 
@@ -115,57 +116,51 @@ fn slice(dir: &Path, model: &Path, name: &str, extra: &[&str]) -> Run {
     }
 }
 
+/// Steps the modal machine (Marlin) over `gcode`: `each` gets every line's text and, when the
+/// line moves, its start, end and E change.
+fn replay_lines(gcode: &str, mut each: impl FnMut(&str, Option<([f64; 3], [f64; 3], f64)>)) {
+    let g = conduit_gcode::parse(gcode.as_bytes()).expect("G-code parses");
+    let mut machine = Machine::new(Firmware::Marlin, 25.0);
+    for line in &g.lines {
+        let mv = machine.step(line).map(|m| (xyz(m.from), xyz(m.to), m.e));
+        each(&String::from_utf8_lossy(&line.text), mv);
+    }
+}
+
+/// Whether a move changes X or Y.
+fn moves_xy(from: [f64; 3], to: [f64; 3]) -> bool {
+    from[0] != to[0] || from[1] != to[1]
+}
+
 /// The end points of every extruding move inside the curved blocks, with their block's depth.
 fn curved_points(gcode: &str) -> Vec<([f64; 3], f64)> {
-    let (mut pos, mut e) = ([0.0f64; 3], 0.0f64);
     let mut depth: Option<f64> = None;
     let mut out = Vec::new();
-    for line in gcode.lines() {
+    replay_lines(gcode, |line, mv| {
         if let Some(rest) = line.strip_prefix(&format!("; {LAYER_COMMENT} layer ")) {
             depth = rest.split_whitespace().nth(2).and_then(|d| d.parse().ok());
-            continue;
-        }
-        if line.starts_with(";LAYER_CHANGE") {
+        } else if line.starts_with(";LAYER_CHANGE") {
             depth = None;
         }
-        let code = line.split(';').next().unwrap_or("").trim();
-        let mut words = code.split_whitespace();
-        let Some(cmd) = words.next() else { continue };
-        let mut new_e = None;
-        for w in words {
-            let (k, v) = w.split_at(1);
-            let Ok(v) = v.parse::<f64>() else { continue };
-            match (cmd, k) {
-                ("G0" | "G1", "X") => pos[0] = v,
-                ("G0" | "G1", "Y") => pos[1] = v,
-                ("G0" | "G1", "Z") => pos[2] = v,
-                ("G0" | "G1", "E") => new_e = Some(v),
-                ("G92", "E") => e = v,
-                _ => {}
+        if let (Some((_, to, de)), Some(d)) = (mv, depth) {
+            if de > 0.0 {
+                out.push((to, d));
             }
         }
-        if let Some(ne) = new_e {
-            if let (Some(d), true) = (depth, ne > e) {
-                out.push((pos, d));
-            }
-            e = ne;
-        }
-    }
+    });
     out
 }
 
 /// Every extruding move of `gcode` as a bead (nozzle path, `;WIDTH:`/`;HEIGHT:` in effect),
 /// and the index of the first bead of the first curved layer.
 fn beads(gcode: &str) -> (Vec<Bead>, Option<usize>) {
-    let (mut pos, mut e) = ([0.0f64; 3], 0.0f64);
     let (mut width, mut height) = (0.45, 0.2);
-    let mut relative_e = false;
     let mut out = Vec::new();
     let mut first_curved = None;
     // Beads of curved layers lie on the surface, no steeper than curved.max_angle.
     let mut lean_deg = 0.0;
     let max_angle = Config::default().curved.max_angle;
-    for line in gcode.lines() {
+    replay_lines(gcode, |line, mv| {
         if line.starts_with(&format!("; {LAYER_COMMENT} layer ")) {
             first_curved.get_or_insert(out.len());
             lean_deg = max_angle;
@@ -179,44 +174,18 @@ fn beads(gcode: &str) -> (Vec<Bead>, Option<usize>) {
         if let Some(v) = line.strip_prefix(";HEIGHT:") {
             height = v.trim().parse().unwrap_or(height);
         }
-        let code = line.split(';').next().unwrap_or("").trim();
-        let mut words = code.split_whitespace();
-        let Some(cmd) = words.next() else { continue };
-        match cmd {
-            "M82" => relative_e = false,
-            "M83" => relative_e = true,
-            _ => {}
-        }
-        let from = pos;
-        let mut new_e = None;
-        for w in words {
-            let (k, v) = w.split_at(1);
-            let Ok(v) = v.parse::<f64>() else { continue };
-            match (cmd, k) {
-                ("G0" | "G1", "X") => pos[0] = v,
-                ("G0" | "G1", "Y") => pos[1] = v,
-                ("G0" | "G1", "Z") => pos[2] = v,
-                ("G0" | "G1", "E") => new_e = Some(v),
-                ("G92", "E") => e = v,
-                _ => {}
-            }
-        }
-        if let Some(ne) = new_e {
-            let de = if relative_e { ne } else { ne - e };
-            if !relative_e {
-                e = ne;
-            }
-            if de > 0.0 && (from[0] != pos[0] || from[1] != pos[1]) {
+        if let Some((from, to, de)) = mv {
+            if de > 0.0 && moves_xy(from, to) {
                 out.push(Bead {
                     from: Point3::new(from[0], from[1], from[2]),
-                    to: Point3::new(pos[0], pos[1], pos[2]),
+                    to: Point3::new(to[0], to[1], to[2]),
                     width,
                     height,
                     lean_deg,
                 });
             }
         }
-    }
+    });
     (out, first_curved)
 }
 
@@ -418,55 +387,25 @@ fn bed_offset(model: &Path) -> [f64; 2] {
 pub(crate) fn curved_segments(gcode: &str) -> Vec<([f64; 3], [f64; 3], f64)> {
     let mut out = Vec::new();
     let mut depth: Option<f64> = None;
-    let mut pos = [0.0f64; 3];
     let (beads, _) = beads(gcode);
     // Pair each bead with the block it is in by replaying the comments in step.
     let mut it = beads.iter();
-    let (mut e, mut relative_e) = (0.0f64, false);
-    for line in gcode.lines() {
+    replay_lines(gcode, |line, mv| {
         if let Some(rest) = line.strip_prefix(&format!("; {LAYER_COMMENT} layer ")) {
             depth = rest.split_whitespace().nth(2).and_then(|d| d.parse().ok());
-            continue;
-        }
-        if line.starts_with(";LAYER_CHANGE") {
+        } else if line.starts_with(";LAYER_CHANGE") {
             depth = None;
         }
-        let code = line.split(';').next().unwrap_or("").trim();
-        let mut words = code.split_whitespace();
-        let Some(cmd) = words.next() else { continue };
-        match cmd {
-            "M82" => relative_e = false,
-            "M83" => relative_e = true,
-            _ => {}
-        }
-        let from = pos;
-        let mut new_e = None;
-        for w in words {
-            let (k, v) = w.split_at(1);
-            let Ok(v) = v.parse::<f64>() else { continue };
-            match (cmd, k) {
-                ("G0" | "G1", "X") => pos[0] = v,
-                ("G0" | "G1", "Y") => pos[1] = v,
-                ("G0" | "G1", "Z") => pos[2] = v,
-                ("G0" | "G1", "E") => new_e = Some(v),
-                ("G92", "E") => e = v,
-                _ => {}
-            }
-        }
-        if let Some(ne) = new_e {
-            let de = if relative_e { ne } else { ne - e };
-            if !relative_e {
-                e = ne;
-            }
-            if de > 0.0 && (from[0] != pos[0] || from[1] != pos[1]) {
+        if let Some((from, to, de)) = mv {
+            if de > 0.0 && moves_xy(from, to) {
                 let b = it.next();
-                assert!(b.is_some_and(|b| b.to.x == pos[0] && b.to.y == pos[1]));
+                assert!(b.is_some_and(|b| b.to.x == to[0] && b.to.y == to[1]));
                 if let Some(d) = depth {
-                    out.push((from, pos, d));
+                    out.push((from, to, d));
                 }
             }
         }
-    }
+    });
     out
 }
 
@@ -542,10 +481,9 @@ fn curved_corpus_wing_and_car_print_curved_tops_on_the_surface_without_head_hits
 
 /// Extruding moves of the planar layers (outside the curved blocks): (layer, role, from, to).
 fn planar_segments(gcode: &str) -> Vec<(usize, String, [f64; 3], [f64; 3])> {
-    let (mut pos, mut e) = ([0.0f64; 3], 0.0f64);
     let (mut layer, mut curved, mut role) = (0usize, false, String::new());
     let mut out = Vec::new();
-    for line in gcode.lines() {
+    replay_lines(gcode, |line, mv| {
         if line.starts_with(";LAYER_CHANGE") {
             layer += 1;
             curved = false;
@@ -556,30 +494,12 @@ fn planar_segments(gcode: &str) -> Vec<(usize, String, [f64; 3], [f64; 3])> {
         if let Some(r) = line.strip_prefix(";TYPE:") {
             role = r.trim().to_owned();
         }
-        let code = line.split(';').next().unwrap_or("").trim();
-        let mut words = code.split_whitespace();
-        let Some(cmd) = words.next() else { continue };
-        let from = pos;
-        let mut new_e = None;
-        for w in words {
-            let (k, v) = w.split_at(1);
-            let Ok(v) = v.parse::<f64>() else { continue };
-            match (cmd, k) {
-                ("G0" | "G1", "X") => pos[0] = v,
-                ("G0" | "G1", "Y") => pos[1] = v,
-                ("G0" | "G1", "Z") => pos[2] = v,
-                ("G0" | "G1", "E") => new_e = Some(v),
-                ("G92", "E") => e = v,
-                _ => {}
+        if let Some((from, to, de)) = mv {
+            if de > 0.0 && !curved && moves_xy(from, to) {
+                out.push((layer, role.clone(), from, to));
             }
         }
-        if let Some(ne) = new_e {
-            if ne > e && !curved && (from[0] != pos[0] || from[1] != pos[1]) {
-                out.push((layer, role.clone(), from, pos));
-            }
-            e = ne;
-        }
-    }
+    });
     out
 }
 

@@ -1,6 +1,8 @@
 //! `conduit slice --circuit --placement`: the bundled LED + coin-cell demo built into a block.
 
-use crate::support::{conduit, sample, stderr, temp_dir};
+use conduit_gcode::{Firmware, Machine};
+
+use crate::support::{conduit, sample, stderr, temp_dir, xyz};
 use serde_json::Value;
 
 /// One extruding move of the replayed G-code.
@@ -36,73 +38,40 @@ fn replay(text: &str) -> Replayed {
         extrusions: Vec::new(),
         events: Vec::new(),
     };
-    let (mut tool, mut role, mut layer_z) = (0usize, String::new(), 0.0f64);
-    let (mut pos, mut e, mut relative_e) = ([0.0f64; 3], 0.0f64, false);
+    let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
+    let mut machine = Machine::new(Firmware::Marlin, 25.0);
+    let mut layer_z = 0.0f64;
     // The paste valve (the default paste_on/off snippets end in these comments).
     let mut valve = false;
-    for line in text.lines() {
-        if line.ends_with("; paste on") {
+    for line in &g.lines {
+        let text = String::from_utf8_lossy(&line.text);
+        if text.ends_with("; paste on") {
             valve = true;
-        } else if line.ends_with("; paste off") {
+        } else if text.ends_with("; paste off") {
             valve = false;
         }
-        if let Some(r) = line.strip_prefix(";TYPE:") {
-            role = r.to_owned();
-        } else if let Some(z) = line.strip_prefix(";Z:") {
+        if let Some(z) = text.strip_prefix(";Z:") {
             layer_z = z.parse().expect(";Z: number");
-        } else if let Some(rest) = line.strip_prefix(";PICK_AND_PLACE PART=") {
+        } else if let Some(rest) = text.strip_prefix(";PICK_AND_PLACE PART=") {
             let part = rest.split(' ').next().unwrap_or_default().to_owned();
             out.events.push((part, layer_z));
-        } else if let Some(rest) = line.strip_prefix(";MANUAL_INSERT PART=") {
+        } else if let Some(rest) = text.strip_prefix(";MANUAL_INSERT PART=") {
             out.events.push((rest.to_owned(), layer_z));
         }
-        let code = line.split(';').next().unwrap_or_default().trim();
-        let mut words = code.split_whitespace();
-        match words.next() {
-            Some(t) if t.starts_with('T') && t.len() > 1 => {
-                tool = t[1..].parse().expect("tool number");
-            }
-            Some("M83") => relative_e = true,
-            Some("M82") => relative_e = false,
-            Some("G92") => {
-                for w in words {
-                    if let Some(v) = w.strip_prefix('E') {
-                        e = v.parse().expect("E");
-                    }
-                }
-            }
-            Some("G0" | "G1") => {
-                let mut to = pos;
-                let mut de = 0.0;
-                for w in words {
-                    let (k, v) = w.split_at(1);
-                    let v: f64 = v.parse().expect("a number");
-                    match k {
-                        "X" => to[0] = v,
-                        "Y" => to[1] = v,
-                        "Z" => to[2] = v,
-                        "E" if relative_e => de = v,
-                        "E" => {
-                            de = v - e;
-                            e = v;
-                        }
-                        _ => {}
-                    }
-                }
-                let moves_xy = to[0] != pos[0] || to[1] != pos[1];
-                // Paste tools carry no E: their moves with the valve open are the traces.
-                if moves_xy && (de > 0.0 || (tool == 1 && valve)) {
-                    out.extrusions.push(Extrusion {
-                        tool,
-                        role: role.clone(),
-                        z: to[2],
-                        from: [pos[0], pos[1]],
-                        to: [to[0], to[1]],
-                    });
-                }
-                pos = to;
-            }
-            _ => {}
+        let Some(m) = machine.step(line) else {
+            continue;
+        };
+        let (from, to) = (xyz(m.from), xyz(m.to));
+        let moves_xy = to[0] != from[0] || to[1] != from[1];
+        // Paste tools carry no E: their moves with the valve open are the traces.
+        if moves_xy && (m.e > 0.0 || (m.tool == 1 && valve)) {
+            out.extrusions.push(Extrusion {
+                tool: m.tool,
+                role: m.role.as_deref().unwrap_or_default().to_owned(),
+                z: to[2],
+                from: [from[0], from[1]],
+                to: [to[0], to[1]],
+            });
         }
     }
     out

@@ -6,9 +6,9 @@
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-use conduit::check::{Move, Replay};
-use conduit::config::{Flavor, JetSettings};
+use conduit::config::JetSettings;
 use conduit::jet::{ModelInput, accumulation};
+use conduit_gcode::{Firmware, Machine, Move};
 use serde_json::Value;
 
 use crate::support::{conduit, sample, stderr, temp_dir};
@@ -67,7 +67,7 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
 /// moves after it at the jetting feed, up to the next travel, still belong to the run.
 fn replay(gcode: &[u8], travel_speed: f64, on_the_fly: bool) -> (Vec<Run>, Vec<String>) {
     let g = conduit_gcode::parse(gcode).expect("the G-code parses");
-    let mut r = Replay::new(Flavor::Marlin, 25.0);
+    let mut r = Machine::new(Firmware::Marlin, 25.0);
     let mut open = false;
     let mut closing = false;
     let mut runs = Vec::new();

@@ -15,7 +15,9 @@ use conduit::geom::Transform;
 use conduit::scene::{LoadOptions, MeshFormat, Scene, load_scene, save};
 use serde_json::Value;
 
-use crate::support::{conduit, corpus, root, sample, stderr, stdout, temp_dir};
+use conduit_gcode::{Firmware, Machine};
+
+use crate::support::{conduit, corpus, root, sample, stderr, stdout, temp_dir, xyz};
 
 /// Tolerance for "the same point" in G-code coordinates, mm (1 µm; XYZ are written to 3
 /// decimals, so equal points are written identically).
@@ -122,7 +124,7 @@ fn two_part_3mf(dir: &Path) -> PathBuf {
 // Replaying G-code
 // ---------------------------------------------------------------------------------------------
 
-/// One `G0`/`G1` move that changes X or Y, with the state it ran in.
+/// One move that changes X or Y, with the state it ran in.
 #[derive(Debug, Clone)]
 struct Move {
     /// 1-based line number.
@@ -190,20 +192,14 @@ fn um(mm: f64) -> i64 {
     (mm * 1000.0).round() as i64
 }
 
-/// Replays `text`: absolute/relative XYZ (`G90`/`G91`) and E (`M82`/`M83`), `G92`, `T<n>`,
-/// `M104`/`M109`, PrusaSlicer's `;TYPE:`/`;WIDTH:`/`;HEIGHT:`/`;Z:` markers, and the paste
+/// Replays `text` on the modal machine (Marlin: positions, modes, `G92`, `T<n>`, `;TYPE:` and
+/// `;WIDTH:`), with `M104`/`M109`, PrusaSlicer's `;HEIGHT:`/`;Z:` markers, and the paste
 /// snippets `paste_on`/`paste_off` (their first lines) when given.
 fn replay_with_paste(text: &str, paste: Option<(&str, &str)>) -> Replay {
     let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
     let mut r = Replay::default();
-    let mut pos = [0.0f64; 3];
-    let mut e = 0.0f64;
-    let mut abs_xyz = true;
-    let mut abs_e = true;
-    let mut role = String::new();
-    let mut width = None;
+    let mut machine = Machine::new(Firmware::Marlin, 25.0);
     let mut height = None;
-    let mut tool = 0usize;
     let mut layer_um = None;
     let mut paste_on = false;
     for line in &g.lines {
@@ -219,93 +215,42 @@ fn replay_with_paste(text: &str, paste: Option<(&str, &str)>) -> Replay {
         r.lines.push(raw);
         if let Some(c) = line.comment_text() {
             let num = |s: &str| s.trim().parse::<f64>().expect("a number after the marker");
-            if let Some(t) = c.strip_prefix("TYPE:") {
-                role = t.to_owned();
-            } else if let Some(w) = c.strip_prefix("WIDTH:") {
-                width = Some(num(w));
-            } else if let Some(h) = c.strip_prefix("HEIGHT:") {
+            if let Some(h) = c.strip_prefix("HEIGHT:") {
                 height = Some(num(h));
             } else if let Some(z) = c.strip_prefix("Z:") {
                 layer_um = Some(um(num(z)));
                 r.layer_comments_um.push(um(num(z)));
             }
         }
-        let Some((letter, number)) = line.command() else {
-            continue;
-        };
-        match (letter, number as u32) {
-            (b'G', 0 | 1) => {
-                let mut to = pos;
-                for (k, axis) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
-                    if let Some(v) = line.get(axis) {
-                        to[k] = if abs_xyz { v } else { pos[k] + v };
-                    }
-                }
-                let mut de = 0.0;
-                if let Some(v) = line.get(b'E') {
-                    let new_e = if abs_e { v } else { e + v };
-                    de = new_e - e;
-                    e = new_e;
-                }
-                if to[0] != pos[0] || to[1] != pos[1] {
-                    r.moves.push(Move {
-                        line: line.number,
-                        from: pos,
-                        to,
-                        de,
-                        role: role.clone(),
-                        width,
-                        height,
-                        tool,
-                        layer_um,
-                        paste_on,
-                    });
-                }
-                pos = to;
+        if let Some((b'M', n @ (104.0 | 109.0))) = line.command() {
+            let t = line.get(b'T').map_or(machine.tool(), |t| t as usize);
+            r.heats.push(Heat {
+                line: line.number,
+                tool: t,
+                celsius: line.get(b'S').expect("M104/M109 with S"),
+                wait: n == 109.0,
+            });
+        }
+        let step = machine.step_with(line, |_, c| {
+            if let conduit_gcode::Command::Tool(t) = c {
+                r.tool_selects.push((line.number, t));
             }
-            (b'G', 90) => {
-                abs_xyz = true;
-                abs_e = true;
-            }
-            (b'G', 91) => {
-                abs_xyz = false;
-                abs_e = false;
-            }
-            (b'G', 92) => {
-                if let Some(v) = line.get(b'E') {
-                    e = v;
-                }
-                for (k, axis) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
-                    if let Some(v) = line.get(axis) {
-                        pos[k] = v;
-                    }
-                }
-            }
-            (b'G', 28) => {
-                let axes = [b'X', b'Y', b'Z'];
-                let all = axes.iter().all(|a| line.get(*a).is_none());
-                for (p, axis) in pos.iter_mut().zip(axes) {
-                    if all || line.get(axis).is_some() {
-                        *p = 0.0;
-                    }
-                }
-            }
-            (b'M', 82) => abs_e = true,
-            (b'M', 83) => abs_e = false,
-            (b'M', n @ (104 | 109)) => {
-                let t = line.get(b'T').map_or(tool, |t| t as usize);
-                r.heats.push(Heat {
-                    line: line.number,
-                    tool: t,
-                    celsius: line.get(b'S').expect("M104/M109 with S"),
-                    wait: n == 109,
-                });
-            }
-            (b'T', n) => {
-                tool = n as usize;
-                r.tool_selects.push((line.number, tool));
-            }
-            _ => {}
+        });
+        let Some(m) = step else { continue };
+        let (from, to) = (xyz(m.from), xyz(m.to));
+        if to[0] != from[0] || to[1] != from[1] {
+            r.moves.push(Move {
+                line: line.number,
+                from,
+                to,
+                de: m.e,
+                role: m.role.as_deref().unwrap_or_default().to_owned(),
+                width: m.width,
+                height,
+                tool: m.tool,
+                layer_um,
+                paste_on,
+            });
         }
     }
     r

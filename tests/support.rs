@@ -1,4 +1,5 @@
-//! Helpers shared by the integration tests: running the binary, finding the corpus, temp dirs.
+//! Helpers shared by the integration tests: running the binary, finding the corpus, temp dirs,
+//! positions of replayed moves.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -83,4 +84,9 @@ pub fn write_stl(path: &Path, tris: &[[conduit::geom::Point3; 3]]) {
         b.extend([0, 0]);
     }
     std::fs::write(path, b).expect("STL written");
+}
+
+/// A replayed position with unknown axes at 0 (where firmware counts from before homing).
+pub fn xyz(p: conduit_gcode::Position) -> [f64; 3] {
+    p.map(|c| c.unwrap_or(0.0))
 }

@@ -1,12 +1,11 @@
-//! The checker: heaters, time, statistics and findings on top of the motion [`Replay`] (see the
+//! The checker: heaters, time, statistics and findings on top of the modal [`Machine`] (see the
 //! module docs of [`super`]).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::f64::consts::PI;
 
-use conduit_gcode::{Gcode, Line};
+use conduit_gcode::{Gcode, Line, Machine, Move, Position};
 
-use super::replay::{Move, Position, Replay};
 use super::time::Planner;
 use super::{Bounds3, CheckParams, CheckReport, Finding, FindingKind, Severity, Stats, ToolUsage};
 use crate::config::ToolKind;
@@ -33,9 +32,9 @@ struct Usage {
     extrusion_moves: usize,
 }
 
-struct Machine<'a> {
+struct Checker<'a> {
     p: &'a CheckParams,
-    replay: Replay,
+    machine: Machine,
     heaters: Vec<Heater>,
     macro_seen: Option<String>,
     planner: Planner,
@@ -67,9 +66,9 @@ const NON_HEATING_MACROS: &[&str] = &[
 ];
 
 pub(super) fn replay(g: &Gcode, p: &CheckParams) -> CheckReport {
-    let mut m = Machine {
+    let mut m = Checker {
         p,
-        replay: Replay::new(p.flavor, p.default_feedrate),
+        machine: Machine::new(p.flavor, p.default_feedrate),
         heaters: Vec::new(),
         macro_seen: None,
         planner: Planner::new(p.max_acceleration, p.jerk),
@@ -89,7 +88,7 @@ pub(super) fn replay(g: &Gcode, p: &CheckParams) -> CheckReport {
     m.finish(g.lines.len())
 }
 
-impl Machine<'_> {
+impl Checker<'_> {
     /// Estimated print time so far, s.
     fn now(&self) -> f64 {
         self.planner.total + self.dwell
@@ -120,10 +119,10 @@ impl Machine<'_> {
     }
 
     fn step(&mut self, line: &Line) {
-        // The replay applies motion and the modal state (units, modes, G92, homing, tool);
+        // The machine applies motion and the modal state (units, modes, G92, homing, tool);
         // the checker adds heaters, time and statistics.
-        let tool_before = self.replay.tool();
-        if let Some(mv) = self.replay.step(line) {
+        let tool_before = self.machine.tool();
+        if let Some(mv) = self.machine.step(line) {
             self.motion(&mv);
             return;
         }
@@ -137,7 +136,7 @@ impl Machine<'_> {
             return;
         }
         let n = number as i64;
-        let current = self.replay.tool();
+        let current = self.machine.tool();
         match (letter, n) {
             (b'G', 4) => {
                 let ms = line.get(b'P').unwrap_or(0.0) + line.get(b'S').unwrap_or(0.0) * 1000.0;
@@ -352,7 +351,7 @@ impl Machine<'_> {
     }
 
     fn check_temperature(&mut self, line: usize) {
-        let tool = self.replay.tool();
+        let tool = self.machine.tool();
         let tc = self.p.tool(tool);
         if tc.kind != ToolKind::Filament {
             return;
@@ -427,7 +426,7 @@ impl Machine<'_> {
     }
 
     fn check_flow(&mut self, line: usize, de: f64, length: f64) {
-        let tc = self.p.tool(self.replay.tool());
+        let tc = self.p.tool(self.machine.tool());
         if tc.kind != ToolKind::Filament || length < self.p.flow_check_min_length {
             return;
         }

@@ -52,15 +52,30 @@
 //!
 //! # Moves
 //!
-//! The motion replay is shared: [`moves`] returns every move of a file (ends, path, E change,
-//! tool, feature role, width, layer, line) for other consumers such as
-//! [`emit::preview`](crate::emit::preview), and the checker steps the same [`Replay`].
+//! The motion replay is the modal [`Machine`] of `conduit-gcode` (see
+//! [`conduit_gcode::machine`]), re-exported here: [`moves`] returns every move of a file (ends,
+//! path, E change, tool, feature role, width, layer, line) for other consumers such as
+//! [`emit::preview`](crate::emit::preview), and the checker steps the same machine, with
+//! [`CheckParams::flavor`] as its [`Firmware`].
 
 mod machine;
-mod replay;
 mod time;
 
-pub use replay::{Move, Moves, Position, Replay, moves};
+pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves};
+
+/// [`Machine`] under the name the checker uses for it.
+pub type Replay = Machine;
+
+impl From<Flavor> for Firmware {
+    /// The firmware dialect of a printer's `flavor`.
+    fn from(flavor: Flavor) -> Self {
+        match flavor {
+            Flavor::Marlin => Firmware::Marlin,
+            Flavor::Klipper => Firmware::Klipper,
+            Flavor::RepRapFirmware => Firmware::RepRapFirmware,
+        }
+    }
+}
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -412,17 +412,3 @@ fn default_start_and_end_gcode_check_clean() -> Result<(), crate::config::Config
     assert_eq!(r.stats.max_bed_temperature, Some(60.0));
     Ok(())
 }
-
-#[test]
-fn paste_moves_between_dispense_markers_print_without_e() {
-    // A paste tool writes no E: the writer's `;DISPENSE:` markers say when its valve is open.
-    let g = conduit_gcode::parse(
-        b"G28\nT1\nG1 X0 Y0 Z1\n;DISPENSE:ON\nG1 X10 Y0\nG1 X10 Y10 Z1.5\n;DISPENSE:OFF\nG1 X0 Y0\n",
-    )
-    .expect("parses");
-    let m = replay::moves(&g, Flavor::Marlin);
-    let printing: Vec<bool> = m.moves.iter().map(|m| m.extruding).collect();
-    assert_eq!(printing, vec![false, true, true, false]);
-    // Both heights of the dispensed moves are printed layers.
-    assert_eq!(m.layer_z, vec![1.0, 1.5]);
-}

@@ -2,10 +2,10 @@
 //!
 //! Place in the pipeline: used by [`super::rewrite`] on every extruding move of a layer that has
 //! cuts. A move is a polyline (a straight `G1` has two points, an arc the samples of
-//! [`crate::check::Move::path`]); [`split_move`] finds the stretches of it inside the cut region
+//! [`conduit_gcode::Move::path`]); [`split_move`] finds the stretches of it inside the cut region
 //! and returns the move as [`Piece`]s in order: stretches outside keep extruding, each with the
-//! move's E scaled by its share of the move's length (so the E of the kept pieces is exact, up
-//! to the 5 decimals of the output); stretches inside become travels.
+//! move's E scaled by its share of the move's length (so the E of the kept pieces is exact, up to
+//! the 5 decimals of the output); stretches inside become travels.
 //!
 //! The region is tested in floating point: each segment is intersected with every edge of the
 //! region's rings, and each stretch between two crossings is inside when its midpoint is (even-odd

@@ -30,7 +30,7 @@
 //! An extruding move names X or Y and increases E (as `conduit check` counts them). Consecutive
 //! extruding moves form one [`ExtrusionPath`] while they join end to start and keep the tool,
 //! feature and width; travels, retractions and tool changes end a path. Arcs are sampled as in
-//! [`crate::check::Move::path`]. A path's width is the latest `;WIDTH:` / `; LINE_WIDTH:`
+//! [`conduit_gcode::Move::path`]. A path's width is the latest `;WIDTH:` / `; LINE_WIDTH:`
 //! comment when the host writes them; otherwise it is worked out from the flow: the filament
 //! volume `E·π·d²/4` over the path length is the bead's cross-section, and the bead model of
 //! [`crate::program::extrusion`] (a rounded rectangle of the layer's height; a round thread for
@@ -40,13 +40,12 @@
 use std::ops::Range;
 use std::sync::Arc;
 
-use conduit_gcode::{Gcode, Line};
+use conduit_gcode::{Gcode, Line, Machine, Move};
 use serde::Serialize;
 
 use super::comments::{HostComment, LayerMarker, read_comment};
 use super::host::Host;
 use super::roles::role_of;
-use crate::check::{Move, Replay};
 use crate::config::{Config, Flavor, ToolKind};
 use crate::geom::Point3;
 use crate::program::Role;
@@ -350,7 +349,7 @@ impl HostLayers {
 pub fn read_layers(gcode: &Gcode, markers: &[LayerMarker], params: &LayerParams) -> HostLayers {
     let mut walk = Walk {
         by_comments: !markers.is_empty(),
-        replay: Replay::new(params.flavor, DEFAULT_FEEDRATE),
+        machine: Machine::new(params.flavor, DEFAULT_FEEDRATE),
         done: Vec::new(),
         current: None,
         feature: None,
@@ -415,7 +414,7 @@ struct LayerBuilder {
 }
 
 impl LayerBuilder {
-    fn new(start: usize, replay: &Replay) -> Self {
+    fn new(start: usize, machine: &Machine) -> Self {
         Self {
             start,
             markers: Vec::new(),
@@ -424,8 +423,8 @@ impl LayerBuilder {
             declared_height: None,
             first_extrusion: None,
             last_extrusion: None,
-            e_relative: replay.e_is_relative(),
-            tool_at_start: replay.tool(),
+            e_relative: machine.e_is_relative(),
+            tool_at_start: machine.tool(),
             tools: Vec::new(),
             retraction: None,
             paths: Vec::new(),
@@ -621,7 +620,7 @@ fn role_widths(paths: &[ExtrusionPath]) -> Vec<RoleWidth> {
 /// The state of one walk through the file.
 struct Walk {
     by_comments: bool,
-    replay: Replay,
+    machine: Machine,
     done: Vec<LayerBuilder>,
     current: Option<LayerBuilder>,
     /// The feature from the latest `;TYPE:` / `; FEATURE:` comment.
@@ -642,7 +641,7 @@ impl Walk {
             done.close_path();
             self.done.push(done);
         }
-        self.current = Some(LayerBuilder::new(start, &self.replay));
+        self.current = Some(LayerBuilder::new(start, &self.machine));
     }
 
     fn line(&mut self, index: usize, line: &Line) {
@@ -697,9 +696,9 @@ impl Walk {
                 layer.close_path();
             }
         }
-        let tool_before = self.replay.tool();
-        let Some(mv) = self.replay.step(line) else {
-            if self.replay.tool() != tool_before {
+        let tool_before = self.machine.tool();
+        let Some(mv) = self.machine.step(line) else {
+            if self.machine.tool() != tool_before {
                 if let Some(layer) = self.current.as_mut() {
                     layer.close_path();
                 }
@@ -726,7 +725,7 @@ impl Walk {
             let spiral = matches!((mv.from[2], mv.to[2]), (Some(a), Some(b)) if b > a);
             self.follow_z(index, mv.to[2], spiral);
         }
-        let e_relative = self.replay.e_is_relative();
+        let e_relative = self.machine.e_is_relative();
         let feature = this_move_feature.or_else(|| self.feature.clone());
         let width = self.width;
         let Some(layer) = self.current.as_mut() else {

@@ -3,7 +3,7 @@
 //! byte for byte, in order.
 //!
 //! Place in the pipeline: the last step of post-processing, after [`super::plan`]. It walks the
-//! host's lines once, replaying the machine state ([`Replay`]) so that every edit knows the
+//! host's lines once, replaying the machine state ([`Machine`]) so that every edit knows the
 //! position, E register, feed rate and tool the host's next line expects.
 //!
 //! # Cut moves
@@ -44,14 +44,13 @@
 
 use std::collections::BTreeMap;
 
-use conduit_gcode::{Gcode, Line, LineEnding, fmt_e, fmt_f, fmt_xyz};
+use conduit_gcode::{Gcode, Line, LineEnding, Machine, Move, fmt_e, fmt_f, fmt_xyz};
 
 use super::comments::{HostComment, read_comment};
 use super::cut::{CutRegion, Piece, split_move};
 use super::layers::{HostLayer, RetractionStyle};
 use super::plan::CircuitPlan;
 use super::{HostPrint, PostprocessError};
-use crate::check::{Position, Replay};
 use crate::config::Config;
 use crate::emit::gcode::{Recorder, Resume, write_block};
 use crate::geom::Point3;
@@ -147,15 +146,9 @@ fn summary_index(gcode: &Gcode) -> usize {
         .unwrap_or(gcode.lines.len())
 }
 
-/// The machine state the walk keeps beside the [`Replay`].
+/// The walk's state: the [`Machine`] and what the host's comments and heaters say.
 struct State {
-    replay: Replay,
-    pos: Position,
-    /// The E register (what `G92 E` sets and absolute E values are measured against), mm.
-    e: f64,
-    feed: f64,
-    coord_relative: bool,
-    inches: bool,
+    machine: Machine,
     /// Target temperature per tool, from `M104`/`M109`.
     temps: BTreeMap<usize, f64>,
     /// The latest feature, width and height comment lines.
@@ -167,9 +160,9 @@ struct State {
 impl State {
     /// Why conduit cannot write coordinates here: relative positioning or inches.
     fn unsupported(&self) -> Option<&'static str> {
-        if self.coord_relative {
+        if self.machine.is_relative() {
             Some("relative positioning (G91)")
-        } else if self.inches {
+        } else if self.machine.is_inches() {
             Some("inch units (G20)")
         } else {
             None
@@ -177,7 +170,7 @@ impl State {
     }
 
     /// Applies line `i` (an index into the file's lines); returns the move it commands.
-    fn step(&mut self, i: usize, line: &Line) -> Option<crate::check::Move> {
+    fn step(&mut self, i: usize, line: &Line) -> Option<Move> {
         if line.comment.is_some() {
             match read_comment(line) {
                 Some(HostComment::Feature(_)) => self.feature = Some(i),
@@ -186,54 +179,16 @@ impl State {
                 _ => {}
             }
         }
-        if line.is_command(b'G', 90) {
-            self.coord_relative = false;
-        } else if line.is_command(b'G', 91) {
-            self.coord_relative = true;
-        } else if line.is_command(b'G', 20) {
-            self.inches = true;
-        } else if line.is_command(b'G', 21) {
-            self.inches = false;
-        } else if line.is_command(b'M', 104) || line.is_command(b'M', 109) {
+        if line.is_command(b'M', 104) || line.is_command(b'M', 109) {
             if let Some(s) = line.get(b'S') {
                 let tool = line
                     .get(b'T')
                     .filter(|t| *t >= 0.0)
-                    .map_or(self.replay.tool(), |t| t as usize);
+                    .map_or(self.machine.tool(), |t| t as usize);
                 self.temps.insert(tool, s);
             }
         }
-        let mv = self.replay.step(line);
-        match &mv {
-            Some(m) => {
-                self.e += m.e;
-                self.pos = m.to;
-                self.feed = m.feed;
-            }
-            None => {
-                if line.is_command(b'G', 92) {
-                    let scale = if self.inches { 25.4 } else { 1.0 };
-                    if let Some(v) = line.get(b'E') {
-                        self.e = v * scale;
-                    }
-                    for (k, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
-                        if let Some(v) = line.get(letter) {
-                            self.pos[k] = Some(v * scale);
-                        }
-                    }
-                } else if line.is_command(b'G', 28) {
-                    // Homing: the replay knows which axes; positions follow its next move.
-                    let named =
-                        [b'X', b'Y', b'Z'].map(|l| line.words.iter().any(|w| w.letter == l));
-                    for (k, n) in named.iter().enumerate() {
-                        if *n || !named.contains(&true) {
-                            self.pos[k] = Some(0.0);
-                        }
-                    }
-                }
-            }
-        }
-        mv
+        self.machine.step(line)
     }
 }
 
@@ -267,12 +222,7 @@ pub fn rewrite(
         }
     }
     let mut state = State {
-        replay: Replay::new(cfg.printer.flavor, 25.0),
-        pos: [None; 3],
-        e: 0.0,
-        feed: 25.0,
-        coord_relative: false,
-        inches: false,
+        machine: Machine::new(cfg.printer.flavor, 25.0),
         temps: BTreeMap::new(),
         feature: None,
         width: None,
@@ -290,7 +240,7 @@ pub fn rewrite(
         "G1"
     };
     for (i, line) in gcode.lines.iter().enumerate() {
-        let e_before = state.e;
+        let e_before = state.machine.e();
         let mv = state.step(i, line);
         match (cuts.get(&i), &mv) {
             (Some(cut), Some(m)) if m.extruding => {
@@ -302,9 +252,9 @@ pub fn rewrite(
                 let pieces = Pieces {
                     line,
                     cut,
-                    relative: state.replay.e_is_relative(),
+                    relative: state.machine.e_is_relative(),
                     e_before,
-                    e_after: state.e,
+                    e_after: state.machine.e(),
                     feed: m.feed,
                     feed_changed: line.get(b'F').is_some(),
                     style,
@@ -467,13 +417,13 @@ fn block(
         .or_else(|| layer.lines.end.checked_sub(1))
         .map_or(0, |l| l + 1);
     let why = state.unsupported();
-    let (Some(x), Some(y), Some(z), None) = (state.pos[0], state.pos[1], state.pos[2], why) else {
+    let ([Some(x), Some(y), Some(z)], None) = (state.machine.position(), why) else {
         return Err(PostprocessError::MachineState {
             line: at,
             what: why.unwrap_or("an unknown position"),
         });
     };
-    let tool = state.replay.tool();
+    let tool = state.machine.tool();
     // The block retracts, heats and resumes the host's tool the way the host does.
     let mut cfg = cfg.gcode_params();
     match layer.retraction.or(fallback_style) {
@@ -508,9 +458,9 @@ fn block(
     let resume = Resume {
         tool,
         position: Point3::new(x, y, z),
-        relative_e: state.replay.e_is_relative(),
-        e: state.e,
-        feed: state.feed,
+        relative_e: state.machine.e_is_relative(),
+        e: state.machine.e(),
+        feed: state.machine.feed(),
         layer_index: layer.index,
         layer_z: layer.z,
     };

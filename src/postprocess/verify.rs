@@ -18,13 +18,13 @@
 //!    top reaches the top of the part's cavity.
 //! 5. **`conduit check`**: the edited file has no error-level finding.
 
-use conduit_gcode::{Gcode, Line, LineEnding};
+use conduit_gcode::{Gcode, Line, LineEnding, Machine, Position};
 
 use super::cut::CutRegion;
 use super::plan::plan_circuit;
 use super::rewrite::{END_MARK, PARTS_MARK, SUMMARY_PREFIX, TRACES_MARK};
 use super::{HostPrint, HostSettings, LayerParams, PostprocessError, detect_host};
-use crate::check::{CheckParams, Replay, check};
+use crate::check::{CheckParams, check};
 use crate::circuit::Electronics;
 use crate::config::Config;
 use crate::geom::{Join, offset};
@@ -144,7 +144,7 @@ pub fn verify_with(
                 .then(|| CutRegion::new(&offset(&l.cuts, -params.tolerance, Join::Miter(2.0))))
         })
         .collect();
-    let mut replay = Replay::new(config.printer.flavor, 25.0);
+    let mut machine = Machine::new(config.printer.flavor, 25.0);
     let mut block_points: Vec<[f64; 2]> = Vec::new();
     let mut host_top: f64 = f64::NEG_INFINITY;
     let mut events: Vec<(String, f64, usize)> = Vec::new();
@@ -157,7 +157,7 @@ pub fn verify_with(
         if let Some(name) = event_part(line) {
             events.push((name, host_top, i + 1));
         }
-        let Some(mv) = replay.step(line) else {
+        let Some(mv) = machine.step(line) else {
             continue;
         };
         if inside_block {
@@ -333,7 +333,7 @@ fn event_part(line: &Line) -> Option<String> {
 }
 
 /// Points every `step` mm along a replayed path (both ends included).
-fn samples(path: &[crate::check::Position], step: f64) -> impl Iterator<Item = [f64; 2]> + '_ {
+fn samples(path: &[Position], step: f64) -> impl Iterator<Item = [f64; 2]> + '_ {
     path.windows(2).flat_map(move |w| {
         let (a, b) = match (w[0], w[1]) {
             ([Some(ax), Some(ay), _], [Some(bx), Some(by), _]) => ([ax, ay], [bx, by]),
@@ -380,10 +380,10 @@ fn match_lines(
     problems: &mut Problems,
 ) -> Vec<std::ops::Range<usize>> {
     let (orig, ed) = (&original.lines, &edited.lines);
-    let mut replay = Replay::new(config.printer.flavor, 25.0);
+    let mut machine = Machine::new(config.printer.flavor, 25.0);
     let extruding: Vec<bool> = orig
         .iter()
-        .map(|l| replay.step(l).is_some_and(|m| m.extruding))
+        .map(|l| machine.step(l).is_some_and(|m| m.extruding))
         .collect();
     let is_block_start = |l: &Line| {
         let t = String::from_utf8_lossy(&l.text);

@@ -1,10 +1,11 @@
-//! G-code tokenizer that round-trips every line byte for byte, plus the number formatter for
-//! writing G-code.
+//! G-code tokenizer that round-trips every line byte for byte, the modal machine that
+//! interprets the lines, plus the number formatter for writing G-code.
 //!
 //! Part of conduit's `formats/` layer: it describes the file and has no dependency on the
 //! pipeline. `postprocess` reads another slicer's G-code with [`parse`], edits lines and writes
-//! them back; `emit` writes numbers with [`fmt_xyz`], [`fmt_e`] and [`fmt_f`]; `conduit info`
-//! shows a [`Summary`].
+//! them back; `emit` writes numbers with [`fmt_xyz`], [`fmt_e`] and [`fmt_f`]; `check`,
+//! `preview` and `postprocess` replay files on the [`Machine`] (see [`machine`]); `conduit info`
+//! shows a [`Summary`], which the machine walks too.
 //!
 //! # The round-trip guarantee
 //!
@@ -46,6 +47,7 @@
 //! ```
 
 mod line;
+pub mod machine;
 mod number;
 mod parse;
 mod summary;
@@ -54,6 +56,7 @@ mod summary;
 mod corpus_tests;
 
 pub use line::{Line, LineEnding, STRING_ARG_COMMANDS, Word};
+pub use machine::{Command, Firmware, Machine, Move, Moves, Position, Reading, moves};
 pub use number::{E_DECIMALS, XYZ_DECIMALS, fmt_e, fmt_f, fmt_fixed, fmt_xyz};
 pub use parse::{BGCODE_MAGIC, Gcode, GcodeError, is_binary_gcode, parse};
 pub use summary::{Bounds, ExtrusionMode, Flavour, LayerSource, Summary, Units, summarize};

@@ -1,8 +1,12 @@
 //! What is in a G-code file, for `conduit info`: counts, layers, tools, extents, producer.
+//!
+//! Part of the `formats/` layer: [`summarize`] walks the file with the modal [`Machine`] in
+//! its lenient [`Reading::Survey`] and counts what it sees; `conduit info` shows the result.
 
 use serde::Serialize;
 
-use crate::{Gcode, Line};
+use crate::Gcode;
+use crate::machine::{Command, Firmware, Machine, Position, Reading};
 
 /// Statistics of a G-code file, from [`summarize`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -47,7 +51,7 @@ pub struct Summary {
     pub extrusion: ExtrusionMode,
     /// Units of the coordinates in the file (`G20` inches, `G21` millimetres).
     pub units: Units,
-    /// Lines with at least one [`Line::unparsed`] span.
+    /// Lines with at least one [`Line::unparsed`](crate::Line::unparsed) span.
     pub lines_with_unparsed: usize,
 }
 
@@ -199,34 +203,12 @@ fn generator(text: &str) -> Option<(Flavour, String)> {
     None
 }
 
-/// Machine state while walking the file.
-struct State {
-    pos: [f64; 3],
-    e: f64,
-    relative_xyz: bool,
-    relative_e: bool,
-    /// Millimetres per file unit (1 or 25.4).
-    scale: f64,
-    motion: Option<u32>,
-    tool: Option<u32>,
-}
-
-/// The integer value of a command word (`G1` → 1), or `None` for `G29.1`, `G-1` and the like.
-fn code(v: f64) -> Option<u32> {
-    (v.fract() == 0.0 && (0.0..=1e6).contains(&v)).then_some(v as u32)
-}
-
-/// Walks the file once, tracking position, E and modes, and collects a [`Summary`].
+/// Walks the file once with a [`Machine`] in the [`Reading::Survey`] (Marlin's modes, positions
+/// starting at 0) and collects a [`Summary`].
 pub fn summarize(g: &Gcode) -> Summary {
-    let mut st = State {
-        pos: [0.0; 3],
-        e: 0.0,
-        relative_xyz: false,
-        relative_e: false,
-        scale: 1.0,
-        motion: None,
-        tool: None,
-    };
+    let mut machine = Machine::new(Firmware::Marlin, 25.0)
+        .with_reading(Reading::Survey)
+        .with_position([Some(0.0); 3]);
     let mut marker_counts = [0usize; MARKERS.len()];
     let mut flavour = None::<(Flavour, String)>;
     let mut flavor_line = false;
@@ -254,111 +236,48 @@ pub fn summarize(g: &Gcode) -> Summary {
                 flavor_line |= text.starts_with("FLAVOR:");
             }
         }
-        if line.words.is_empty() {
-            continue;
-        }
-        let mut motion = None;
-        let mut has_command = false;
-        for w in &line.words {
-            match (w.letter, code(w.value)) {
-                (b'G', c) => {
-                    has_command = true;
-                    match c {
-                        Some(m @ 0..=3) => motion = Some(m),
-                        Some(20) => {
-                            st.scale = 25.4;
-                            saw_g20 = true;
-                        }
-                        Some(21) => {
-                            st.scale = 1.0;
-                            saw_g21 = true;
-                        }
-                        // Marlin 2: G90/G91 set every axis, E included; M82/M83 then override E.
-                        Some(90) => (st.relative_xyz, st.relative_e) = (false, false),
-                        Some(91) => (st.relative_xyz, st.relative_e) = (true, true),
-                        Some(92) => set_position(&mut st, line),
-                        Some(28) => home(&mut st, line),
-                        _ => {}
-                    }
+        let step = machine.step_with(line, |before, command| match command {
+            Command::Inches => saw_g20 = true,
+            Command::Millimetres => saw_g21 = true,
+            Command::AbsoluteE => declared_e = Some(false),
+            Command::RelativeE => declared_e = Some(true),
+            Command::Tool(t) => {
+                if before.selected_tool() != Some(t) {
+                    tool_changes += 1;
                 }
-                (b'M', c) => {
-                    has_command = true;
-                    match c {
-                        Some(82) => {
-                            st.relative_e = false;
-                            declared_e = Some(false);
-                        }
-                        Some(83) => {
-                            st.relative_e = true;
-                            declared_e = Some(true);
-                        }
-                        Some(6) => {
-                            if let Some(t) = line.get(b'T').and_then(code) {
-                                select_tool(&mut st, &mut tools, &mut tool_changes, t);
-                            }
-                        }
-                        _ => {}
-                    }
-                }
-                (b'T', c) => {
-                    has_command = true;
-                    if let (Some(t), Some((b'T', _))) = (c, line.command()) {
-                        select_tool(&mut st, &mut tools, &mut tool_changes, t);
-                    }
-                }
-                _ => {}
+                // Survey command numbers are at most 10⁶.
+                tools.extend(u32::try_from(t).ok());
             }
-        }
-        let motion = match motion {
-            Some(m) => {
-                st.motion = Some(m);
-                Some(m)
-            }
-            // CNC modal style: "X1 Y2" continues the last motion command.
-            None if !has_command
-                && line
-                    .words
-                    .iter()
-                    .any(|w| matches!(w.letter, b'X' | b'Y' | b'Z' | b'E')) =>
-            {
-                st.motion
-            }
-            None => None,
-        };
-        let Some(m) = motion else { continue };
+            _ => {}
+        });
+        let Some(m) = step else { continue };
         moves += 1;
-        let arc = m >= 2;
-        if arc {
+        if m.arc {
             arcs += 1;
         }
-        let start = st.pos;
-        for (axis, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
-            if let Some(v) = line.get(letter) {
-                let v = v * st.scale;
-                st.pos[axis] = if st.relative_xyz { st.pos[axis] + v } else { v };
-            }
+        if line.get(b'E').is_none() {
+            continue;
         }
-        let Some(e) = line.get(b'E') else { continue };
-        let e = e * st.scale;
-        let delta = if st.relative_e { e } else { e - st.e };
-        st.e = if st.relative_e { st.e + e } else { e };
         let moved =
-            st.pos != start || (arc && [b'I', b'J', b'R'].iter().any(|&l| line.get(l).is_some()));
-        if delta > 0.0 && moved {
+            m.from != m.to || (m.arc && [b'I', b'J', b'R'].iter().any(|&l| line.get(l).is_some()));
+        if m.e > 0.0 && moved {
             extruding += 1;
-            if st.relative_e {
+            if machine.e_is_relative() {
                 rel_moves += 1;
             } else {
                 abs_moves += 1;
             }
-            for p in [start, st.pos] {
+            // Survey positions start known, so they are never `None`.
+            let known = |p: Position| p.map(|c| c.unwrap_or(0.0));
+            let (start, end) = (known(m.from), known(m.to));
+            for p in [start, end] {
                 for axis in 0..3 {
                     min[axis] = min[axis].min(p[axis]);
                     max[axis] = max[axis].max(p[axis]);
                 }
             }
             // 1 µm buckets; saturating cast keeps absurd Z values from misbehaving.
-            z_levels.push((st.pos[2] * 1000.0).round() as i64);
+            z_levels.push((end[2] * 1000.0).round() as i64);
         }
     }
 
@@ -415,52 +334,6 @@ pub fn summarize(g: &Gcode) -> Summary {
             _ => Units::Millimetres,
         },
         lines_with_unparsed,
-    }
-}
-
-fn select_tool(st: &mut State, tools: &mut Vec<u32>, changes: &mut usize, t: u32) {
-    if st.tool != Some(t) {
-        *changes += 1;
-        st.tool = Some(t);
-    }
-    tools.push(t);
-}
-
-/// `G92`: set the named axes (all, when none is named) to the given values.
-fn set_position(st: &mut State, line: &Line) {
-    let named: Vec<(u8, f64)> = line
-        .words
-        .iter()
-        .filter(|w| matches!(w.letter, b'X' | b'Y' | b'Z' | b'E'))
-        .map(|w| (w.letter, w.value))
-        .collect();
-    if named.is_empty() {
-        st.pos = [0.0; 3];
-        st.e = 0.0;
-    }
-    for (letter, v) in named {
-        match letter {
-            b'X' => st.pos[0] = v * st.scale,
-            b'Y' => st.pos[1] = v * st.scale,
-            b'Z' => st.pos[2] = v * st.scale,
-            _ => st.e = v * st.scale,
-        }
-    }
-}
-
-/// `G28`: home the named axes (all, when none is named) to 0.
-fn home(st: &mut State, line: &Line) {
-    let named: Vec<usize> = [b'X', b'Y', b'Z']
-        .iter()
-        .enumerate()
-        .filter(|(_, l)| line.words.iter().any(|w| w.letter == **l))
-        .map(|(i, _)| i)
-        .collect();
-    if named.is_empty() {
-        st.pos = [0.0; 3];
-    }
-    for axis in named {
-        st.pos[axis] = 0.0;
     }
 }
 

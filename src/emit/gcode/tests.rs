@@ -6,7 +6,7 @@ use crate::geom::Point3;
 use crate::program::machine::{Flavor, Printer, Tool};
 use crate::program::{Event, Layer, LayerItem, Role, Toolpath, e_per_mm};
 
-/// One replayed G0/G1 move.
+/// One replayed move.
 #[derive(Debug, Clone, Copy)]
 struct Move {
     /// Index of the line in the file.
@@ -27,50 +27,27 @@ impl Move {
     }
 }
 
-/// Parses `text` and replays it: positions, E (absolute or relative per M82/M83, G92 E), tool.
-/// Returns the lines and the moves from the first `;LAYER_CHANGE` on (the start G-code's
-/// priming moves are left out).
+/// Parses `text` and replays it on the modal machine: positions, E (absolute or relative per
+/// M82/M83, G92 E), tool. Returns the lines and the moves from the first `;LAYER_CHANGE` on
+/// (the start G-code's priming moves are left out).
 fn replay(text: &str) -> (Vec<String>, Vec<Move>) {
     let g = match conduit_gcode::parse(text.as_bytes()) {
         Ok(g) => g,
         Err(e) => panic!("output does not parse: {e}"),
     };
     let lines: Vec<String> = text.lines().map(str::to_owned).collect();
-    let (mut pos, mut e, mut relative, mut tool) = ([0.0f64; 3], 0.0f64, false, 0usize);
+    let mut machine = conduit_gcode::Machine::new(Flavor::Marlin, 25.0);
+    let known = |p: conduit_gcode::Position| p.map(|c| c.unwrap_or(0.0));
     let mut moves = Vec::new();
     for (i, l) in g.lines.iter().enumerate() {
-        match l.command() {
-            Some((b'G', c)) if c == 0.0 || c == 1.0 => {
-                let mut to = pos;
-                for (k, letter) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
-                    if let Some(v) = l.get(letter) {
-                        to[k] = v;
-                    }
-                }
-                let de = match l.get(b'E') {
-                    Some(v) if relative => v,
-                    Some(v) => v - e,
-                    None => 0.0,
-                };
-                e += de;
-                moves.push(Move {
-                    line: i,
-                    tool,
-                    from: pos,
-                    to,
-                    de,
-                });
-                pos = to;
-            }
-            Some((b'G', 92.0)) => {
-                if let Some(v) = l.get(b'E') {
-                    e = v;
-                }
-            }
-            Some((b'M', 82.0)) => relative = false,
-            Some((b'M', 83.0)) => relative = true,
-            Some((b'T', n)) => tool = n as usize,
-            _ => {}
+        if let Some(m) = machine.step(l) {
+            moves.push(Move {
+                line: i,
+                tool: m.tool,
+                from: known(m.from),
+                to: known(m.to),
+                de: m.e,
+            });
         }
     }
     let body = lines.iter().position(|l| l == ";LAYER_CHANGE").unwrap_or(0);

@@ -28,7 +28,7 @@ pub mod svg;
 
 use std::path::{Path, PathBuf};
 
-use crate::check::Moves;
+use conduit_gcode::Moves;
 
 /// Stroke width of extrusions without a `;WIDTH:` comment, mm.
 pub const DEFAULT_WIDTH: f64 = 0.4;
