@@ -14,7 +14,9 @@ use crate::config::Config;
 use crate::geom::{BoundingBox, ExPolygon, Point2, Point3, Polygon, scaled};
 use crate::program::{Event, LayerExtras, Role, Toolpath};
 use crate::region::cavity::{Cavity, carve_cavities, carve_channels};
-use crate::route::{PadCopper, RouteLayer, RouteParams, Wire, min_trace_spacing, route};
+use crate::route::{
+    PadCopper, RouteLayer, RouteParams, RouteResult, Wire, min_trace_spacing, route,
+};
 use crate::slice::LayerZ;
 
 /// A circuit and where its parts go: what `--circuit` and `--placement` give.
@@ -265,13 +267,70 @@ pub fn object_stage(
     extras: &mut LayerExtras,
     report: &mut ElectronicsReport,
 ) -> ObjectCuts {
-    let parts = &circuit.parts;
-    let spans: Vec<(f64, f64)> = zs.iter().map(|z| (z.bottom, z.top)).collect();
-    let mine: Vec<(usize, &PlacedPart)> = parts
+    let mine: Vec<(usize, &PlacedPart)> = circuit
+        .parts
         .iter()
         .enumerate()
         .filter(|(_, p)| p.object == object)
         .collect();
+    let cavities = carve_part_cavities(&mine, islands, zs, cfg);
+    let (mine_wires, between): (Vec<&CircuitWire>, Vec<&CircuitWire>) = circuit
+        .wires
+        .iter()
+        .filter(|w| w.object == object)
+        .partition(|w| w.other_object.is_none());
+    report_between_objects(&between, object, report);
+    if object == 0 {
+        report
+            .unplaced_pins
+            .extend(circuit.unplaced.iter().cloned());
+    }
+    let result = route_object(&mine, &mine_wires, islands, zs, cfg, report);
+    let style = TraceStyle::of(cfg);
+    let mut per_layer = trace_paths(&result, &mine_wires, zs, cfg, style, report);
+    if cfg.route.pad_drops {
+        add_pad_drops(&mine, zs, style, &mut per_layer);
+    }
+    add_traces(per_layer, zs, extras);
+    add_part_events(&mine, zs, extras, report);
+    total_up(report);
+    ObjectCuts {
+        cavities,
+        channels: result.channels,
+    }
+}
+
+/// How the conductive tool prints the traces and the pad drops.
+#[derive(Debug, Clone, Copy)]
+struct TraceStyle {
+    /// The conductive tool.
+    tool: usize,
+    /// Feed, mm/s.
+    speed: f64,
+    /// Trace width, mm.
+    width: f64,
+}
+
+impl TraceStyle {
+    /// The style `[route]` and `[slice]` give.
+    fn of(cfg: &Config) -> Self {
+        Self {
+            tool: cfg.route.conductive_tool,
+            speed: cfg.slice.conductive_speed,
+            width: cfg.route.conductive_width,
+        }
+    }
+}
+
+/// The cavities of the object's parts (`mine`, with their placement indices), carved from its
+/// islands.
+fn carve_part_cavities(
+    mine: &[(usize, &PlacedPart)],
+    islands: &mut [Vec<ExPolygon>],
+    zs: &[LayerZ],
+    cfg: &Config,
+) -> Vec<Cavity> {
+    let spans: Vec<(f64, f64)> = zs.iter().map(|z| (z.bottom, z.top)).collect();
     let cavities: Vec<Cavity> = mine
         .iter()
         .map(|(_, p)| {
@@ -284,13 +343,12 @@ pub fn object_stage(
         })
         .collect();
     carve_cavities(islands, &spans, &cavities);
+    cavities
+}
 
-    let (mine_wires, between): (Vec<&CircuitWire>, Vec<&CircuitWire>) = circuit
-        .wires
-        .iter()
-        .filter(|w| w.object == object)
-        .partition(|w| w.other_object.is_none());
-    // A wire between parts on two objects has no material to run in: reported, not routed.
+/// Reports the wires between parts on two objects: a wire there has no material to run in, so
+/// it gets a warning and an unrouted entry.
+fn report_between_objects(between: &[&CircuitWire], object: usize, report: &mut ElectronicsReport) {
     for w in between {
         report.warnings.push(format!(
             "net {} joins {} on object {} and {} on object {}: a trace cannot leave its \
@@ -313,12 +371,20 @@ pub fn object_stage(
             joins: None,
         });
     }
+}
+
+/// Routes the object's wires through its layers (the islands with the cavities carved) around
+/// its parts' pads, after warning about pads too close for two traces, and carves the
+/// channels from the islands.
+fn route_object(
+    mine: &[(usize, &PlacedPart)],
+    mine_wires: &[&CircuitWire],
+    islands: &mut [Vec<ExPolygon>],
+    zs: &[LayerZ],
+    cfg: &Config,
+    report: &mut ElectronicsReport,
+) -> RouteResult {
     let wires: Vec<Wire> = mine_wires.iter().map(|w| w.wire.clone()).collect();
-    if object == 0 {
-        report
-            .unplaced_pins
-            .extend(circuit.unplaced.iter().cloned());
-    }
     let layers: Vec<RouteLayer> = zs
         .iter()
         .zip(islands.iter())
@@ -343,13 +409,21 @@ pub fn object_stage(
         .extend(mine.iter().filter_map(|(_, p)| pitch_warning(p, &params)));
     let result = route(&layers, &wires, &pads, &params);
     carve_channels(islands, &result.channels);
+    result
+}
 
-    // Traces: one path per wire and layer, longest first on each layer.
-    let tool = cfg.route.conductive_tool;
-    let speed = cfg.slice.conductive_speed;
-    let width = cfg.route.conductive_width;
+/// Reports every routed (or unrouted) wire and returns the traces: one path per routed wire
+/// and layer, by layer index.
+fn trace_paths(
+    result: &RouteResult,
+    mine_wires: &[&CircuitWire],
+    zs: &[LayerZ],
+    cfg: &Config,
+    style: TraceStyle,
+    report: &mut ElectronicsReport,
+) -> BTreeMap<usize, Vec<Toolpath>> {
     let mut per_layer: BTreeMap<usize, Vec<Toolpath>> = BTreeMap::new();
-    for (w, ends) in result.wires.iter().zip(&mine_wires) {
+    for (w, ends) in result.wires.iter().zip(mine_wires) {
         report.wires.push(NetRoute {
             net: w.net.clone(),
             from: ends.from.clone(),
@@ -384,32 +458,45 @@ pub fn object_stage(
                     .collect(),
                 closed: false,
                 role: Role::ConductiveTrace,
-                tool,
-                width,
+                tool: style.tool,
+                width: style.width,
                 height,
-                speed,
+                speed: style.speed,
                 tool_axis: None,
             });
         }
     }
-    if cfg.route.pad_drops {
-        for (_, part) in &mine {
-            for pad in &part.pads {
-                let Some(layer) = floor_layer(zs, pad.centre.z) else {
-                    continue;
-                };
-                let z = zs[layer].top;
-                per_layer.entry(layer).or_default().push(drop_path(
-                    pad.centre,
-                    z,
-                    width,
-                    zs[layer].height(),
-                    tool,
-                    speed,
-                ));
-            }
+    per_layer
+}
+
+/// Adds a drop on every pad of the object's parts to the layer at its seating plane.
+fn add_pad_drops(
+    mine: &[(usize, &PlacedPart)],
+    zs: &[LayerZ],
+    style: TraceStyle,
+    per_layer: &mut BTreeMap<usize, Vec<Toolpath>>,
+) {
+    for (_, part) in mine {
+        for pad in &part.pads {
+            let Some(layer) = floor_layer(zs, pad.centre.z) else {
+                continue;
+            };
+            let z = zs[layer].top;
+            per_layer.entry(layer).or_default().push(drop_path(
+                pad.centre,
+                z,
+                style.width,
+                zs[layer].height(),
+                style.tool,
+                style.speed,
+            ));
         }
     }
+}
+
+/// Hands the traces and drops to the extras, printed after their layer, longest first on each
+/// layer.
+fn add_traces(per_layer: BTreeMap<usize, Vec<Toolpath>>, zs: &[LayerZ], extras: &mut LayerExtras) {
     for (layer, mut paths) in per_layer {
         paths.sort_by(|a, b| b.length().total_cmp(&a.length()));
         extras
@@ -418,10 +505,17 @@ pub fn object_stage(
             .or_default()
             .extend(paths);
     }
+}
 
-    // Part events: at the start of the first layer above the cavity; parts standing above the
-    // last layer are placed after it.
-    for (index, part) in mine {
+/// The part events, at the start of the first layer above each cavity (parts standing above
+/// the last layer are placed after it), and the parts' report entries.
+fn add_part_events(
+    mine: &[(usize, &PlacedPart)],
+    zs: &[LayerZ],
+    extras: &mut LayerExtras,
+    report: &mut ElectronicsReport,
+) {
+    for &(index, part) in mine {
         let top = part.position.z + part.body_height;
         let event = part_event(index + 1, part);
         let report_entry = |after: f64| PartReport {
@@ -452,6 +546,10 @@ pub fn object_stage(
             }
         }
     }
+}
+
+/// The report's totals over every wire reported so far.
+fn total_up(report: &mut ElectronicsReport) {
     report.routed = report.wires.iter().filter(|w| w.routed).count();
     report.unrouted = report.wires.len() - report.routed;
     report.total_length = report.wires.iter().map(|w| w.length).sum();
@@ -461,10 +559,6 @@ pub fn object_stage(
         .filter(|w| w.routed)
         .map(|w| w.lower_bound)
         .sum();
-    ObjectCuts {
-        cavities,
-        channels: result.channels,
-    }
 }
 
 /// A warning when two connected pads of different nets on `part` are closer than two traces

@@ -270,16 +270,315 @@ const PER_EXTRUDER: &[&str] = &[
     "retract_length",
 ];
 
+/// A field of the config that one key writes.
+type Field<T> = fn(&mut Config) -> &mut T;
+
+/// A number field of a tool that one per-extruder list writes.
+type ToolField = fn(&mut Tool) -> &mut f64;
+
+/// Per-extruder number lists, in reading order, and the tool field each fills. A list shorter
+/// than the number of extruders repeats its last value.
+const TOOL_NUMBERS: &[(&str, ToolField)] = &[
+    ("nozzle_diameter", |t| &mut t.nozzle_diameter),
+    ("filament_diameter", |t| &mut t.filament_diameter),
+    ("filament_density", |t| &mut t.filament_density),
+    ("temperature", |t| &mut t.temperature),
+    ("first_layer_temperature", |t| {
+        &mut t.first_layer_temperature
+    }),
+    ("extrusion_multiplier", |t| &mut t.extrusion_multiplier),
+];
+
+/// How the value of one PrusaSlicer key lands in the config.
+enum Rule {
+    /// A number, copied as is.
+    Num(Field<f64>),
+    /// A whole number ≥ 0.
+    Count(Field<usize>),
+    /// A flag (`0`/`1`).
+    Flag(Field<bool>),
+    /// A number, or a percentage of the value the first function reads from the config as
+    /// filled so far (the PrusaSlicer parent setting).
+    Percent(fn(&Config) -> f64, Field<f64>),
+    /// A G-code snippet with its escapes undone; a warning names the key when it uses macros.
+    Gcode(Field<String>),
+    /// A solid-infill pattern: conduit prints rectilinear and warns about any other.
+    Solid(Field<SolidPattern>),
+    /// A key with its own reader (which may read further keys).
+    Custom(fn(&mut Import, &str) -> Result<(), ConfigError>),
+}
+
+/// The printer and slicing keys after the tools, in reading order: the order decides which
+/// error is reported first, the order of the warnings, and which values a `%` refers to.
+const RULES: &[(&str, Rule)] = &[
+    // Printer.
+    ("bed_shape", Rule::Custom(bed_shape)),
+    ("max_print_height", Rule::Num(|c| &mut c.printer.max_height)),
+    ("gcode_flavor", Rule::Custom(gcode_flavor)),
+    ("start_gcode", Rule::Gcode(|c| &mut c.printer.start_gcode)),
+    ("end_gcode", Rule::Gcode(|c| &mut c.printer.end_gcode)),
+    ("toolchange_gcode", Rule::Custom(toolchange_gcode)),
+    (
+        "bed_temperature",
+        Rule::Num(|c| &mut c.printer.bed_temperature),
+    ),
+    (
+        "first_layer_bed_temperature",
+        Rule::Num(|c| &mut c.printer.first_layer_bed_temperature),
+    ),
+    ("retract_speed", Rule::Num(|c| &mut c.printer.retract_speed)),
+    (
+        "deretract_speed",
+        Rule::Num(|c| &mut c.printer.deretract_speed),
+    ),
+    (
+        "retract_before_travel",
+        Rule::Num(|c| &mut c.printer.retract_before_travel),
+    ),
+    ("retract_lift", Rule::Num(|c| &mut c.printer.retract_lift)),
+    ("travel_speed", Rule::Num(|c| &mut c.printer.travel_speed)),
+    ("min_fan_speed", Rule::Num(|c| &mut c.printer.fan_min_speed)),
+    ("max_fan_speed", Rule::Num(|c| &mut c.printer.fan_max_speed)),
+    (
+        "machine_max_acceleration_extruding",
+        Rule::Custom(acceleration),
+    ),
+    (
+        "disable_fan_first_layers",
+        Rule::Count(|c| &mut c.printer.disable_fan_first_layers),
+    ),
+    (
+        "use_relative_e_distances",
+        Rule::Flag(|c| &mut c.printer.use_relative_e_distances),
+    ),
+    (
+        "use_firmware_retraction",
+        Rule::Flag(|c| &mut c.printer.use_firmware_retraction),
+    ),
+    // Slicing.
+    (
+        "layer_height",
+        Rule::Num(|c| &mut c.slice.region.layer_height),
+    ),
+    (
+        "first_layer_height",
+        Rule::Percent(
+            |c| c.slice.region.layer_height,
+            |c| &mut c.slice.first_layer_height,
+        ),
+    ),
+    (
+        "perimeters",
+        Rule::Count(|c| &mut c.slice.region.perimeters),
+    ),
+    (
+        "top_solid_layers",
+        Rule::Count(|c| &mut c.slice.region.top_solid_layers),
+    ),
+    (
+        "bottom_solid_layers",
+        Rule::Count(|c| &mut c.slice.region.bottom_solid_layers),
+    ),
+    ("skirts", Rule::Count(|c| &mut c.slice.region.skirt_loops)),
+    ("fill_density", Rule::Custom(fill_density)),
+    (
+        "solid_infill_below_area",
+        Rule::Num(|c| &mut c.slice.region.solid_infill_below_area),
+    ),
+    (
+        "gap_fill_enabled",
+        Rule::Flag(|c| &mut c.slice.region.gap_fill),
+    ),
+    ("fill_pattern", Rule::Custom(fill_pattern)),
+    (
+        "top_fill_pattern",
+        Rule::Solid(|c| &mut c.slice.top_fill_pattern),
+    ),
+    (
+        "top_infill_pattern",
+        Rule::Solid(|c| &mut c.slice.top_fill_pattern),
+    ),
+    (
+        "bottom_fill_pattern",
+        Rule::Solid(|c| &mut c.slice.bottom_fill_pattern),
+    ),
+    (
+        "bottom_infill_pattern",
+        Rule::Solid(|c| &mut c.slice.bottom_fill_pattern),
+    ),
+    (
+        "fill_angle",
+        Rule::Num(|c| &mut c.slice.region.infill_angle_deg),
+    ),
+    ("infill_overlap", Rule::Custom(infill_overlap)),
+    (
+        "external_perimeters_first",
+        Rule::Flag(|c| &mut c.slice.region.external_perimeters_first),
+    ),
+    (
+        "support_material",
+        Rule::Flag(|c| &mut c.slice.support_material),
+    ),
+    (
+        "skirt_distance",
+        Rule::Num(|c| &mut c.slice.region.skirt_distance),
+    ),
+    ("brim_width", Rule::Num(|c| &mut c.slice.brim_width)),
+    ("perimeter_generator", Rule::Custom(perimeter_generator)),
+    // Widths (every role width is read with the generic one).
+    ("extrusion_width", Rule::Custom(extrusion_widths)),
+    // Speeds; a percentage is of the parent PrusaSlicer uses.
+    (
+        "perimeter_speed",
+        Rule::Num(|c| &mut c.slice.perimeter_speed),
+    ),
+    (
+        "external_perimeter_speed",
+        Rule::Percent(
+            |c| c.slice.perimeter_speed,
+            |c| &mut c.slice.external_perimeter_speed,
+        ),
+    ),
+    ("infill_speed", Rule::Num(|c| &mut c.slice.infill_speed)),
+    (
+        "solid_infill_speed",
+        Rule::Percent(
+            |c| c.slice.infill_speed,
+            |c| &mut c.slice.solid_infill_speed,
+        ),
+    ),
+    (
+        "top_solid_infill_speed",
+        Rule::Percent(
+            |c| c.slice.solid_infill_speed,
+            |c| &mut c.slice.top_solid_infill_speed,
+        ),
+    ),
+    ("bridge_speed", Rule::Num(|c| &mut c.slice.bridge_speed)),
+    ("gap_fill_speed", Rule::Num(|c| &mut c.slice.gap_fill_speed)),
+    (
+        "first_layer_speed",
+        Rule::Percent(
+            |c| c.slice.perimeter_speed,
+            |c| &mut c.slice.first_layer_speed,
+        ),
+    ),
+    (
+        "support_material_speed",
+        Rule::Percent(|c| c.slice.perimeter_speed, |c| &mut c.slice.skirt_speed),
+    ),
+];
+
+/// Role widths: key, automatic width (× nozzle) and field. Read after `extrusion_width`.
+const WIDTHS: &[(&str, f64, Field<f64>)] = &[
+    ("perimeter_extrusion_width", 1.125, |c| {
+        &mut c.slice.region.perimeter_width
+    }),
+    ("external_perimeter_extrusion_width", 1.125, |c| {
+        &mut c.slice.region.external_perimeter_width
+    }),
+    ("infill_extrusion_width", 1.125, |c| {
+        &mut c.slice.region.infill_width
+    }),
+    ("solid_infill_extrusion_width", 1.125, |c| {
+        &mut c.slice.region.solid_infill_width
+    }),
+    ("top_infill_extrusion_width", 1.0, |c| {
+        &mut c.slice.region.top_solid_infill_width
+    }),
+];
+
+/// A conversion under way: the pairs (with the keys read so far), the config they fill and the
+/// warnings given.
+struct Import {
+    p: Pairs,
+    cfg: Config,
+    warnings: Vec<String>,
+}
+
+impl Rule {
+    /// Reads `key` from the pairs and writes its value into the config (a missing key leaves
+    /// the default).
+    fn apply(&self, key: &str, imp: &mut Import) -> Result<(), ConfigError> {
+        let (p, cfg) = (&mut imp.p, &mut imp.cfg);
+        match *self {
+            Rule::Num(field) => {
+                if let Some(v) = p.num(key)? {
+                    *field(cfg) = v;
+                }
+            }
+            Rule::Count(field) => {
+                if let Some(v) = p.count(key)? {
+                    *field(cfg) = v;
+                }
+            }
+            Rule::Flag(field) => {
+                if let Some(v) = p.flag(key)? {
+                    *field(cfg) = v;
+                }
+            }
+            Rule::Percent(base, field) => {
+                if let Some(v) = p.abs_or_percent(key, base(cfg))? {
+                    *field(cfg) = v;
+                }
+            }
+            Rule::Gcode(field) => {
+                if let Some(g) = p.gcode(key) {
+                    if has_macros(&g) {
+                        imp.warnings.push(format!(
+                            "{key} uses PrusaSlicer macros ({{if …}} or expressions) that conduit \
+                             cannot fill; edit printer.{key}"
+                        ));
+                    }
+                    *field(cfg) = g;
+                }
+            }
+            Rule::Solid(field) => {
+                if let Some(pat) = p.raw(key).map(str::to_owned) {
+                    if pat.trim() != "rectilinear" {
+                        imp.warnings.push(format!(
+                            "{key} = {}: not available, rectilinear solid infill is printed",
+                            pat.trim()
+                        ));
+                    }
+                    *field(cfg) = SolidPattern::Rectilinear;
+                }
+            }
+            Rule::Custom(read) => read(imp, key)?,
+        }
+        Ok(())
+    }
+}
+
+/// The conversion: the technology check, the tools, every key of [`RULES`] in order, then one
+/// warning for the keys no step read and the config's own validation.
 fn convert(
     list: Vec<(String, String, Option<usize>)>,
 ) -> Result<(Config, Vec<String>), ConfigError> {
-    let mut p = Pairs {
-        values: list.into_iter().map(|(k, v, l)| (k, (v, l))).collect(),
-        used: BTreeSet::new(),
+    let mut imp = Import {
+        p: Pairs {
+            values: list.into_iter().map(|(k, v, l)| (k, (v, l))).collect(),
+            used: BTreeSet::new(),
+        },
+        cfg: Config::default(),
+        warnings: Vec::new(),
     };
-    let mut cfg = Config::default();
-    let mut warnings = Vec::new();
+    check_technology(&mut imp.p)?;
+    read_tools(&mut imp)?;
+    for (key, rule) in RULES {
+        rule.apply(key, &mut imp)?;
+    }
+    warn_ignored(&mut imp);
+    let Import {
+        cfg, mut warnings, ..
+    } = imp;
+    let more = cfg.validate()?;
+    warnings.extend(more);
+    Ok((cfg, warnings))
+}
 
+/// Refuses a profile of a printer that is not FFF (`printer_technology`).
+fn check_technology(p: &mut Pairs) -> Result<(), ConfigError> {
     if let Some(tech) = p.raw("printer_technology").map(str::to_owned) {
         if !tech.eq_ignore_ascii_case("FFF") {
             return Err(p.err(
@@ -288,8 +587,14 @@ fn convert(
             ));
         }
     }
+    Ok(())
+}
 
-    // Tools: one per extruder.
+/// Builds the tools, one per extruder (the longest per-extruder list), then appends conduit's
+/// paste tool; the first nozzle becomes the slicing nozzle and the first retraction the
+/// printer's.
+fn read_tools(imp: &mut Import) -> Result<(), ConfigError> {
+    let p = &mut imp.p;
     let n_tools = PER_EXTRUDER
         .iter()
         .filter_map(|k| p.values.get(*k))
@@ -298,32 +603,58 @@ fn convert(
         .unwrap_or(1)
         .max(1);
     let mut tools = vec![Tool::filament(); n_tools];
-    macro_rules! per_tool {
-        ($key:literal, $field:ident) => {
-            let values = p.list($key)?;
-            for (t, v) in tools.iter_mut().zip(values.iter().chain(std::iter::repeat(
-                values.last().unwrap_or(&Tool::filament().$field),
-            ))) {
-                t.$field = *v;
-            }
-        };
-    }
-    per_tool!("nozzle_diameter", nozzle_diameter);
-    per_tool!("filament_diameter", filament_diameter);
-    per_tool!("filament_density", filament_density);
-    for t in tools.iter_mut() {
-        if t.filament_density <= 0.0 {
-            t.filament_density = Tool::filament().filament_density;
-        }
-    }
-    per_tool!("temperature", temperature);
-    per_tool!("first_layer_temperature", first_layer_temperature);
-    per_tool!("extrusion_multiplier", extrusion_multiplier);
+    read_tool_numbers(p, &mut tools)?;
     for (t, name) in tools.iter_mut().zip(p.strings("filament_type")) {
         if !name.is_empty() {
             t.name = name;
         }
     }
+    read_idle_temperatures(p, &mut tools)?;
+    if let Some(raw) = p.raw("extruder_offset").map(str::to_owned) {
+        for (t, xy) in tools.iter_mut().zip(raw.split(',')) {
+            t.offset = parse_xy(xy).ok_or_else(|| p.err("extruder_offset", "expected XxY"))?;
+        }
+    }
+    let retract = p.list("retract_length")?;
+    if let Some(&first) = retract.first() {
+        imp.cfg.printer.retract_length = first;
+        for (t, &r) in tools.iter_mut().zip(&retract) {
+            if r != first {
+                t.retract_length = Some(r);
+            }
+        }
+    }
+    let nozzle = tools[0].nozzle_diameter;
+    imp.cfg.tools = tools;
+    imp.cfg.tools.push(Tool::paste());
+    imp.cfg.slice.region.nozzle_diameter = nozzle;
+    Ok(())
+}
+
+/// Fills the number fields of [`TOOL_NUMBERS`]; a density of 0 (PrusaSlicer's "unknown")
+/// keeps the default.
+fn read_tool_numbers(p: &mut Pairs, tools: &mut [Tool]) -> Result<(), ConfigError> {
+    for (key, field) in TOOL_NUMBERS {
+        let values = p.list(key)?;
+        let default = *field(&mut Tool::filament());
+        let fill = values.last().copied().unwrap_or(default);
+        for (t, v) in tools
+            .iter_mut()
+            .zip(values.iter().copied().chain(std::iter::repeat(fill)))
+        {
+            *field(t) = v;
+        }
+    }
+    for t in tools.iter_mut() {
+        if t.filament_density <= 0.0 {
+            t.filament_density = Tool::filament().filament_density;
+        }
+    }
+    Ok(())
+}
+
+/// Reads `idle_temperature` into the standby temperatures (`nil` leaves a tool without one).
+fn read_idle_temperatures(p: &mut Pairs, tools: &mut [Tool]) -> Result<(), ConfigError> {
     if let Some(raw) = p.raw("idle_temperature").map(str::to_owned) {
         for (t, v) in tools.iter_mut().zip(raw.split(',')) {
             let v = v.trim();
@@ -335,31 +666,17 @@ fn convert(
             }
         }
     }
-    if let Some(raw) = p.raw("extruder_offset").map(str::to_owned) {
-        for (t, xy) in tools.iter_mut().zip(raw.split(',')) {
-            t.offset = parse_xy(xy).ok_or_else(|| p.err("extruder_offset", "expected XxY"))?;
-        }
-    }
-    let retract = p.list("retract_length")?;
-    if let Some(&first) = retract.first() {
-        cfg.printer.retract_length = first;
-        for (t, &r) in tools.iter_mut().zip(&retract) {
-            if r != first {
-                t.retract_length = Some(r);
-            }
-        }
-    }
-    let nozzle = tools[0].nozzle_diameter;
-    cfg.tools = tools;
-    cfg.tools.push(Tool::paste());
+    Ok(())
+}
 
-    // Printer.
-    let pr = &mut cfg.printer;
-    if let Some(raw) = p.raw("bed_shape").map(str::to_owned) {
+/// `bed_shape`: the bounding box of the bed polygon gives the bed origin and size.
+fn bed_shape(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let p = &mut imp.p;
+    if let Some(raw) = p.raw(key).map(str::to_owned) {
         let points: Option<Vec<[f64; 2]>> = raw.split(',').map(parse_xy).collect();
         let points = points
             .filter(|pts| pts.len() >= 3)
-            .ok_or_else(|| p.err("bed_shape", "expected a polygon `XxY,XxY,XxY,…`"))?;
+            .ok_or_else(|| p.err(key, "expected a polygon `XxY,XxY,XxY,…`"))?;
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for q in &points {
             for a in 0..2 {
@@ -367,108 +684,65 @@ fn convert(
                 hi[a] = hi[a].max(q[a]);
             }
         }
+        let pr = &mut imp.cfg.printer;
         pr.bed_origin = lo;
         pr.bed_size = [hi[0] - lo[0], hi[1] - lo[1]];
     }
-    if let Some(v) = p.num("max_print_height")? {
-        pr.max_height = v;
-    }
-    if let Some(f) = p.raw("gcode_flavor").map(str::to_owned) {
-        pr.flavor = match f.trim() {
+    Ok(())
+}
+
+/// `gcode_flavor`: the firmware dialect; an unsupported one becomes marlin with a warning.
+fn gcode_flavor(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    if let Some(f) = imp.p.raw(key).map(str::to_owned) {
+        imp.cfg.printer.flavor = match f.trim() {
             "marlin" | "marlin2" | "marlinlegacy" => Flavor::Marlin,
             "reprapfirmware" => Flavor::RepRapFirmware,
             "klipper" => Flavor::Klipper,
             other => {
-                warnings.push(format!(
+                imp.warnings.push(format!(
                     "gcode_flavor = {other}: not supported, G-code is written for marlin"
                 ));
                 Flavor::Marlin
             }
         };
     }
-    for (key, field) in [
-        ("start_gcode", &mut pr.start_gcode),
-        ("end_gcode", &mut pr.end_gcode),
-    ] {
-        if let Some(g) = p.gcode(key) {
-            if has_macros(&g) {
-                warnings.push(format!(
-                    "{key} uses PrusaSlicer macros ({{if …}} or expressions) that conduit cannot \
-                     fill; edit printer.{key}"
-                ));
-            }
-            *field = g;
-        }
-    }
-    // PrusaSlicer's tool-change G-code runs before each tool change, as conduit's
-    // `before_tool_change_gcode` does; its extruder placeholders are conduit's tool ones.
-    if let Some(g) = p.gcode("toolchange_gcode") {
+    Ok(())
+}
+
+/// `toolchange_gcode`: PrusaSlicer's tool-change G-code runs before each tool change, as
+/// conduit's `before_tool_change_gcode` does; its extruder placeholders are conduit's tool
+/// ones.
+fn toolchange_gcode(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    if let Some(g) = imp.p.gcode(key) {
         let g = tool_placeholders(&g);
         if has_macros(&g) {
-            warnings.push(
+            imp.warnings.push(
                 "toolchange_gcode uses PrusaSlicer macros ({if …} or expressions) that conduit \
                  cannot fill; edit printer.before_tool_change_gcode"
                     .to_owned(),
             );
         }
-        pr.before_tool_change_gcode = g;
+        imp.cfg.printer.before_tool_change_gcode = g;
     }
-    for (key, field) in [
-        ("bed_temperature", &mut pr.bed_temperature),
-        (
-            "first_layer_bed_temperature",
-            &mut pr.first_layer_bed_temperature,
-        ),
-        ("retract_speed", &mut pr.retract_speed),
-        ("deretract_speed", &mut pr.deretract_speed),
-        ("retract_before_travel", &mut pr.retract_before_travel),
-        ("retract_lift", &mut pr.retract_lift),
-        ("travel_speed", &mut pr.travel_speed),
-        ("min_fan_speed", &mut pr.fan_min_speed),
-        ("max_fan_speed", &mut pr.fan_max_speed),
-    ] {
-        if let Some(v) = p.num(key)? {
-            *field = v;
-        }
-    }
-    let accel = p.num("machine_max_acceleration_extruding")?;
-    let default_accel = p.num("default_acceleration")?;
+    Ok(())
+}
+
+/// `machine_max_acceleration_extruding`, or when it is absent or 0 `default_acceleration`.
+fn acceleration(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let accel = imp.p.num(key)?;
+    let default_accel = imp.p.num("default_acceleration")?;
     if let Some(a) = accel
         .filter(|a| *a > 0.0)
         .or(default_accel.filter(|a| *a > 0.0))
     {
-        pr.max_acceleration = a;
+        imp.cfg.printer.max_acceleration = a;
     }
-    if let Some(v) = p.count("disable_fan_first_layers")? {
-        pr.disable_fan_first_layers = v;
-    }
-    if let Some(v) = p.flag("use_relative_e_distances")? {
-        pr.use_relative_e_distances = v;
-    }
-    if let Some(v) = p.flag("use_firmware_retraction")? {
-        pr.use_firmware_retraction = v;
-    }
+    Ok(())
+}
 
-    // Slicing.
-    let s = &mut cfg.slice;
-    s.region.nozzle_diameter = nozzle;
-    if let Some(v) = p.num("layer_height")? {
-        s.region.layer_height = v;
-    }
-    if let Some(v) = p.abs_or_percent("first_layer_height", s.region.layer_height)? {
-        s.first_layer_height = v;
-    }
-    for (key, field) in [
-        ("perimeters", &mut s.region.perimeters),
-        ("top_solid_layers", &mut s.region.top_solid_layers),
-        ("bottom_solid_layers", &mut s.region.bottom_solid_layers),
-        ("skirts", &mut s.region.skirt_loops),
-    ] {
-        if let Some(v) = p.count(key)? {
-            *field = v;
-        }
-    }
-    if let Some(raw) = p.raw("fill_density").map(str::to_owned) {
+/// `fill_density`: `20%` (or `20`, or `0.2`) → 0.2.
+fn fill_density(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    if let Some(raw) = imp.p.raw(key).map(str::to_owned) {
         let raw = raw.trim();
         let d = match raw.strip_suffix('%') {
             Some(pc) => pc.trim().parse::<f64>().map(|v| v / 100.0),
@@ -476,150 +750,80 @@ fn convert(
                 .parse::<f64>()
                 .map(|v| if v > 1.0 { v / 100.0 } else { v }),
         };
-        s.region.infill_density = d.map_err(|_| p.err("fill_density", "expected a percentage"))?;
+        imp.cfg.slice.region.infill_density =
+            d.map_err(|_| imp.p.err(key, "expected a percentage"))?;
     }
-    if let Some(v) = p.num("solid_infill_below_area")? {
-        s.region.solid_infill_below_area = v;
-    }
-    if let Some(v) = p.flag("gap_fill_enabled")? {
-        s.region.gap_fill = v;
-    }
-    if let Some(pat) = p.raw("fill_pattern").map(str::to_owned) {
-        s.region.infill_pattern = match pat.trim() {
+    Ok(())
+}
+
+/// `fill_pattern`: the sparse infill pattern; one conduit lacks becomes rectilinear with a
+/// warning.
+fn fill_pattern(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    if let Some(pat) = imp.p.raw(key).map(str::to_owned) {
+        imp.cfg.slice.region.infill_pattern = match pat.trim() {
             "rectilinear" => InfillPatternKind::Rectilinear,
             "grid" => InfillPatternKind::Grid,
             "triangles" => InfillPatternKind::Triangles,
             other => {
-                warnings.push(format!(
+                imp.warnings.push(format!(
                     "fill_pattern = {other}: not available, rectilinear infill is printed"
                 ));
                 InfillPatternKind::Rectilinear
             }
         };
     }
-    for (keys, field) in [
-        (
-            ["top_fill_pattern", "top_infill_pattern"],
-            &mut s.top_fill_pattern,
-        ),
-        (
-            ["bottom_fill_pattern", "bottom_infill_pattern"],
-            &mut s.bottom_fill_pattern,
-        ),
-    ] {
-        for key in keys {
-            if let Some(pat) = p.raw(key).map(str::to_owned) {
-                if pat.trim() != "rectilinear" {
-                    warnings.push(format!(
-                        "{key} = {}: not available, rectilinear solid infill is printed",
-                        pat.trim()
-                    ));
-                }
-                *field = SolidPattern::Rectilinear;
-            }
-        }
+    Ok(())
+}
+
+/// `infill_overlap`: PrusaSlicer gives mm, or % of the perimeter extrusion width; conduit a
+/// fraction of it (the perimeter width as it stands before the widths are read).
+fn infill_overlap(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let region = &mut imp.cfg.slice.region;
+    let perimeter_width_guess = region.perimeter_width;
+    if let Some(v) = imp.p.abs_or_percent(key, perimeter_width_guess)? {
+        region.infill_overlap = v / perimeter_width_guess;
     }
-    if let Some(v) = p.num("fill_angle")? {
-        s.region.infill_angle_deg = v;
-    }
-    let perimeter_width_guess = s.region.perimeter_width;
-    if let Some(v) = p.abs_or_percent("infill_overlap", perimeter_width_guess)? {
-        // PrusaSlicer: mm, or % of the perimeter extrusion width; conduit: a fraction of it.
-        s.region.infill_overlap = v / perimeter_width_guess;
-    }
-    if let Some(v) = p.flag("external_perimeters_first")? {
-        s.region.external_perimeters_first = v;
-    }
-    if let Some(v) = p.flag("support_material")? {
-        s.support_material = v;
-    }
-    if let Some(v) = p.num("skirt_distance")? {
-        s.region.skirt_distance = v;
-    }
-    if let Some(v) = p.num("brim_width")? {
-        s.brim_width = v;
-    }
-    if let Some(g) = p.raw("perimeter_generator").map(str::to_owned) {
+    Ok(())
+}
+
+/// `perimeter_generator`: conduit prints classic perimeters and warns about any other.
+fn perimeter_generator(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    if let Some(g) = imp.p.raw(key).map(str::to_owned) {
         if g.trim() != "classic" {
-            warnings.push(format!(
+            imp.warnings.push(format!(
                 "perimeter_generator = {}: conduit prints classic perimeters",
                 g.trim()
             ));
         }
     }
+    Ok(())
+}
 
-    // Widths: role key, automatic factor (× nozzle), field.
-    let generic = p
-        .abs_or_percent("extrusion_width", nozzle)?
-        .filter(|w| *w > 0.0);
-    let width = |p: &mut Pairs, key: &str, auto: f64| -> Result<Option<f64>, ConfigError> {
-        let given = p.abs_or_percent(key, nozzle)?;
-        Ok(match given {
-            Some(w) if w > 0.0 => Some(w),
-            _ => Some(generic.unwrap_or(auto * nozzle)),
-        })
-    };
-    for (key, auto, field) in [
-        (
-            "perimeter_extrusion_width",
-            1.125,
-            &mut s.region.perimeter_width,
-        ),
-        (
-            "external_perimeter_extrusion_width",
-            1.125,
-            &mut s.region.external_perimeter_width,
-        ),
-        ("infill_extrusion_width", 1.125, &mut s.region.infill_width),
-        (
-            "solid_infill_extrusion_width",
-            1.125,
-            &mut s.region.solid_infill_width,
-        ),
-        (
-            "top_infill_extrusion_width",
-            1.0,
-            &mut s.region.top_solid_infill_width,
-        ),
-    ] {
-        if let Some(w) = width(&mut p, key, auto)? {
-            *field = w;
-        }
+/// `extrusion_width` and the role widths of [`WIDTHS`]: a role's 0 (or missing) width falls
+/// back to the generic one, and when that is 0 too to the automatic width; a first-layer width
+/// of 0 takes the perimeter width.
+fn extrusion_widths(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let (p, cfg) = (&mut imp.p, &mut imp.cfg);
+    // The first tool's nozzle, as `read_tools` set it.
+    let nozzle = cfg.slice.region.nozzle_diameter;
+    let generic = p.abs_or_percent(key, nozzle)?.filter(|w| *w > 0.0);
+    for (role, auto, field) in WIDTHS {
+        *field(cfg) = match p.abs_or_percent(role, nozzle)? {
+            Some(w) if w > 0.0 => w,
+            _ => generic.unwrap_or(auto * nozzle),
+        };
     }
+    let region = &mut cfg.slice.region;
     match p.abs_or_percent("first_layer_extrusion_width", nozzle)? {
-        Some(w) if w > 0.0 => s.region.first_layer_width = w,
-        _ => s.region.first_layer_width = s.region.perimeter_width,
+        Some(w) if w > 0.0 => region.first_layer_width = w,
+        _ => region.first_layer_width = region.perimeter_width,
     }
+    Ok(())
+}
 
-    // Speeds; a percentage is of the parent PrusaSlicer uses.
-    if let Some(v) = p.num("perimeter_speed")? {
-        s.perimeter_speed = v;
-    }
-    if let Some(v) = p.abs_or_percent("external_perimeter_speed", s.perimeter_speed)? {
-        s.external_perimeter_speed = v;
-    }
-    if let Some(v) = p.num("infill_speed")? {
-        s.infill_speed = v;
-    }
-    if let Some(v) = p.abs_or_percent("solid_infill_speed", s.infill_speed)? {
-        s.solid_infill_speed = v;
-    }
-    if let Some(v) = p.abs_or_percent("top_solid_infill_speed", s.solid_infill_speed)? {
-        s.top_solid_infill_speed = v;
-    }
-    if let Some(v) = p.num("bridge_speed")? {
-        s.bridge_speed = v;
-    }
-    if let Some(v) = p.num("gap_fill_speed")? {
-        s.gap_fill_speed = v;
-    }
-    if let Some(v) = p.abs_or_percent("first_layer_speed", s.perimeter_speed)? {
-        s.first_layer_speed = v;
-    }
-    if let Some(v) = p.abs_or_percent("support_material_speed", s.perimeter_speed)? {
-        s.skirt_speed = v;
-    }
-
+/// Lists, in one warning, every key no step has read.
+fn warn_ignored(imp: &mut Import) {
+    let p = &mut imp.p;
     for key in ACCEPTED {
         p.used.insert((*key).to_owned());
     }
@@ -630,14 +834,11 @@ fn convert(
         .map(String::as_str)
         .collect();
     if !ignored.is_empty() {
-        warnings.push(format!(
+        imp.warnings.push(format!(
             "ignored PrusaSlicer settings (no conduit equivalent): {}",
             ignored.join(", ")
         ));
     }
-    let more = cfg.validate()?;
-    warnings.extend(more);
-    Ok((cfg, warnings))
 }
 
 /// `250x125` → [250, 125].
@@ -646,7 +847,6 @@ fn parse_xy(s: &str) -> Option<[f64; 2]> {
     Some([x.trim().parse().ok()?, y.trim().parse().ok()?])
 }
 
-/// True when a template has `{…}` that is not a plain `{key}` / `{key[N]}` placeholder.
 /// `g` with PrusaSlicer's extruder placeholders (`{next_extruder}`, `[next_extruder]`,
 /// `{previous_extruder}`, `[previous_extruder]`) written as conduit's `{next_tool}` and
 /// `{previous_tool}`.
@@ -663,6 +863,7 @@ fn tool_placeholders(g: &str) -> String {
     out
 }
 
+/// True when a template has `{…}` that is not a plain `{key}` / `{key[N]}` placeholder.
 fn has_macros(g: &str) -> bool {
     g.split('{').skip(1).any(|part| {
         let inner = part.split('}').next().unwrap_or_default();

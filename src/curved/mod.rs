@@ -41,7 +41,7 @@ use crate::geom::{
     ExPolygon, Join, Point2, Point3, Polygon, difference, intersection, offset, scaled, union,
 };
 use crate::mesh::Mesh;
-use crate::program::{Event, LayerItem, Program, ProgramParams, Role, Toolpath};
+use crate::program::{Event, LayerItem, Program, ProgramParams, Role, RoleSpeeds, Toolpath};
 use crate::region::infill::{InfillPattern, Rectilinear};
 use crate::region::make_perimeters;
 use crate::slice::LayerZ;
@@ -327,6 +327,9 @@ fn collision_rejection(oi: usize, hit: &collision::Hit, what: String) -> Rejecti
     }
 }
 
+/// Plans one top region: sets it up, steps its layers in from the material beside it, trims
+/// them where the head hits until it clears, reports the trimmed rim pieces to `rejections`
+/// and turns the layers into toolpaths.
 fn plan_region(
     objects: &[CurvedObject<'_>],
     oi: usize,
@@ -336,164 +339,262 @@ fn plan_region(
     cfg: &Config,
     rejections: &mut Vec<Rejection>,
 ) -> Result<RegionPlan, Rejection> {
-    let obj = &objects[oi];
-    let c = &cfg.curved;
-    let n = cfg.slice.region.top_solid_layers;
-    let h = cfg.slice.region.layer_height;
-    let peak = [region.peak.x, region.peak.y, region.peak.z];
-    let Some(after) = top_layer_at(obj.layers, region.peak.z) else {
-        return Err(Rejection {
-            object: oi,
-            kind: "below_first_layer",
-            reason: "the surface lies below the first layer's slicing plane".to_owned(),
-            position: peak,
-            setting: "a lower slice.first_layer_height".to_owned(),
-        });
-    };
-    let speeds = ProgramParams::from_config(cfg)
-        .tools
-        .get(obj.tool)
-        .map(|t| t.speeds)
-        .unwrap_or_default();
+    let job = RegionJob::new(objects, oi, region, hf, head, cfg)?;
     // Each deeper layer steps in from the one above so the head clears the planar columns
     // beside it ([`tops::rim_step`]); where the head still hits, the layer and those under it
     // are trimmed around the material it hits, and the stack is planned again.
-    let top_area = vec![region.area.clone()];
-    let step = rim_step(c.head_angle, h, region.max_slope_deg);
-    // The object's islands near the region (within the head's and the loops' reach) and at
-    // its height (from `n + 1` layers under its lowest point up to the layers over its top):
-    // all that the removals, the material beside it and the collision test look at. The rest
-    // of each island is far away, and clipping it off keeps the polygon operations small.
-    let params = cfg.slice.region.for_layer(1);
-    let reach = (params.perimeters + 2) as f64 * params.perimeter_width
-        + n as f64 * step.unwrap_or(0.0)
-        + 1.0;
-    let bb = ring_bbox(&region.area);
-    let grow = head.max_radius().max(reach) + 1.0;
-    let window = [bb[0] - grow, bb[1] - grow, bb[2] + grow, bb[3] + grow];
-    let window_area = [ExPolygon {
-        contour: Polygon::new(vec![
-            Point2::from_mm(window[0], window[1]),
-            Point2::from_mm(window[2], window[1]),
-            Point2::from_mm(window[2], window[3]),
-            Point2::from_mm(window[0], window[3]),
-        ]),
-        holes: Vec::new(),
-    }];
-    let z_from = region.z_min - (n + 1) as f64 * h;
-    let islands: Vec<Vec<ExPolygon>> = obj
-        .layers
-        .iter()
-        .zip(obj.islands)
-        .enumerate()
-        .map(|(j, (lz, isl))| {
-            if lz.top >= z_from && j <= after + n + 1 {
-                intersection(isl, &window_area)
-            } else {
-                Vec::new()
-            }
-        })
-        .collect();
-    // The footprint at the region's height: where planar material stands beside the region
-    // when its curved layers are printed. Elsewhere the region's rim is an outer wall.
-    // Layer by layer: stacked layers repeat the same edges, which one overlay of all of them
-    // handles very slowly.
-    let footprint = islands[..=after].iter().filter(|isl| !isl.is_empty()).fold(
-        Vec::new(),
-        |acc: Vec<ExPolygon>, isl| {
-            if acc.is_empty() {
-                isl.clone()
-            } else {
-                union(&[acc.as_slice(), isl.as_slice()].concat())
-            }
-        },
-    );
-    let footprint = footprint.as_slice();
-    // Planar material beside the region (slivers along outer walls left out).
-    let material = offset(
-        &offset(
-            &difference(footprint, &top_area),
-            -SLIVER_MM,
-            Join::Miter(2.0),
-        ),
-        SLIVER_MM,
-        Join::Miter(2.0),
-    );
-    let mut areas: Vec<Vec<ExPolygon>> = (0..n)
-        .map(|k| match (k, step) {
-            (0, _) => top_area.clone(),
-            _ if material.is_empty() => top_area.clone(),
-            (_, Some(s)) => difference(
-                &top_area,
-                &offset(&material, k as f64 * s, Join::Miter(2.0)),
-            ),
-            (_, None) => Vec::new(),
-        })
-        .collect();
-    let after_top = obj.layers[after].top;
-    let mut trims: Vec<(usize, collision::Hit)> = Vec::new();
-    let mut rounds = 0;
-    let (layers, remove) = loop {
-        let layers = project_layers(&areas, region, obj, hf, cfg);
-        if layers.iter().all(|(_, pieces, ..)| pieces.is_empty()) {
-            return Err(match trims.first() {
-                Some((_, hit)) => collision_rejection(
-                    oi,
-                    hit,
-                    format!(
-                        "trimming the rim where the head hits leaves nothing of the region \
-                         ({:.1} mm²)",
-                        region.area.area_mm2()
-                    ),
-                ),
-                None => Rejection {
-                    object: oi,
-                    kind: "too_small",
-                    reason: format!(
-                        "the region ({:.1} mm²) is too small for a perimeter or infill line",
-                        region.area.area_mm2()
-                    ),
-                    position: peak,
-                    setting: "narrower extrusion widths in [slice]".to_owned(),
-                },
+    let mut areas = job.stepped_areas();
+    let cleared = job.trim_until_clear(&mut areas)?;
+    job.report_trims(&cleared.trims, rejections);
+    Ok(job.emit(cleared, &areas))
+}
+
+/// One top region being planned: its object, the shared inputs, and what the setup derives
+/// from them once for every step.
+struct RegionJob<'a> {
+    /// Every object (the collision test sees them all).
+    objects: &'a [CurvedObject<'a>],
+    /// Index of the region's object.
+    oi: usize,
+    /// The region's object.
+    obj: &'a CurvedObject<'a>,
+    /// The region.
+    region: &'a TopRegion,
+    /// The object's top surface.
+    hf: &'a HeightField,
+    /// The head model.
+    head: &'a Head,
+    /// The whole config.
+    cfg: &'a Config,
+    /// Number of curved layers (the top solid layers).
+    n: usize,
+    /// Layer height, mm.
+    h: f64,
+    /// The planar layer holding the region's highest point.
+    after: usize,
+    /// That layer's top, mm.
+    after_top: f64,
+    /// How far each deeper layer steps in ([`tops::rim_step`]).
+    step: Option<f64>,
+    /// The region's area, as the topmost curved layer covers it.
+    top_area: Vec<ExPolygon>,
+    /// The window around the region the islands are clipped to: [min x, min y, max x, max y].
+    window: [f64; 4],
+    /// The object's islands clipped to the window and to the region's height.
+    islands: Vec<Vec<ExPolygon>>,
+}
+
+/// The trimming loop's outcome: the projected layers that clear the head, the planar areas
+/// they replace, every trimmed hit (by layer) and the number of rounds.
+struct Cleared {
+    /// The curved layers, lowest first.
+    layers: Vec<ProjectedLayer>,
+    /// Per planar layer, the area the curved layers replace.
+    remove: Vec<Vec<ExPolygon>>,
+    /// Every hit trimmed, with its layer.
+    trims: Vec<(usize, collision::Hit)>,
+    /// Rounds of trimming.
+    rounds: usize,
+}
+
+impl<'a> RegionJob<'a> {
+    /// Sets the region up: finds the planar layer it follows (a rejection when it lies below
+    /// the first layer), its rim step and the islands near it.
+    fn new(
+        objects: &'a [CurvedObject<'a>],
+        oi: usize,
+        region: &'a TopRegion,
+        hf: &'a HeightField,
+        head: &'a Head,
+        cfg: &'a Config,
+    ) -> Result<Self, Rejection> {
+        let obj = &objects[oi];
+        let n = cfg.slice.region.top_solid_layers;
+        let h = cfg.slice.region.layer_height;
+        let Some(after) = top_layer_at(obj.layers, region.peak.z) else {
+            return Err(Rejection {
+                object: oi,
+                kind: "below_first_layer",
+                reason: "the surface lies below the first layer's slicing plane".to_owned(),
+                position: peak(region),
+                setting: "a lower slice.first_layer_height".to_owned(),
             });
+        };
+        let top_area = vec![region.area.clone()];
+        let step = rim_step(cfg.curved.head_angle, h, region.max_slope_deg);
+        let window = region_window(region, head, cfg, step);
+        let islands = islands_near(obj, region, window, after, n, h);
+        Ok(Self {
+            objects,
+            oi,
+            obj,
+            region,
+            hf,
+            head,
+            cfg,
+            n,
+            h,
+            after,
+            after_top: obj.layers[after].top,
+            step,
+            top_area,
+            window,
+            islands,
+        })
+    }
+
+    /// The area of each curved layer (topmost first) before any trimming: the region, each
+    /// deeper layer stepped in a rim step more from the planar material beside it.
+    fn stepped_areas(&self) -> Vec<Vec<ExPolygon>> {
+        let top_area = &self.top_area;
+        // The footprint at the region's height: where planar material stands beside the region
+        // when its curved layers are printed. Elsewhere the region's rim is an outer wall.
+        // Layer by layer: stacked layers repeat the same edges, which one overlay of all of them
+        // handles very slowly.
+        let footprint = self.islands[..=self.after]
+            .iter()
+            .filter(|isl| !isl.is_empty())
+            .fold(Vec::new(), |acc: Vec<ExPolygon>, isl| {
+                if acc.is_empty() {
+                    isl.clone()
+                } else {
+                    union(&[acc.as_slice(), isl.as_slice()].concat())
+                }
+            });
+        let footprint = footprint.as_slice();
+        // Planar material beside the region (slivers along outer walls left out).
+        let material = offset(
+            &offset(
+                &difference(footprint, top_area),
+                -SLIVER_MM,
+                Join::Miter(2.0),
+            ),
+            SLIVER_MM,
+            Join::Miter(2.0),
+        );
+        (0..self.n)
+            .map(|k| match (k, self.step) {
+                (0, _) => top_area.clone(),
+                _ if material.is_empty() => top_area.clone(),
+                (_, Some(s)) => {
+                    difference(top_area, &offset(&material, k as f64 * s, Join::Miter(2.0)))
+                }
+                (_, None) => Vec::new(),
+            })
+            .collect()
+    }
+
+    /// Projects the layers over `areas` and tests them against the head; while it hits, trims
+    /// `areas` around the hits and projects again. A rejection when nothing of the region is
+    /// left or the head still hits after [`MAX_TRIM_ROUNDS`] rounds.
+    fn trim_until_clear(&self, areas: &mut [Vec<ExPolygon>]) -> Result<Cleared, Rejection> {
+        let mut trims: Vec<(usize, collision::Hit)> = Vec::new();
+        let mut rounds = 0;
+        loop {
+            let layers = project_layers(areas, self.region, self.obj, self.hf, self.cfg);
+            if layers.iter().all(|(_, pieces, ..)| pieces.is_empty()) {
+                return Err(self.nothing_left(&trims));
+            }
+            let remove = removal_stepped(areas, &self.islands);
+            let material = self.material_under(&layers, &remove);
+            let found = self.head_hits(&layers, &material);
+            if found.is_empty() {
+                return Ok(Cleared {
+                    layers,
+                    remove,
+                    trims,
+                    rounds,
+                });
+            }
+            rounds += 1;
+            if rounds > MAX_TRIM_ROUNDS {
+                let (k, hit) = found[0];
+                return Err(collision_rejection(
+                    self.oi,
+                    &hit,
+                    format!("curved layer {k} still collides after {MAX_TRIM_ROUNDS} trims"),
+                ));
+            }
+            self.trim(areas, &found);
+            trims.extend(found);
         }
-        let remove = removal_stepped(&areas, &islands);
+    }
+
+    /// The rejection when the layers hold no path: the first trim took it all, or the region
+    /// is too small for one.
+    fn nothing_left(&self, trims: &[(usize, collision::Hit)]) -> Rejection {
+        let region = self.region;
+        match trims.first() {
+            Some((_, hit)) => collision_rejection(
+                self.oi,
+                hit,
+                format!(
+                    "trimming the rim where the head hits leaves nothing of the region \
+                     ({:.1} mm²)",
+                    region.area.area_mm2()
+                ),
+            ),
+            None => Rejection {
+                object: self.oi,
+                kind: "too_small",
+                reason: format!(
+                    "the region ({:.1} mm²) is too small for a perimeter or infill line",
+                    region.area.area_mm2()
+                ),
+                position: peak(region),
+                setting: "narrower extrusion widths in [slice]".to_owned(),
+            },
+        }
+    }
+
+    /// The material printed before the curved layers, from the lowest curved point up to the
+    /// planar layer they follow: every object's layers, this object's less what `remove`
+    /// gives up.
+    fn material_under(&self, layers: &[ProjectedLayer], remove: &[Vec<ExPolygon>]) -> Material {
         let z_low = layers
             .iter()
             .flat_map(|(_, pieces, ..)| pieces.iter().flat_map(|p| p.points.iter()))
             .map(|p| p.z)
             .fold(f64::MAX, f64::min);
         let mut material = Material::default();
-        for (o, other) in objects.iter().enumerate() {
+        for (o, other) in self.objects.iter().enumerate() {
             for (j, lz) in other.layers.iter().enumerate() {
-                if lz.top <= z_low || lz.top > after_top + 1e-9 {
+                if lz.top <= z_low || lz.top > self.after_top + 1e-9 {
                     continue;
                 }
-                let isl = if o == oi {
-                    islands.get(j)
+                let isl = if o == self.oi {
+                    self.islands.get(j)
                 } else {
                     other.islands.get(j)
                 };
                 let Some(isl) = isl else {
                     continue;
                 };
-                if o == oi && !remove[j].is_empty() {
-                    material.add_layer(lz.top, &difference(isl, &remove[j]), window);
+                if o == self.oi && !remove[j].is_empty() {
+                    material.add_layer(lz.top, &difference(isl, &remove[j]), self.window);
                 } else {
-                    material.add_layer(lz.top, isl, window);
+                    material.add_layer(lz.top, isl, self.window);
                 }
             }
         }
-        // Every layer's nozzles against the planar material and the layer's own points (a
-        // concave surface may rise into the head beside the nozzle).
+        material
+    }
+
+    /// Every layer's nozzles against the planar material and the layer's own points (a concave
+    /// surface may rise into the head beside the nozzle): the hits, one per layer and
+    /// [`HIT_GRID_MM`] square.
+    fn head_hits(
+        &self,
+        layers: &[ProjectedLayer],
+        material: &Material,
+    ) -> Vec<(usize, collision::Hit)> {
         let mut found: Vec<(usize, collision::Hit)> = Vec::new();
         let mut seen = std::collections::BTreeSet::new();
-        for (k, pieces, ..) in &layers {
+        for (k, pieces, ..) in layers {
             let nozzles = sample_nozzles(pieces.iter().flat_map(|p| p.points.iter().copied()));
             let mut with_own = material.clone();
             with_own.add_points(nozzles.iter().copied());
-            for hit in head.hits(&nozzles, &with_own) {
+            for hit in self.head.hits(&nozzles, &with_own) {
                 let key = (
                     *k,
                     (hit.material.x / HIT_GRID_MM).floor() as i64,
@@ -504,27 +605,20 @@ fn plan_region(
                 }
             }
         }
-        if found.is_empty() {
-            break (layers, remove);
-        }
-        rounds += 1;
-        if rounds > MAX_TRIM_ROUNDS {
-            let (k, hit) = found[0];
-            return Err(collision_rejection(
-                oi,
-                &hit,
-                format!("curved layer {k} still collides after {MAX_TRIM_ROUNDS} trims"),
-            ));
-        }
-        // A hit on layer k trims it and every deeper layer, each deeper one a rim step more
-        // (what it trims becomes planar material beside the deeper layers).
+        found
+    }
+
+    /// Trims `areas` around the hits: a hit on layer k trims it and every deeper layer, each
+    /// deeper one a rim step more (what it trims becomes planar material beside the deeper
+    /// layers).
+    fn trim(&self, areas: &mut [Vec<ExPolygon>], found: &[(usize, collision::Hit)]) {
         let discs_of = |k: usize| -> Vec<ExPolygon> {
             found
                 .iter()
                 .filter(|(hk, _)| *hk <= k)
                 .map(|(hk, hit)| {
-                    let r = head.radius_at(hit.rise()).map_or(0.0, |(r, _)| r);
-                    let steps = (k - hk) as f64 * step.unwrap_or(0.0);
+                    let r = self.head.radius_at(hit.rise()).map_or(0.0, |(r, _)| r);
+                    let steps = (k - hk) as f64 * self.step.unwrap_or(0.0);
                     disc(hit.material.x, hit.material.y, r + TRIM_MARGIN_MM + steps)
                 })
                 .collect()
@@ -535,60 +629,101 @@ fn plan_region(
                 *area = difference(area, &union(&discs));
             }
         }
-        trims.extend(found);
-    };
-    // Report every trimmed piece: per layer, each connected group of trimmed hits.
-    for k in 0..n {
-        let hits: Vec<&collision::Hit> = trims
-            .iter()
-            .filter(|(hk, _)| *hk == k)
-            .map(|(_, h)| h)
-            .collect();
-        if hits.is_empty() {
-            continue;
-        }
-        let discs: Vec<ExPolygon> = hits
-            .iter()
-            .map(|hit| {
-                let r = head.radius_at(hit.rise()).map_or(0.0, |(r, _)| r);
-                disc(hit.material.x, hit.material.y, r + TRIM_MARGIN_MM)
-            })
-            .collect();
-        for group in union(&discs) {
-            let Some(hit) = hits
+    }
+
+    /// Reports every trimmed piece to `rejections`: per layer, each connected group of trimmed
+    /// hits with the area of the rim it leaves planar.
+    fn report_trims(&self, trims: &[(usize, collision::Hit)], rejections: &mut Vec<Rejection>) {
+        for k in 0..self.n {
+            let hits: Vec<&collision::Hit> = trims
                 .iter()
-                .find(|hit| group.contains(Point2::from_mm(hit.material.x, hit.material.y)))
-            else {
+                .filter(|(hk, _)| *hk == k)
+                .map(|(_, h)| h)
+                .collect();
+            if hits.is_empty() {
                 continue;
-            };
-            let lost = area_of(&intersection(std::slice::from_ref(&group), &top_area));
-            rejections.push(collision_rejection(
-                oi,
-                hit,
-                format!(
-                    "curved layer {k} (depth {:.2} mm) leaves out {lost:.1} mm² of the region's \
-                     rim here, printed planar",
-                    k as f64 * h
-                ),
-            ));
+            }
+            let discs: Vec<ExPolygon> = hits
+                .iter()
+                .map(|hit| {
+                    let r = self.head.radius_at(hit.rise()).map_or(0.0, |(r, _)| r);
+                    disc(hit.material.x, hit.material.y, r + TRIM_MARGIN_MM)
+                })
+                .collect();
+            for group in union(&discs) {
+                let Some(hit) = hits
+                    .iter()
+                    .find(|hit| group.contains(Point2::from_mm(hit.material.x, hit.material.y)))
+                else {
+                    continue;
+                };
+                let lost = area_of(&intersection(std::slice::from_ref(&group), &self.top_area));
+                rejections.push(collision_rejection(
+                    self.oi,
+                    hit,
+                    format!(
+                        "curved layer {k} (depth {:.2} mm) leaves out {lost:.1} mm² of the region's \
+                         rim here, printed planar",
+                        k as f64 * self.h
+                    ),
+                ));
+            }
         }
     }
-    let mut items = Vec::new();
-    let mut rep = RegionReport {
-        object: oi,
-        area_mm2: region.area.area_mm2(),
-        curved_area_mm2: area_of(&areas[0]),
-        rim_step_mm: step,
-        trim_rounds: rounds,
-        min_slope_deg: region.min_slope_deg,
-        max_slope_deg: region.max_slope_deg,
-        after_layer: after,
-        layers: Vec::new(),
-        points_dropped: 0,
-        z_speed_limited: 0,
-    };
-    let cusp = h * region.max_slope_deg.to_radians().cos();
-    for (k, pieces, meta, dropped) in layers {
+
+    /// The region's plan: the planar removals, the curved layers as toolpaths (lowest first,
+    /// each after its comment) and the region's report (layers topmost first).
+    fn emit(&self, cleared: Cleared, areas: &[Vec<ExPolygon>]) -> RegionPlan {
+        let region = self.region;
+        let speeds = ProgramParams::from_config(self.cfg)
+            .tools
+            .get(self.obj.tool)
+            .map(|t| t.speeds)
+            .unwrap_or_default();
+        let mut items = Vec::new();
+        let mut rep = RegionReport {
+            object: self.oi,
+            area_mm2: region.area.area_mm2(),
+            curved_area_mm2: area_of(&areas[0]),
+            rim_step_mm: self.step,
+            trim_rounds: cleared.rounds,
+            min_slope_deg: region.min_slope_deg,
+            max_slope_deg: region.max_slope_deg,
+            after_layer: self.after,
+            layers: Vec::new(),
+            points_dropped: 0,
+            z_speed_limited: 0,
+        };
+        let cusp = self.h * region.max_slope_deg.to_radians().cos();
+        for layer in cleared.layers {
+            let area_mm2 = area_of(&areas[layer.0]);
+            let lr = self.emit_layer(layer, area_mm2, cusp, &speeds, &mut rep, &mut items);
+            rep.layers.push(lr);
+        }
+        rep.layers.reverse();
+        (
+            cleared.remove,
+            CurvedInsert {
+                after_z: self.after_top,
+                tool: self.obj.tool,
+                items,
+            },
+            rep,
+        )
+    }
+
+    /// One curved layer's comment and toolpaths, appended to `items`; returns its report and
+    /// adds its dropped points and z-limited moves to `rep`.
+    fn emit_layer(
+        &self,
+        (k, pieces, meta, dropped): ProjectedLayer,
+        area_mm2: f64,
+        cusp: f64,
+        speeds: &RoleSpeeds,
+        rep: &mut RegionReport,
+        items: &mut Vec<LayerItem>,
+    ) -> CurvedLayerReport {
+        let (oi, h) = (self.oi, self.h);
         let depth = k as f64 * h;
         items.push(LayerItem::Event(Event::Comment(format!(
             "{LAYER_COMMENT} layer {k} depth {depth:.3} (object {oi})"
@@ -596,7 +731,7 @@ fn plan_region(
         let mut lr = CurvedLayerReport {
             k,
             depth,
-            area_mm2: area_of(&areas[k]),
+            area_mm2,
             points: 0,
             max_deviation: 0.0,
             planar_cusp: cusp,
@@ -608,13 +743,14 @@ fn plan_region(
                 points: Vec::new(),
                 closed: false,
                 role,
-                tool: obj.tool,
+                tool: self.obj.tool,
                 width,
                 height: h,
                 speed: speeds.for_role(role),
                 tool_axis: None,
             };
-            let (paths, stats) = motion::to_toolpaths(piece, &template, c.max_z_speed);
+            let (paths, stats) =
+                motion::to_toolpaths(piece, &template, self.cfg.curved.max_z_speed);
             rep.z_speed_limited += stats.z_limited;
             if let Some((lo, hi)) = stats.thickness {
                 lr.thickness = Some(match lr.thickness {
@@ -624,22 +760,68 @@ fn plan_region(
             }
             for p in paths {
                 lr.points += p.points.len();
-                lr.max_deviation = lr.max_deviation.max(deviation(&p, hf, depth));
+                lr.max_deviation = lr.max_deviation.max(deviation(&p, self.hf, depth));
                 items.push(LayerItem::Path(p));
             }
         }
-        rep.layers.push(lr);
+        lr
     }
-    rep.layers.reverse();
-    Ok((
-        remove,
-        CurvedInsert {
-            after_z: after_top,
-            tool: obj.tool,
-            items,
-        },
-        rep,
-    ))
+}
+
+/// The region's highest point, as a rejection's position.
+fn peak(region: &TopRegion) -> [f64; 3] {
+    [region.peak.x, region.peak.y, region.peak.z]
+}
+
+/// The window around `region` that the head and the loops can reach, [min x, min y, max x,
+/// max y], mm: the region's bounding box grown by the larger of the head's radius and the
+/// reach of its perimeters and rim steps.
+fn region_window(region: &TopRegion, head: &Head, cfg: &Config, step: Option<f64>) -> [f64; 4] {
+    let n = cfg.slice.region.top_solid_layers;
+    let params = cfg.slice.region.for_layer(1);
+    let reach = (params.perimeters + 2) as f64 * params.perimeter_width
+        + n as f64 * step.unwrap_or(0.0)
+        + 1.0;
+    let bb = ring_bbox(&region.area);
+    let grow = head.max_radius().max(reach) + 1.0;
+    [bb[0] - grow, bb[1] - grow, bb[2] + grow, bb[3] + grow]
+}
+
+/// The object's islands near the region (within `window`) and at its height (from `n + 1`
+/// layers under its lowest point up to the layers over its top, `after` being the planar
+/// layer holding its peak); other layers are left empty. That is all the removals, the
+/// material beside the region and the collision test look at: the rest of each island is far
+/// away, and clipping it off keeps the polygon operations small.
+fn islands_near(
+    obj: &CurvedObject<'_>,
+    region: &TopRegion,
+    window: [f64; 4],
+    after: usize,
+    n: usize,
+    h: f64,
+) -> Vec<Vec<ExPolygon>> {
+    let window_area = [ExPolygon {
+        contour: Polygon::new(vec![
+            Point2::from_mm(window[0], window[1]),
+            Point2::from_mm(window[2], window[1]),
+            Point2::from_mm(window[2], window[3]),
+            Point2::from_mm(window[0], window[3]),
+        ]),
+        holes: Vec::new(),
+    }];
+    let z_from = region.z_min - (n + 1) as f64 * h;
+    obj.layers
+        .iter()
+        .zip(obj.islands)
+        .enumerate()
+        .map(|(j, (lz, isl))| {
+            if lz.top >= z_from && j <= after + n + 1 {
+                intersection(isl, &window_area)
+            } else {
+                Vec::new()
+            }
+        })
+        .collect()
 }
 
 /// Largest distance of a path's points and segment midpoints from surface − depth, mm.

@@ -56,6 +56,7 @@ use crate::curved::motion;
 use crate::geom::{ExPolygon, Point3};
 use crate::mesh::Mesh;
 use crate::program::{Event, Layer, LayerItem, ProgramParams, Role, RoleSpeeds, Toolpath};
+use collide::Collisions;
 use layers::{LayerSpec, LiftedLayer, lift_layer};
 use outline::Rim;
 use report::{CoreReport, LayerReport, PlacementReport, ScaffoldReport, SectionReport};
@@ -130,6 +131,30 @@ pub fn plan(
     raised: f64,
     cfg: &Config,
 ) -> Result<ClfffPlan, ClfffError> {
+    check_tools(cfg)?;
+    let shape = Shape::new(meshes, cfg)?;
+    let limit = shape.limit(cfg);
+    let scaffold = build_scaffold(&shape.area, &limit, cfg);
+    let support = |x: f64, y: f64| scaffold.top_at(&limit, x, y);
+    let sandwich = sandwich_of(shape.n, cfg);
+    let specs = layer_specs(shape.n, sandwich.as_ref(), cfg);
+    let lifted = lift_layers(&shape, specs, sandwich.as_ref(), &support, cfg);
+    let made = Made {
+        shape: &shape,
+        scaffold: &scaffold,
+        lifted: &lifted,
+        sandwich: sandwich.as_ref(),
+        support: &support,
+    };
+    let emitted = emit_sections(&made, tool, cfg)?;
+    Ok(assemble_plan(&made, emitted, raised, cfg))
+}
+
+/// A support height at (x, y): the scaffold's top under a point, mm.
+type Support<'a> = &'a dyn Fn(f64, f64) -> f64;
+
+/// Refuses a scaffold or buffer tool the config does not define.
+fn check_tools(cfg: &Config) -> Result<(), ClfffError> {
     let c = &cfg.curved;
     for (key, t) in [
         ("scaffold_tool", c.scaffold_tool),
@@ -143,63 +168,119 @@ pub fn plan(
             });
         }
     }
-    let shell = Shell::from_meshes(meshes);
-    let out = outline::outline(&shell);
-    if shell.is_empty() || out.is_empty() {
-        return Err(ClfffError::NoSurface);
-    }
-    let h = cfg.slice.region.layer_height;
-    let thickness = shell.median_thickness();
-    if c.sandwich && thickness <= 0.0 {
-        return Err(ClfffError::SandwichWithoutThickness);
-    }
-    let n = if c.layers > 0 {
-        c.layers
-    } else if c.sandwich {
-        c.top_layers.max(1)
-    } else {
-        ((thickness / h).round() as usize).max(1)
-    };
-    let buffer_h = if c.buffer { h } else { 0.0 };
-    let rim = Rim::new(&out, &shell);
-    let limit = Limit {
-        shell: &shell,
-        rim: &rim,
-        below: buffer_h + c.scaffold_clearance,
-    };
-    let area = outline::scaffold_area(&out, c.scaffold_margin);
-    let params = ProgramParams::from_config(cfg);
-    let region = &cfg.slice.region;
+    Ok(())
+}
 
-    // Scaffold.
-    let scaffold = if c.scaffold {
+/// The shell of the placed meshes and what its geometry gives the later steps.
+struct Shape {
+    /// The bottom and top surfaces.
+    shell: Shell,
+    /// The top-down outline (holes kept).
+    out: Vec<ExPolygon>,
+    /// The shell's median thickness, mm.
+    thickness: f64,
+    /// Number of bottom (model) layers.
+    n: usize,
+    /// The outline's rim heights.
+    rim: Rim,
+    /// The scaffold area: the outline's convex hull grown by `curved.scaffold_margin`.
+    area: Vec<ExPolygon>,
+}
+
+impl Shape {
+    /// Reads the surfaces and outline of `meshes` and counts the model layers (`curved.layers`,
+    /// else the top skin's with a sandwich, else the thickness in layers). Errors when there
+    /// is no surface, or no thickness for a sandwich.
+    fn new(meshes: &[Mesh], cfg: &Config) -> Result<Self, ClfffError> {
+        let c = &cfg.curved;
+        let shell = Shell::from_meshes(meshes);
+        let out = outline::outline(&shell);
+        if shell.is_empty() || out.is_empty() {
+            return Err(ClfffError::NoSurface);
+        }
+        let h = cfg.slice.region.layer_height;
+        let thickness = shell.median_thickness();
+        if c.sandwich && thickness <= 0.0 {
+            return Err(ClfffError::SandwichWithoutThickness);
+        }
+        let n = if c.layers > 0 {
+            c.layers
+        } else if c.sandwich {
+            c.top_layers.max(1)
+        } else {
+            ((thickness / h).round() as usize).max(1)
+        };
+        let rim = Rim::new(&out, &shell);
+        let area = outline::scaffold_area(&out, c.scaffold_margin);
+        Ok(Self {
+            shell,
+            out,
+            thickness,
+            n,
+            rim,
+            area,
+        })
+    }
+
+    /// The limit the scaffold stays under: the buffer's height plus `curved.scaffold_clearance`
+    /// below the bottom surface.
+    fn limit(&self, cfg: &Config) -> Limit<'_> {
+        let c = &cfg.curved;
+        let buffer_h = if c.buffer {
+            cfg.slice.region.layer_height
+        } else {
+            0.0
+        };
+        Limit {
+            shell: &self.shell,
+            rim: &self.rim,
+            below: buffer_h + c.scaffold_clearance,
+        }
+    }
+}
+
+/// The scaffold's planar layers over the scaffold area (none when `curved.scaffold` is off),
+/// its first layer ordered from the bed origin.
+fn build_scaffold(area: &[ExPolygon], limit: &Limit<'_>, cfg: &Config) -> Scaffold {
+    let c = &cfg.curved;
+    if c.scaffold {
         let p = ScaffoldParams {
             first_top: cfg.slice.first_layer_height,
-            layer_height: h,
+            layer_height: cfg.slice.region.layer_height,
             vectors: c.scaffold_vectors.clone(),
             spacing: c.scaffold_spacing,
             step: c.step,
-            width: region.infill_width,
+            width: cfg.slice.region.infill_width,
         };
         scaffold::build(
-            &area,
-            &limit,
+            area,
+            limit,
             &p,
             (cfg.printer.bed_origin[0], cfg.printer.bed_origin[1]),
         )
     } else {
         Scaffold::default()
-    };
-    let support = |x: f64, y: f64| scaffold.top_at(&limit, x, y);
+    }
+}
 
-    // Curved layers.
-    let sandwich = c.sandwich.then_some(Sandwich {
-        h,
+/// The sandwich of `curved.sandwich` with `n` bottom-skin layers, or none.
+fn sandwich_of(n: usize, cfg: &Config) -> Option<Sandwich> {
+    let c = &cfg.curved;
+    c.sandwich.then_some(Sandwich {
+        h: cfg.slice.region.layer_height,
         bottom_layers: n,
         top_layers: c.top_layers,
         first_top: cfg.slice.first_layer_height,
         buffer: c.buffer,
-    });
+    })
+}
+
+/// The specs of every curved layer in print order: the buffer, the `n` model (bottom skin)
+/// layers, then a sandwich's top skin; raster angles cycle through `curved.angles`.
+fn layer_specs(n: usize, sandwich: Option<&Sandwich>, cfg: &Config) -> Vec<LayerSpec> {
+    let c = &cfg.curved;
+    let h = cfg.slice.region.layer_height;
+    let region = &cfg.slice.region;
     let mut specs = Vec::new();
     let angle = |i: usize| {
         c.angles
@@ -235,7 +316,7 @@ pub fn plan(
             region,
         ));
     }
-    if let Some(s) = &sandwich {
+    if let Some(s) = sandwich {
         for j in 0..s.top_layers {
             let below = (s.top_layers - 1 - j) as f64 * h;
             let top = j + 1 == s.top_layers;
@@ -251,31 +332,69 @@ pub fn plan(
             ));
         }
     }
-    let lifted: Vec<LiftedLayer> = specs
-        .into_iter()
-        .map(|spec| match &sandwich {
-            Some(s) if spec.section == Section::Model => {
-                sandwich::lift_skin_layer(&shell, &out, spec, c.step, s, &support)
-            }
-            _ => lift_layer(&shell, &out, spec, c.step, &support),
-        })
-        .collect();
+    specs
+}
 
-    // Toolpaths, grouped at long travels.
-    let bottom_max = shell.bottom_range().map_or(0.0, |r| r.1);
-    let head = Head {
-        angle_deg: c.head_angle,
-        height: c.head_height,
-        carriage_radius: c.carriage_radius,
-        carriage_clearance: c.carriage_clearance,
-    };
+/// Lifts every spec's flat layer onto its surface (a sandwich's skins by its own lift).
+fn lift_layers(
+    shape: &Shape,
+    specs: Vec<LayerSpec>,
+    sandwich: Option<&Sandwich>,
+    support: Support<'_>,
+    cfg: &Config,
+) -> Vec<LiftedLayer> {
+    let step = cfg.curved.step;
+    specs
+        .into_iter()
+        .map(|spec| match sandwich {
+            Some(s) if spec.section == Section::Model => {
+                sandwich::lift_skin_layer(&shape.shell, &shape.out, spec, step, s, support)
+            }
+            _ => lift_layer(&shape.shell, &shape.out, spec, step, support),
+        })
+        .collect()
+}
+
+/// The sections' Program layers and what their emission reports.
+struct Emitted {
+    /// Scaffold, buffer and model, in print order.
+    sections: Vec<SectionLayers>,
+    /// Every curved layer's report, in print order.
+    layers: Vec<LayerReport>,
+    /// Moves whose feed the z speed limit lowered.
+    z_limited: usize,
+    /// The sandwich core's report.
+    core: Option<CoreReport>,
+}
+
+/// The inputs of [`emit_sections`] and [`assemble_plan`] that the earlier steps made.
+struct Made<'a> {
+    /// The shell's shape.
+    shape: &'a Shape,
+    /// The scaffold.
+    scaffold: &'a Scaffold,
+    /// The lifted curved layers, in print order.
+    lifted: &'a [LiftedLayer],
+    /// The sandwich, if any.
+    sandwich: Option<&'a Sandwich>,
+    /// The scaffold's top at (x, y).
+    support: Support<'a>,
+}
+
+/// The sections' Program layers: the scaffold's, then the buffer's and the model's curved
+/// layers on their tools (a sandwich's core before its top skin), grouped at long travels.
+fn emit_sections(made: &Made<'_>, tool: usize, cfg: &Config) -> Result<Emitted, ClfffError> {
+    let c = &cfg.curved;
+    let h = cfg.slice.region.layer_height;
+    let params = ProgramParams::from_config(cfg);
+    let bottom_max = made.shape.shell.bottom_range().map_or(0.0, |r| r.1);
     let mut layer_reports = Vec::new();
     let mut z_limited = 0;
     let mut core_report = None;
     let mut sections = vec![scaffold_section(
-        &scaffold,
+        made.scaffold,
         c.scaffold_tool,
-        region.infill_width,
+        cfg.slice.region.infill_width,
         &params,
     )];
     for section in [Section::Buffer, Section::Model] {
@@ -284,9 +403,9 @@ pub fn plan(
             _ => tool,
         };
         let ctx = LayerCtx {
-            shell: &shell,
-            sandwich: sandwich.as_ref(),
-            support: &support,
+            shell: &made.shape.shell,
+            sandwich: made.sandwich,
+            support: made.support,
             tool: tool_of,
             speeds: params.tool(tool_of).speeds,
             h,
@@ -298,17 +417,17 @@ pub fn plan(
             h,
             None,
         );
-        grouper.check_short = sandwich.is_some();
+        grouper.check_short = made.sandwich.is_some();
         let mut first = true;
-        for layer in lifted.iter().filter(|l| l.spec.section == section) {
-            if let Some(s) = &sandwich
+        for layer in made.lifted.iter().filter(|l| l.spec.section == section) {
+            if let Some(s) = made.sandwich
                 && layer.spec.surface == Follows::Top
                 && core_report.is_none()
             {
                 core_report = Some(emit_core(&ctx, s, cfg, &mut grouper)?);
             }
             let first_z = (first && layer.spec.surface == Follows::Bottom)
-                .then(|| scaffold.max_z().max(bottom_max + layer.spec.offset));
+                .then(|| made.scaffold.max_z().max(bottom_max + layer.spec.offset));
             let rep = emit_curved(&ctx, layer, section, &mut grouper, first_z);
             first &= rep.paths == 0;
             z_limited += rep.z_speed_limited;
@@ -320,13 +439,56 @@ pub fn plan(
             layers: grouper.finish(),
         });
     }
+    Ok(Emitted {
+        sections,
+        layers: layer_reports,
+        z_limited,
+        core: core_report,
+    })
+}
 
-    let combined = sections::programs(&sections, false);
-    let collisions = combined
+/// The plan: the sections and the report (placement, scaffold, every curved layer, the head
+/// of `[curved]` replayed over the first Program, the sections, the core).
+fn assemble_plan(made: &Made<'_>, emitted: Emitted, raised: f64, cfg: &Config) -> ClfffPlan {
+    let Emitted {
+        sections,
+        layers,
+        z_limited,
+        core,
+    } = emitted;
+    let collisions = replay_head(&sections, cfg);
+    let section_reports = section_reports(&sections);
+    let report = ClfffReport {
+        placement: placement_report(made.shape, raised),
+        scaffold: scaffold_report(made.scaffold, cfg.curved.scaffold_tool),
+        layers,
+        collisions,
+        z_speed_limited: z_limited,
+        sections: section_reports,
+        core,
+    };
+    ClfffPlan { sections, report }
+}
+
+/// The head model of `[curved]` replayed over the sections combined into one Program.
+fn replay_head(sections: &[SectionLayers], cfg: &Config) -> Collisions {
+    let c = &cfg.curved;
+    let head = Head {
+        angle_deg: c.head_angle,
+        height: c.head_height,
+        carriage_radius: c.carriage_radius,
+        carriage_clearance: c.carriage_clearance,
+    };
+    let combined = sections::programs(sections, false);
+    combined
         .first()
         .map(|(_, p)| collide::replay(p, &head))
-        .unwrap_or_default();
-    let section_reports = sections
+        .unwrap_or_default()
+}
+
+/// Per section with layers: its tool, Program layers, paths and their length.
+fn section_reports(sections: &[SectionLayers]) -> Vec<SectionReport> {
+    sections
         .iter()
         .filter(|s| !s.layers.is_empty())
         .map(|s| {
@@ -340,37 +502,38 @@ pub fn plan(
                 file: None,
             }
         })
-        .collect();
-    let report = ClfffReport {
-        placement: PlacementReport {
-            raised_mm: raised,
-            bottom_z: shell.bottom_range().map_or([0.0; 2], |(a, b)| [a, b]),
-            thickness_mm: thickness,
-            max_slope_deg: shell.max_slope_deg(),
-            outline_area_mm2: out.iter().map(ExPolygon::area_mm2).sum(),
-            outline_holes: out.iter().map(|e| e.holes.len()).sum(),
-            scaffold_area_mm2: area.iter().map(ExPolygon::area_mm2).sum(),
-        },
-        scaffold: ScaffoldReport {
-            tool: c.scaffold_tool,
-            layers: scaffold.layers.len(),
-            lines: scaffold.layers.iter().map(|l| l.lines.len()).sum(),
-            length_mm: scaffold
-                .layers
-                .iter()
-                .flat_map(|l| &l.lines)
-                .map(|l| l.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<f64>())
-                .sum(),
-            top_z: scaffold.max_z(),
-            cuts: scaffold.cuts,
-        },
-        layers: layer_reports,
-        collisions,
-        z_speed_limited: z_limited,
-        sections: section_reports,
-        core: core_report,
-    };
-    Ok(ClfffPlan { sections, report })
+        .collect()
+}
+
+/// Where the shell stands: the lift applied, its bottom range, thickness, steepest slope,
+/// outline and scaffold areas.
+fn placement_report(shape: &Shape, raised: f64) -> PlacementReport {
+    PlacementReport {
+        raised_mm: raised,
+        bottom_z: shape.shell.bottom_range().map_or([0.0; 2], |(a, b)| [a, b]),
+        thickness_mm: shape.thickness,
+        max_slope_deg: shape.shell.max_slope_deg(),
+        outline_area_mm2: shape.out.iter().map(ExPolygon::area_mm2).sum(),
+        outline_holes: shape.out.iter().map(|e| e.holes.len()).sum(),
+        scaffold_area_mm2: shape.area.iter().map(ExPolygon::area_mm2).sum(),
+    }
+}
+
+/// The scaffold's layers, lines, their length, its top and its cuts.
+fn scaffold_report(scaffold: &Scaffold, tool: usize) -> ScaffoldReport {
+    ScaffoldReport {
+        tool,
+        layers: scaffold.layers.len(),
+        lines: scaffold.layers.iter().map(|l| l.lines.len()).sum(),
+        length_mm: scaffold
+            .layers
+            .iter()
+            .flat_map(|l| &l.lines)
+            .map(|l| l.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<f64>())
+            .sum(),
+        top_z: scaffold.max_z(),
+        cuts: scaffold.cuts,
+    }
 }
 
 /// The spec of a model layer: bottom skin layer `k` (`surface` bottom, `offset` k·h) or top
