@@ -14,32 +14,11 @@ use crate::{Limits, Model, ObjectContent, read, write};
 /// (file name, manifest outcome we knowingly do not meet, why).
 const DISPUTED: &[(&str, &str, &str)] = &[
     (
-        "MUSTFAIL_Chapter3.4.1a_MissingMetadataName.3mf",
-        "reject",
-        "the file has name=\"Undefined\", byte-for-byte the same case as MUSTPASS_Chapter3.4.1c \
-         (name=\"MustIgnore\") and lib3mf's MetaData_*_Fail files, which must load; conduit \
-         loads all of them with a warning",
-    ),
-    (
-        "CS-1111_3dmodel-e1r1_other-e1r1.3mf",
-        "load",
-        "two StartPart relationships to 3D models, exactly the case of \
-         MUSTFAIL_Chapter2.1.2_PartsRelationships_MoreThanOne3DModelPart; conduit follows the \
-         core specification (exactly one StartPart) and rejects both",
-    ),
-    (
         "dodeca_chain_loop_color.3mf",
         "load",
         "two <metadata name=\"Description\">, the same defect as \
          MUSTFAIL_Chapter3.4.1b_DuplicatedMetadataName (two \"Title\"); conduit rejects \
          duplicated metadata names as the core specification requires",
-    ),
-    (
-        "3mfbase1_cube.3mf",
-        "load",
-        "compositematerials and multiproperties both use id 3 and triangles reference pid 3, \
-         the defect MUSTFAIL_3MF100_Extension_Chapter2_DuplicatedIdAcrossGroup must be \
-         rejected for",
     ),
 ];
 
