@@ -38,7 +38,6 @@ const STAGES: [&str; 12] = [
 const KNOWN: &[&str] = &[
     "check/machine.rs -> crate::config",
     "check/mod.rs -> crate::config",
-    "check/replay.rs -> crate::config",
     "check/tests.rs -> crate::config",
     "circuit/stage.rs -> crate::config",
     "curved/clfff/core.rs -> crate::config",
@@ -60,7 +59,6 @@ const KNOWN: &[&str] = &[
     "program/build.rs -> crate::config",
     "program/build.rs -> crate::region",
     "program/build.rs -> crate::slice",
-    "program/extrusion.rs -> crate::region",
 ];
 
 /// Every `.rs` file under `dir`, sorted.
