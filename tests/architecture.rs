@@ -36,9 +36,6 @@ const STAGES: [&str; 12] = [
 
 /// `file -> crate::module` breaches of the rules that are still to be mended.
 const KNOWN: &[&str] = &[
-    "check/machine.rs -> crate::config",
-    "check/mod.rs -> crate::config",
-    "check/tests.rs -> crate::config",
     "circuit/stage.rs -> crate::config",
     "curved/clfff/core.rs -> crate::config",
     "curved/clfff/mod.rs -> crate::config",
@@ -47,9 +44,6 @@ const KNOWN: &[&str] = &[
     "emit/gcode/tests.rs -> crate::config",
     "emit/gcode/tests.rs -> crate::region",
     "emit/gcode/tests.rs -> crate::slice",
-    "emit/preview/mod.rs -> crate::check",
-    "emit/preview/mod.rs -> crate::config",
-    "emit/preview/mod.rs -> crate::scene",
     "postprocess/layers.rs -> crate::config",
     "postprocess/mod.rs -> crate::config",
     "postprocess/plan.rs -> crate::config",

@@ -8,7 +8,7 @@ use conduit_gcode::{Gcode, Line, Machine, Move, Position};
 
 use super::time::Planner;
 use super::{Bounds3, CheckParams, CheckReport, Finding, FindingKind, Severity, Stats, ToolUsage};
-use crate::config::ToolKind;
+use crate::program::machine::ToolKind;
 
 /// Heater state of one tool.
 #[derive(Debug, Clone, Default)]

@@ -2,7 +2,7 @@
 //! wrong, plus what the print consists of (layers, filament, extent, time).
 //!
 //! Place in the pipeline: the last station, after `emit` (or after any other slicer): it reads a
-//! parsed [`conduit_gcode::Gcode`] and a [`CheckParams`] (built from the [`Config`] with
+//! parsed [`conduit_gcode::Gcode`] and a [`CheckParams`] (built from the config with
 //! [`CheckParams::from_config`]) and never reaches back into the pipeline. The test suites use it
 //! on conduit's own output, as PrusaSlicer's tests re-parse their G-code and check the machine
 //! state; the CLI exits 1 when [`CheckReport::has_errors`].
@@ -82,7 +82,7 @@ use std::fmt;
 
 use serde::Serialize;
 
-use crate::config::{Config, Flavor, ToolKind};
+use crate::program::machine::{Flavor, Printer, Tool, ToolKind};
 
 /// What the checker needs to know about the printer. Build it with
 /// [`CheckParams::from_config`]; [`Default`] is the default config's.
@@ -159,17 +159,15 @@ impl Default for ToolCheck {
 }
 
 impl CheckParams {
-    /// The printer and tools of `config`, with the default thresholds.
-    pub fn from_config(config: &Config) -> Self {
-        let p = &config.printer;
+    /// The `printer` and `tools`, with the default thresholds.
+    pub fn for_machine(p: &Printer, tools: &[Tool]) -> Self {
         Self {
             flavor: p.flavor,
             bed_origin: p.bed_origin,
             bed_size: p.bed_size,
             max_height: p.max_height,
             bed_margin: 5.0,
-            tools: config
-                .tools
+            tools: tools
                 .iter()
                 .map(|t| ToolCheck {
                     kind: t.kind,
@@ -202,9 +200,10 @@ impl CheckParams {
 }
 
 impl Default for CheckParams {
-    /// [`CheckParams::from_config`] of [`Config::default`].
+    /// [`CheckParams::for_machine`] of the default printer with the default two tools (a
+    /// filament extruder and a paste dispenser), as the default config has them.
     fn default() -> Self {
-        Self::from_config(&Config::default())
+        Self::for_machine(&Printer::default(), &[Tool::filament(), Tool::paste()])
     }
 }
 

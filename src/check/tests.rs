@@ -399,16 +399,3 @@ fn bare_coordinates_continue_the_last_motion() {
     assert_eq!(r.stats.extrusion_moves, 3);
     assert!(close(filament(&r, 0), 3.0, 1e-12));
 }
-
-#[test]
-fn default_start_and_end_gcode_check_clean() -> Result<(), crate::config::ConfigError> {
-    let cfg = Config::default();
-    let start = cfg.render_template(&cfg.printer.start_gcode, 0, &[])?;
-    let end = cfg.render_template(&cfg.printer.end_gcode, 0, &[])?;
-    let r = run(&format!("{start}G1 Z0.2\nG1 X100 Y100 E1\n{end}"));
-    assert!(r.findings.is_empty(), "{:?}", r.findings);
-    // The prime line (9 mm) and the one line (1 mm).
-    assert!(close(filament(&r, 0), 10.0, 1e-12));
-    assert_eq!(r.stats.max_bed_temperature, Some(60.0));
-    Ok(())
-}

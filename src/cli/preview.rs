@@ -3,9 +3,12 @@
 
 use super::{Failure, args::PreviewArgs};
 use anyhow::Context;
-use conduit::check::moves;
-use conduit::config::Flavor;
-use conduit::emit::preview::{PreviewParams, layered_by_markers, write};
+use conduit::check::{Firmware, moves};
+use conduit::emit::preview::{
+    CONTACT_SHEET, PreviewParams, SIDE_VIEWS, layered_by_markers, render,
+};
+use conduit::scene::write_atomically;
+use std::io::Write;
 
 pub(crate) fn run(args: PreviewArgs) -> Result<(), Failure> {
     let params = PreviewParams {
@@ -16,22 +19,24 @@ pub(crate) fn run(args: PreviewArgs) -> Result<(), Failure> {
     let bytes = std::fs::read(&args.file).with_context(|| format!("{file}: cannot read file"))?;
     let gcode = conduit_gcode::parse(&bytes).with_context(|| format!("{file}"))?;
     // Marlin's modes; the flavour matters only for Klipper's `G91` making E relative.
-    let moves = layered_by_markers(&gcode, moves(&gcode, Flavor::Marlin));
-    let files = write(&moves, &args.out_dir, &params).with_context(|| format!("{file}"))?;
+    let moves = layered_by_markers(&gcode, moves(&gcode, Firmware::Marlin));
+    let drawn = render(&moves, &params).with_context(|| format!("{file}"))?;
+    let dir = &args.out_dir;
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot write", dir.display()))?;
+    for (name, bytes) in &drawn.files {
+        let path = dir.join(name);
+        write_atomically(&path, |f| f.write_all(bytes))
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
     println!(
         "{file}: {} layers: {} SVG files and {} (every {} layer(s), {} tiles), side views {} in {}",
-        files.svgs.len(),
-        files.svgs.len(),
-        files.contact_sheet.display(),
-        files.every,
-        files.tiles,
-        files
-            .side_views
-            .iter()
-            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-            .collect::<Vec<_>>()
-            .join(", "),
-        args.out_dir.display()
+        drawn.layers,
+        drawn.layers,
+        dir.join(CONTACT_SHEET).display(),
+        drawn.every,
+        drawn.tiles,
+        SIDE_VIEWS.join(", "),
+        dir.display()
     );
     Ok(())
 }

@@ -62,6 +62,7 @@ use std::path::{Path, PathBuf};
 use serde::de::{self, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
+use crate::check::CheckParams;
 use crate::emit::gcode::{GcodeParams, UnknownPlaceholder};
 pub use crate::program::machine::{
     DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, PnpSettings, Printer, Tool, ToolKind,
@@ -499,6 +500,11 @@ impl Config {
         }
     }
 
+    /// The replay checker's parameters: the printer and the tools, with the default thresholds.
+    pub fn check_params(&self) -> CheckParams {
+        CheckParams::for_machine(&self.printer, &self.tools)
+    }
+
     /// Fills the `{placeholders}` of `template` for tool `tool` as the G-code writer does
     /// ([`GcodeParams::render_template`]), with the caller's extra variables `vars` (such as
     /// `previous_tool`, `next_tool`, `layer_z`) taking precedence over config keys.
@@ -776,3 +782,10 @@ mod tools_table {
 
 #[cfg(test)]
 mod tests;
+
+impl CheckParams {
+    /// The replay checker's parameters for `config` ([`Config::check_params`]).
+    pub fn from_config(config: &Config) -> Self {
+        config.check_params()
+    }
+}

@@ -210,3 +210,27 @@ fn every_corrections_mode_parses_from_its_name() -> Result<(), ConfigError> {
     }
     Ok(())
 }
+
+#[test]
+fn default_start_and_end_gcode_check_clean() -> Result<(), ConfigError> {
+    let cfg = Config::default();
+    let start = cfg.render_template(&cfg.printer.start_gcode, 0, &[])?;
+    let end = cfg.render_template(&cfg.printer.end_gcode, 0, &[])?;
+    let src = format!("{start}G1 Z0.2\nG1 X100 Y100 E1\n{end}");
+    let g = match conduit_gcode::parse(src.as_bytes()) {
+        Ok(g) => g,
+        Err(e) => panic!("{e}"),
+    };
+    let r = crate::check::check(&g, &cfg.check_params());
+    assert!(r.findings.is_empty(), "{:?}", r.findings);
+    // The prime line (9 mm) and the one line (1 mm).
+    let filament = r
+        .stats
+        .tools
+        .iter()
+        .find(|t| t.tool == 0)
+        .map_or(0.0, |t| t.filament_mm);
+    assert!((filament - 10.0).abs() <= 1e-12, "{filament}");
+    assert_eq!(r.stats.max_bed_temperature, Some(60.0));
+    Ok(())
+}

@@ -1,7 +1,7 @@
 //! Previews of a G-code file: one SVG per printed layer and a PNG contact sheet.
 //!
 //! Place in the pipeline: the end of the line, beside `check`. It reads the [`Moves`] that
-//! [`check::moves`](crate::check::moves) replays from any G-code (conduit's own or another
+//! [`conduit_gcode::moves`] replays from any G-code (conduit's own or another
 //! slicer's) and never reaches back into the pipeline.
 //!
 //! - [`Preview::from_moves`] groups the moves of each layer into polylines: extrusions by
@@ -17,16 +17,14 @@
 //!   ([`svg::side`]) and PNG ([`png::side`]). An extrusion is curved when a point of it lies off
 //!   its layer's Z; [`layered_by_markers`] keeps curved extrusions in the layer they are printed
 //!   in (by the `;LAYER_CHANGE` markers) instead of making a layer of every height.
-//! - [`write()`] writes `layer_0001.svg`…, [`CONTACT_SHEET`] and the side views into a folder,
-//!   each file atomically.
+//! - [`render`] draws `layer_0001.svg`…, [`CONTACT_SHEET`] and the side views as named files
+//!   for the caller to write.
 //!
 //! Output bytes depend only on the input: SVG numbers have a fixed 3 decimals and the PNG
 //! encoder writes no timestamp.
 
 pub mod png;
 pub mod svg;
-
-use std::path::{Path, PathBuf};
 
 use conduit_gcode::Moves;
 
@@ -87,15 +85,6 @@ pub enum PreviewError {
     /// PNG encoding failed.
     #[error("encoding the contact sheet as PNG")]
     Png(#[source] Box<dyn std::error::Error + Send + Sync>),
-    /// A file or folder could not be written.
-    #[error("{}: cannot write", path.display())]
-    Io {
-        /// The file or folder.
-        path: PathBuf,
-        /// The cause.
-        #[source]
-        source: std::io::Error,
-    },
 }
 
 /// What one polyline draws.
@@ -458,28 +447,23 @@ pub fn layer_file_name(index: usize) -> String {
     format!("layer_{:04}.svg", index + 1)
 }
 
-/// What [`write()`] wrote.
+/// What [`render`] drew: every file of the preview, named, in the order they are written.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PreviewFiles {
-    /// One SVG per layer, in layer order.
-    pub svgs: Vec<PathBuf>,
-    /// The contact sheet.
-    pub contact_sheet: PathBuf,
+    /// `(file name, bytes)`: one SVG per layer in layer order, [`CONTACT_SHEET`], then the side
+    /// views ([`SIDE_VIEWS`]).
+    pub files: Vec<(String, Vec<u8>)>,
+    /// Layers (one SVG each).
+    pub layers: usize,
     /// Every how many layers the contact sheet shows.
     pub every: usize,
     /// Tiles on the contact sheet.
     pub tiles: usize,
-    /// The side views ([`SIDE_VIEWS`]).
-    pub side_views: Vec<PathBuf>,
 }
 
-/// Writes the preview of `moves` into `dir` (created if missing): one SVG per layer and
-/// [`CONTACT_SHEET`], each atomically.
-pub fn write(
-    moves: &Moves,
-    dir: &Path,
-    params: &PreviewParams,
-) -> Result<PreviewFiles, PreviewError> {
+/// Draws the preview of `moves`: one SVG per layer ([`layer_file_name`]), [`CONTACT_SHEET`]
+/// and the side views ([`SIDE_VIEWS`]), as named files for the caller to write.
+pub fn render(moves: &Moves, params: &PreviewParams) -> Result<PreviewFiles, PreviewError> {
     if params.every == Some(0) {
         return Err(PreviewError::InvalidParams("every must be at least 1"));
     }
@@ -489,56 +473,38 @@ pub fn write(
         ));
     }
     let preview = Preview::from_moves(moves)?;
-    // Render the sheet first: a sheet that is too large fails before any file is written.
+    // Render the sheet first: a sheet that is too large fails before anything else is drawn.
     let every = preview.every(params);
     let sheet = png::contact_sheet(&preview, every, params.tile_px)?;
-    std::fs::create_dir_all(dir).map_err(|source| PreviewError::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    let mut svgs = Vec::with_capacity(preview.layers.len());
+    let mut files = Vec::with_capacity(preview.layers.len() + 1 + SIDE_VIEWS.len());
     for i in 0..preview.layers.len() {
-        let path = dir.join(layer_file_name(i));
-        write_file(&path, svg::layer(&preview, i).as_bytes())?;
-        svgs.push(path);
+        files.push((layer_file_name(i), svg::layer(&preview, i).into_bytes()));
     }
-    let contact_sheet = dir.join(CONTACT_SHEET);
-    write_file(&contact_sheet, &sheet)?;
-    let mut side_views = Vec::with_capacity(SIDE_VIEWS.len());
+    files.push((CONTACT_SHEET.to_owned(), sheet));
     for axis in [SideAxis::X, SideAxis::Y] {
-        let path = dir.join(format!("side_{}.svg", axis.name()));
-        write_file(&path, svg::side(&preview, axis).as_bytes())?;
-        side_views.push(path);
+        files.push((
+            format!("side_{}.svg", axis.name()),
+            svg::side(&preview, axis).into_bytes(),
+        ));
     }
     for axis in [SideAxis::X, SideAxis::Y] {
-        let path = dir.join(format!("side_{}.png", axis.name()));
-        write_file(&path, &png::side(&preview, axis, params.tile_px * 4)?)?;
-        side_views.push(path);
+        files.push((
+            format!("side_{}.png", axis.name()),
+            png::side(&preview, axis, params.tile_px * 4)?,
+        ));
     }
     Ok(PreviewFiles {
-        svgs,
-        contact_sheet,
+        files,
+        layers: preview.layers.len(),
         every,
         tiles: preview.layers.len().div_ceil(every),
-        side_views,
-    })
-}
-
-fn write_file(path: &Path, bytes: &[u8]) -> Result<(), PreviewError> {
-    use std::io::Write;
-    crate::scene::write_atomically(path, |f| f.write_all(bytes)).map_err(|source| {
-        PreviewError::Io {
-            path: path.to_path_buf(),
-            source,
-        }
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::moves;
-    use crate::config::Flavor;
+    use conduit_gcode::{Firmware, moves};
 
     /// Two layers: a 10 mm square (External perimeter, no width comment, tool 0) at Z 0.2
     /// after a travel from the origin, a travel out and back, then the same square (Perimeter,
@@ -554,7 +520,7 @@ mod tests {
 
     fn two_layers() -> Moves {
         match conduit_gcode::parse(TWO_LAYERS.as_bytes()) {
-            Ok(g) => moves(&g, Flavor::Marlin),
+            Ok(g) => moves(&g, Firmware::Marlin),
             Err(e) => panic!("test G-code does not parse: {e}"),
         }
     }
@@ -679,50 +645,32 @@ mod tests {
     }
 
     #[test]
-    fn write_makes_one_svg_per_layer_and_a_sheet_deterministically() {
+    fn render_makes_one_svg_per_layer_and_a_sheet_deterministically() {
         let m = two_layers();
         let params = PreviewParams {
             every: None,
             tile_px: 64,
         };
-        let dirs = [tempfile::tempdir(), tempfile::tempdir()].map(|d| d.expect("a temp dir"));
-        let mut outputs = Vec::new();
-        for d in &dirs {
-            let out = d.path().join("new");
-            let files = write(&m, &out, &params).expect("the preview is written");
-            assert_eq!(files.svgs.len(), 2);
-            assert_eq!(files.svgs[0], out.join("layer_0001.svg"));
-            assert_eq!(files.svgs[1], out.join("layer_0002.svg"));
-            assert_eq!((files.every, files.tiles), (1, 2));
-            let mut names: Vec<String> = std::fs::read_dir(&out)
-                .expect("the folder exists")
-                .map(|e| {
-                    e.expect("an entry")
-                        .file_name()
-                        .to_string_lossy()
-                        .into_owned()
-                })
-                .collect();
-            names.sort();
-            assert_eq!(
-                names,
-                [
-                    "contact_sheet.png",
-                    "layer_0001.svg",
-                    "layer_0002.svg",
-                    "side_xz.png",
-                    "side_xz.svg",
-                    "side_yz.png",
-                    "side_yz.svg"
-                ]
-            );
-            let bytes: Vec<Vec<u8>> = names
-                .iter()
-                .map(|n| std::fs::read(out.join(n)).expect("readable"))
-                .collect();
-            outputs.push(bytes);
-        }
-        assert_eq!(outputs[0], outputs[1]);
+        let runs =
+            [render(&m, &params), render(&m, &params)].map(|r| r.expect("the preview is drawn"));
+        let files = &runs[0];
+        assert_eq!(files.layers, 2);
+        assert_eq!((files.every, files.tiles), (1, 2));
+        let names: Vec<&str> = files.files.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "layer_0001.svg",
+                "layer_0002.svg",
+                "contact_sheet.png",
+                "side_xz.svg",
+                "side_yz.svg",
+                "side_xz.png",
+                "side_yz.png"
+            ]
+        );
+        assert!(files.files.iter().all(|(_, bytes)| !bytes.is_empty()));
+        assert_eq!(runs[0], runs[1]);
     }
 
     #[test]
@@ -743,7 +691,7 @@ mod tests {
     fn travels_only_is_an_error() {
         let g = conduit_gcode::parse(b"G28\nG1 X10 Y10\n").expect("parses");
         assert!(matches!(
-            Preview::from_moves(&moves(&g, Flavor::Marlin)),
+            Preview::from_moves(&moves(&g, Firmware::Marlin)),
             Err(PreviewError::NoExtrusion)
         ));
     }
@@ -765,7 +713,7 @@ mod tests {
     #[test]
     fn curved_extrusions_stay_in_their_layer_and_are_highlighted_in_the_side_view() {
         let g = conduit_gcode::parse(CURVED.as_bytes()).expect("parses");
-        let plain = moves(&g, Flavor::Marlin);
+        let plain = moves(&g, Firmware::Marlin);
         // By heights: 0.2, 0.4, 0.5, 0.6.
         assert_eq!(plain.layer_z, vec![0.2, 0.4, 0.5, 0.6]);
         let m = layered_by_markers(&g, plain);
