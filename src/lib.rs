@@ -26,6 +26,8 @@
 //!   electronics stage (parts placed, cavities carved, wires routed, pick-and-place records).
 //! - [`route`]: weighted A* trace routing on per-layer perimeter graphs.
 //! - [`curved`]: non-planar top surfaces over a planar core; `clfff`: curved-layer FFF.
+//! - [`toolpaths`]: regions and the other stages' per-layer contributions → [`program::Program`]
+//!   (roles, widths, speeds, travel order, tool changes).
 //! - [`conform`]: 2D designs laid onto scanned surfaces — registration, projection,
 //!   nozzle-aware corrections, tool orientation, deposit report.
 //! - [`robot`]: robot set-up and calibration — tool centre point, frame registration, gap
@@ -58,6 +60,7 @@ pub mod region;
 pub mod circuit;
 pub mod route;
 pub mod curved;
+pub mod toolpaths;
 pub mod conform;
 pub mod robot;
 pub mod jet;

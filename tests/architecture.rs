@@ -41,18 +41,12 @@ const KNOWN: &[&str] = &[
     "curved/clfff/mod.rs -> crate::config",
     "curved/clfff/place.rs -> crate::config",
     "curved/mod.rs -> crate::config",
-    "emit/gcode/tests.rs -> crate::config",
-    "emit/gcode/tests.rs -> crate::region",
-    "emit/gcode/tests.rs -> crate::slice",
     "postprocess/layers.rs -> crate::config",
     "postprocess/mod.rs -> crate::config",
     "postprocess/plan.rs -> crate::config",
     "postprocess/rewrite.rs -> crate::config",
     "postprocess/settings.rs -> crate::config",
     "postprocess/verify.rs -> crate::config",
-    "program/build.rs -> crate::config",
-    "program/build.rs -> crate::region",
-    "program/build.rs -> crate::slice",
 ];
 
 /// Every `.rs` file under `dir`, sorted.

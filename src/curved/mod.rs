@@ -41,10 +41,11 @@ use crate::geom::{
     ExPolygon, Join, Point2, Point3, Polygon, difference, intersection, offset, scaled, union,
 };
 use crate::mesh::Mesh;
-use crate::program::{Event, LayerItem, Program, ProgramParams, Role, RoleSpeeds, Toolpath};
+use crate::program::{Event, LayerItem, Program, Role, Toolpath};
 use crate::region::infill::{InfillPattern, Rectilinear};
 use crate::region::make_perimeters;
 use crate::slice::LayerZ;
+use crate::toolpaths::{ProgramParams, RoleSpeeds};
 use collision::{Head, HeadPart, Material};
 use tops::{
     AreaIndex, Projector, TopRegion, find_top_regions, removal_stepped, rim_step, top_layer_at,

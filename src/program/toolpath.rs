@@ -1,6 +1,8 @@
 //! The Program's vocabulary: [`Toolpath`]s with a [`Role`], [`Event`]s, and [`Layer`]s of both in
 //! print order.
 
+use std::collections::BTreeMap;
+
 use crate::geom::{Point3, Vector3};
 
 /// What an extrusion is for. Decides speed, cooling and the `;TYPE:` comment of G-code output.
@@ -276,6 +278,21 @@ impl Program {
     pub fn first_tool(&self) -> Option<usize> {
         self.paths().next().map(|p| p.tool)
     }
+}
+
+/// What a layer gets besides its objects' regions: the part events that come before it and
+/// the paths printed after them (conductive traces, drops), keyed by the layer's print height on
+/// the nanometre grid (`scaled(z)`). Heights no object layer has are ignored.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LayerExtras {
+    /// Events at the start of the layer, in order (e.g. placing a part whose cavity is done).
+    pub events_before: BTreeMap<i64, Vec<Event>>,
+    /// Paths printed after the objects' paths, tool by tool in ascending order, each tool's in
+    /// the order given.
+    pub paths_after: BTreeMap<i64, Vec<Toolpath>>,
+    /// Events at the end of the layer, after its paths (e.g. placing a part that stands above
+    /// the last layer).
+    pub events_after: BTreeMap<i64, Vec<Event>>,
 }
 
 #[cfg(test)]

@@ -16,7 +16,7 @@
 //! The core's islands are the intersection of the two.
 //!
 //! The islands go through [`crate::region::make_regions_with_heights`] and
-//! [`crate::program::build_program`] as a planar object would, with `[slice]` perimeters and
+//! [`crate::toolpaths::build_program`] as a planar object would, with `[slice]` perimeters and
 //! infill, but no top or bottom solid layers of their own (the skins are the part's solid
 //! faces) and no skirt; an empty layer under the core keeps the first-layer widths and speed
 //! off it. The lowest core layer over each point reaches down to the bottom skin's top: its
@@ -32,9 +32,10 @@ use crate::config::Config;
 use crate::curved::motion;
 use crate::curved::surface::SurfaceTriangle;
 use crate::geom::{ExPolygon, Point2, Point3, intersection, union};
-use crate::program::{ObjectLayers, ProgramParams, Toolpath, build_program};
+use crate::program::Toolpath;
 use crate::region::{RegionError, make_regions_with_heights};
 use crate::slice::LayerZ;
+use crate::toolpaths::{ObjectLayers, ProgramParams, build_program};
 
 /// One planar core layer as toolpaths in print order.
 #[derive(Debug, Clone, PartialEq)]

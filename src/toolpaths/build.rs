@@ -32,11 +32,10 @@
 
 use std::collections::BTreeMap;
 
-use super::extrusion::BeadShape;
 use super::order::{Group, OrderParams, order_groups};
-use super::toolpath::{Event, Layer, LayerItem, Program, Role, Toolpath};
-use crate::config::{Config, ToolKind};
 use crate::geom::{Point2, Point3, Polygon, scaled, segment_distance2, unscaled};
+use crate::program::extrusion::BeadShape;
+use crate::program::{Event, Layer, LayerExtras, LayerItem, Program, Role, Toolpath};
 use crate::region::gapfill::split_by_width;
 use crate::region::{LayerRegions, SolidRole};
 use crate::slice::LayerZ;
@@ -227,50 +226,6 @@ pub fn simplify(points: &[Point2], tolerance: i64, closed: bool) -> Vec<Point2> 
 }
 
 impl ProgramParams {
-    /// Parameters from a run's configuration: role speeds and the first-layer speed from `[slice]` limited to `printer.max_print_speed`;
-    /// paste tools print every path as [`Role::ConductiveTrace`] at `slice.conductive_speed`
-    /// (also on the first layer, if that is slower than `first_layer_speed`). Ordering and
-    /// start position take their defaults.
-    pub fn from_config(cfg: &Config) -> Self {
-        let s = &cfg.slice;
-        let max = cfg.printer.max_print_speed;
-        let speeds = RoleSpeeds {
-            external_perimeter: s.external_perimeter_speed,
-            perimeter: s.perimeter_speed,
-            solid_infill: s.solid_infill_speed,
-            top_solid_infill: s.top_solid_infill_speed,
-            sparse_infill: s.infill_speed,
-            bridge: s.bridge_speed,
-            gap_fill: s.gap_fill_speed,
-            skirt: s.skirt_speed,
-            conductive: s.conductive_speed,
-        }
-        .clamped(max);
-        let tools = cfg
-            .tools
-            .iter()
-            .map(|t| {
-                let base = ToolPathParams {
-                    speeds,
-                    first_layer_speed: s.first_layer_speed.min(max),
-                    ..ToolPathParams::default()
-                };
-                match t.kind {
-                    ToolKind::Filament => base,
-                    ToolKind::Paste => ToolPathParams {
-                        role: Some(Role::ConductiveTrace),
-                        first_layer_speed: base.first_layer_speed.min(speeds.conductive),
-                        ..base
-                    },
-                }
-            })
-            .collect();
-        Self {
-            tools,
-            ..Self::default()
-        }
-    }
-
     /// The parameters of tool `tool`.
     pub fn tool(&self, tool: usize) -> ToolPathParams {
         self.tools.get(tool).copied().unwrap_or_default()
@@ -412,21 +367,6 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
         groups.push(loose);
     }
     (skirt, groups)
-}
-
-/// What a layer gets besides its objects' regions: the part events that come before it and
-/// the paths printed after them (conductive traces, drops), keyed by the layer's print height on
-/// the nanometre grid (`scaled(z)`). Heights no object layer has are ignored.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct LayerExtras {
-    /// Events at the start of the layer, in order (e.g. placing a part whose cavity is done).
-    pub events_before: BTreeMap<i64, Vec<Event>>,
-    /// Paths printed after the objects' paths, tool by tool in ascending order, each tool's in
-    /// the order given.
-    pub paths_after: BTreeMap<i64, Vec<Toolpath>>,
-    /// Events at the end of the layer, after its paths (e.g. placing a part that stands above
-    /// the last layer).
-    pub events_after: BTreeMap<i64, Vec<Event>>,
 }
 
 /// The [`Program`] printing `objects` (see the module docs).

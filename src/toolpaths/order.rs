@@ -22,8 +22,8 @@
 //! Travel is measured as the straight 3D distance from the end of one path to the start of the
 //! next.
 
-use super::toolpath::Toolpath;
 use crate::geom::Point3;
+use crate::program::Toolpath;
 
 /// Improvements smaller than this (mm) are not taken, so floating-point noise in the
 /// differences of sums cannot make the improvement loop cycle.
@@ -436,7 +436,7 @@ pub fn order_groups(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::program::toolpath::Role;
+    use crate::program::Role;
 
     fn line(x0: f64, y0: f64, x1: f64, y1: f64) -> Toolpath {
         Toolpath {

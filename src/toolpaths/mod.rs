@@ -1,0 +1,18 @@
+//! The toolpaths stage: each layer's regions, and what the other stages add to a layer
+//! ([`LayerExtras`]: part events, conductive traces), become a [`Program`] — toolpaths with
+//! roles, widths, heights and speeds in print order, with tool changes between tools.
+//!
+//! Place in the pipeline: slice → regions (→ electronics) → **toolpaths** → emit. It takes its
+//! own parameters ([`ProgramParams`], built from the config by the walk) and produces the model
+//! every writer consumes ([`crate::program`]).
+//!
+//! - [`build`]: regions → Program ([`build_program`], [`build_program_with`]).
+//! - [`order`]: travel ordering (nearest neighbour, then 2-opt / or-opt, deterministic).
+
+pub mod build;
+pub mod order;
+
+pub use build::{
+    ObjectLayers, ProgramParams, RoleSpeeds, ToolPathParams, build_program, build_program_with,
+};
+pub use order::{Group, OrderParams, SeamRule, order_groups, order_paths, travel_length};
