@@ -63,6 +63,7 @@ use serde::de::{self, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::check::CheckParams;
+use crate::curved::CurvedParams;
 use crate::emit::gcode::{GcodeParams, UnknownPlaceholder};
 use crate::program::Role;
 pub use crate::program::machine::{
@@ -499,6 +500,19 @@ impl Config {
             tools: self.tools.clone(),
             pnp: self.pnp.clone(),
             template_keys,
+        }
+    }
+
+    /// The curved stages' parameters: `[curved]` and the planar settings they print beside.
+    pub fn curved_params(&self) -> CurvedParams {
+        CurvedParams {
+            curved: self.curved.clone(),
+            region: self.slice.region.clone(),
+            first_layer_height: self.slice.first_layer_height,
+            program: ProgramParams::from_config(self),
+            bed_origin: self.printer.bed_origin,
+            retract_before_travel: self.printer.retract_before_travel,
+            tool_count: self.tools.len(),
         }
     }
 

@@ -33,10 +33,9 @@ pub mod surface;
 pub mod tops;
 
 pub use report::{CurvedLayerReport, CurvedReport, RegionReport, Rejection};
-pub use settings::{CurvedMode, CurvedSettings};
+pub use settings::{CurvedMode, CurvedParams, CurvedSettings};
 pub use surface::{HeightField, SurfaceHit};
 
-use crate::config::Config;
 use crate::geom::{
     ExPolygon, Join, Point2, Point3, Polygon, difference, intersection, offset, scaled, union,
 };
@@ -45,7 +44,7 @@ use crate::program::{Event, LayerItem, Program, Role, Toolpath};
 use crate::region::infill::{InfillPattern, Rectilinear};
 use crate::region::make_perimeters;
 use crate::slice::LayerZ;
-use crate::toolpaths::{ProgramParams, RoleSpeeds};
+use crate::toolpaths::RoleSpeeds;
 use collision::{Head, HeadPart, Material};
 use tops::{
     AreaIndex, Projector, TopRegion, find_top_regions, removal_stepped, rim_step, top_layer_at,
@@ -93,7 +92,7 @@ pub struct TopsPlan {
 }
 
 /// Plans the curved tops of every object (see the module docs).
-pub fn plan_tops(objects: &[CurvedObject<'_>], cfg: &Config) -> TopsPlan {
+pub fn plan_tops(objects: &[CurvedObject<'_>], cfg: &CurvedParams) -> TopsPlan {
     let c = &cfg.curved;
     let head = Head {
         angle_deg: c.head_angle,
@@ -108,7 +107,7 @@ pub fn plan_tops(objects: &[CurvedObject<'_>], cfg: &Config) -> TopsPlan {
             .collect(),
         ..TopsPlan::default()
     };
-    let n = cfg.slice.region.top_solid_layers;
+    let n = cfg.region.top_solid_layers;
     for (oi, obj) in objects.iter().enumerate() {
         let hf = HeightField::from_mesh(obj.mesh);
         let (regions, steep) = find_top_regions(&hf, c.max_angle);
@@ -173,8 +172,8 @@ const SLIVER_MM: f64 = 0.05;
 
 /// The flat paths of curved layer `k` over `area`: perimeter loops around it and solid infill
 /// inside them (top solid infill for the topmost), by the regions stage's generators.
-fn flat_layer(area: &[ExPolygon], k: usize, cfg: &Config) -> Vec<FlatPath> {
-    let params = cfg.slice.region.for_layer(1);
+fn flat_layer(area: &[ExPolygon], k: usize, cfg: &CurvedParams) -> Vec<FlatPath> {
+    let params = cfg.region.for_layer(1);
     let h = params.layer_height;
     let per = make_perimeters(area, &params, h);
     let mut out: Vec<FlatPath> = per
@@ -241,9 +240,9 @@ fn project_layers(
     region: &TopRegion,
     obj: &CurvedObject<'_>,
     hf: &HeightField,
-    cfg: &Config,
+    cfg: &CurvedParams,
 ) -> Vec<ProjectedLayer> {
-    let h = cfg.slice.region.layer_height;
+    let h = cfg.region.layer_height;
     let mut layers = Vec::new();
     for k in (0..areas.len()).rev() {
         let below = areas
@@ -337,7 +336,7 @@ fn plan_region(
     region: &TopRegion,
     hf: &HeightField,
     head: &Head,
-    cfg: &Config,
+    cfg: &CurvedParams,
     rejections: &mut Vec<Rejection>,
 ) -> Result<RegionPlan, Rejection> {
     let job = RegionJob::new(objects, oi, region, hf, head, cfg)?;
@@ -366,7 +365,7 @@ struct RegionJob<'a> {
     /// The head model.
     head: &'a Head,
     /// The whole config.
-    cfg: &'a Config,
+    cfg: &'a CurvedParams,
     /// Number of curved layers (the top solid layers).
     n: usize,
     /// Layer height, mm.
@@ -407,11 +406,11 @@ impl<'a> RegionJob<'a> {
         region: &'a TopRegion,
         hf: &'a HeightField,
         head: &'a Head,
-        cfg: &'a Config,
+        cfg: &'a CurvedParams,
     ) -> Result<Self, Rejection> {
         let obj = &objects[oi];
-        let n = cfg.slice.region.top_solid_layers;
-        let h = cfg.slice.region.layer_height;
+        let n = cfg.region.top_solid_layers;
+        let h = cfg.region.layer_height;
         let Some(after) = top_layer_at(obj.layers, region.peak.z) else {
             return Err(Rejection {
                 object: oi,
@@ -676,7 +675,10 @@ impl<'a> RegionJob<'a> {
     /// each after its comment) and the region's report (layers topmost first).
     fn emit(&self, cleared: Cleared, areas: &[Vec<ExPolygon>]) -> RegionPlan {
         let region = self.region;
-        let speeds = ProgramParams::from_config(self.cfg)
+        let speeds = self
+            .cfg
+            .program
+            .clone()
             .tools
             .get(self.obj.tool)
             .map(|t| t.speeds)
@@ -777,9 +779,14 @@ fn peak(region: &TopRegion) -> [f64; 3] {
 /// The window around `region` that the head and the loops can reach, [min x, min y, max x,
 /// max y], mm: the region's bounding box grown by the larger of the head's radius and the
 /// reach of its perimeters and rim steps.
-fn region_window(region: &TopRegion, head: &Head, cfg: &Config, step: Option<f64>) -> [f64; 4] {
-    let n = cfg.slice.region.top_solid_layers;
-    let params = cfg.slice.region.for_layer(1);
+fn region_window(
+    region: &TopRegion,
+    head: &Head,
+    cfg: &CurvedParams,
+    step: Option<f64>,
+) -> [f64; 4] {
+    let n = cfg.region.top_solid_layers;
+    let params = cfg.region.for_layer(1);
     let reach = (params.perimeters + 2) as f64 * params.perimeter_width
         + n as f64 * step.unwrap_or(0.0)
         + 1.0;

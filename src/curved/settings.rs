@@ -8,6 +8,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::region::RegionParams;
+use crate::toolpaths::ProgramParams;
+
 /// Which curved-layer mode a slice uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -179,4 +182,24 @@ impl CurvedSettings {
         }
         out
     }
+}
+
+/// What the curved stages read: their own `[curved]` settings and the planar settings they
+/// print beside (built by the config, `Config::curved_params`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvedParams {
+    /// The `[curved]` settings.
+    pub curved: CurvedSettings,
+    /// The regions stage's parameters (layer height, widths, top solid layers, ...).
+    pub region: RegionParams,
+    /// Height of the first layer, mm.
+    pub first_layer_height: f64,
+    /// The toolpaths stage's parameters (speeds per role and tool).
+    pub program: ProgramParams,
+    /// The bed's front-left corner [X, Y], mm.
+    pub bed_origin: [f64; 2],
+    /// Travels shorter than this do not retract, mm.
+    pub retract_before_travel: f64,
+    /// How many tools the machine has.
+    pub tool_count: usize,
 }

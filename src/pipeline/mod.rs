@@ -493,7 +493,7 @@ fn curved_tops(
             },
         )
         .collect();
-    let plan = crate::curved::plan_tops(&objects, cfg);
+    let plan = crate::curved::plan_tops(&objects, &cfg.curved_params());
     for ((layers, _), removals) in sliced.iter_mut().zip(&plan.removals) {
         for (layer, remove) in layers.iter_mut().zip(removals) {
             if !remove.is_empty() {
@@ -583,7 +583,8 @@ pub fn slice_clfff(
     }
     progress(Stage::Place);
     let mut meshes = place_on_bed(scene, cfg);
-    let raised = clfff::place::raise(&mut meshes, cfg);
+    let curved = cfg.curved_params();
+    let raised = clfff::place::raise(&mut meshes, &curved);
     check_fits(&meshes, cfg)?;
     for m in &meshes {
         if let Some(bb) = m.bounding_box()
@@ -608,7 +609,7 @@ pub fn slice_clfff(
     laps.lap(Stage::Place);
 
     progress(Stage::Slice);
-    let plan = clfff::plan(&meshes, tool, raised, cfg)?;
+    let plan = clfff::plan(&meshes, tool, raised, &curved)?;
     laps.lap(Stage::Slice);
 
     progress(Stage::Program);

@@ -28,7 +28,7 @@ use super::lift::lift_path;
 use super::outline::ccw_region;
 use super::sandwich::{Column, Sandwich};
 use super::shell::Shell;
-use crate::config::Config;
+use crate::curved::CurvedParams;
 use crate::curved::motion;
 use crate::curved::surface::SurfaceTriangle;
 use crate::geom::{ExPolygon, Point2, Point3, intersection, union};
@@ -165,7 +165,7 @@ pub fn islands(shell: &Shell, s: &Sandwich) -> Vec<(usize, Vec<ExPolygon>)> {
 pub fn layers(
     shell: &Shell,
     s: &Sandwich,
-    cfg: &Config,
+    cfg: &CurvedParams,
     tool: usize,
     start: Point3,
     support: &dyn Fn(f64, f64) -> f64,
@@ -174,7 +174,7 @@ pub fn layers(
     let Some(&(first, _)) = isl.first() else {
         return Ok(Vec::new());
     };
-    let mut region = cfg.slice.region.clone();
+    let mut region = cfg.region.clone();
     region.top_solid_layers = 0;
     region.bottom_solid_layers = 0;
     region.skirt_loops = 0;
@@ -205,7 +205,7 @@ pub fn layers(
     };
     let params = ProgramParams {
         start,
-        ..ProgramParams::from_config(cfg)
+        ..cfg.program.clone()
     };
     let program = build_program(std::slice::from_ref(&object), &params);
     let area = |i: usize| -> f64 {
@@ -245,7 +245,7 @@ fn thicken(
     s: &Sandwich,
     support: &dyn Fn(f64, f64) -> f64,
     index: usize,
-    cfg: &Config,
+    cfg: &CurvedParams,
 ) -> (Vec<Toolpath>, bool) {
     let Some(z) = path.points.first().map(|p| p.z) else {
         return (Vec::new(), false);

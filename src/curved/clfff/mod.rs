@@ -50,7 +50,7 @@ pub mod travel;
 pub use report::ClfffReport;
 pub use sections::{Section, SectionLayers};
 
-use crate::config::Config;
+use crate::curved::CurvedParams;
 use crate::curved::collision::Head;
 use crate::curved::motion;
 use crate::geom::{ExPolygon, Point3};
@@ -130,7 +130,7 @@ pub fn plan(
     meshes: &[Mesh],
     tool: usize,
     raised: f64,
-    cfg: &Config,
+    cfg: &CurvedParams,
 ) -> Result<ClfffPlan, ClfffError> {
     check_tools(cfg)?;
     let shape = Shape::new(meshes, cfg)?;
@@ -155,17 +155,17 @@ pub fn plan(
 type Support<'a> = &'a dyn Fn(f64, f64) -> f64;
 
 /// Refuses a scaffold or buffer tool the config does not define.
-fn check_tools(cfg: &Config) -> Result<(), ClfffError> {
+fn check_tools(cfg: &CurvedParams) -> Result<(), ClfffError> {
     let c = &cfg.curved;
     for (key, t) in [
         ("scaffold_tool", c.scaffold_tool),
         ("buffer_tool", c.buffer_tool),
     ] {
-        if t >= cfg.tools.len() {
+        if t >= cfg.tool_count {
             return Err(ClfffError::UnknownTool {
                 key,
                 tool: t,
-                tools: cfg.tools.len(),
+                tools: cfg.tool_count,
             });
         }
     }
@@ -192,14 +192,14 @@ impl Shape {
     /// Reads the surfaces and outline of `meshes` and counts the model layers (`curved.layers`,
     /// else the top skin's with a sandwich, else the thickness in layers). Errors when there
     /// is no surface, or no thickness for a sandwich.
-    fn new(meshes: &[Mesh], cfg: &Config) -> Result<Self, ClfffError> {
+    fn new(meshes: &[Mesh], cfg: &CurvedParams) -> Result<Self, ClfffError> {
         let c = &cfg.curved;
         let shell = Shell::from_meshes(meshes);
         let out = outline::outline(&shell);
         if shell.is_empty() || out.is_empty() {
             return Err(ClfffError::NoSurface);
         }
-        let h = cfg.slice.region.layer_height;
+        let h = cfg.region.layer_height;
         let thickness = shell.median_thickness();
         if c.sandwich && thickness <= 0.0 {
             return Err(ClfffError::SandwichWithoutThickness);
@@ -225,10 +225,10 @@ impl Shape {
 
     /// The limit the scaffold stays under: the buffer's height plus `curved.scaffold_clearance`
     /// below the bottom surface.
-    fn limit(&self, cfg: &Config) -> Limit<'_> {
+    fn limit(&self, cfg: &CurvedParams) -> Limit<'_> {
         let c = &cfg.curved;
         let buffer_h = if c.buffer {
-            cfg.slice.region.layer_height
+            cfg.region.layer_height
         } else {
             0.0
         };
@@ -242,46 +242,41 @@ impl Shape {
 
 /// The scaffold's planar layers over the scaffold area (none when `curved.scaffold` is off),
 /// its first layer ordered from the bed origin.
-fn build_scaffold(area: &[ExPolygon], limit: &Limit<'_>, cfg: &Config) -> Scaffold {
+fn build_scaffold(area: &[ExPolygon], limit: &Limit<'_>, cfg: &CurvedParams) -> Scaffold {
     let c = &cfg.curved;
     if c.scaffold {
         let p = ScaffoldParams {
-            first_top: cfg.slice.first_layer_height,
-            layer_height: cfg.slice.region.layer_height,
+            first_top: cfg.first_layer_height,
+            layer_height: cfg.region.layer_height,
             vectors: c.scaffold_vectors.clone(),
             spacing: c.scaffold_spacing,
             step: c.step,
-            width: cfg.slice.region.infill_width,
+            width: cfg.region.infill_width,
         };
-        scaffold::build(
-            area,
-            limit,
-            &p,
-            (cfg.printer.bed_origin[0], cfg.printer.bed_origin[1]),
-        )
+        scaffold::build(area, limit, &p, (cfg.bed_origin[0], cfg.bed_origin[1]))
     } else {
         Scaffold::default()
     }
 }
 
 /// The sandwich of `curved.sandwich` with `n` bottom-skin layers, or none.
-fn sandwich_of(n: usize, cfg: &Config) -> Option<Sandwich> {
+fn sandwich_of(n: usize, cfg: &CurvedParams) -> Option<Sandwich> {
     let c = &cfg.curved;
     c.sandwich.then_some(Sandwich {
-        h: cfg.slice.region.layer_height,
+        h: cfg.region.layer_height,
         bottom_layers: n,
         top_layers: c.top_layers,
-        first_top: cfg.slice.first_layer_height,
+        first_top: cfg.first_layer_height,
         buffer: c.buffer,
     })
 }
 
 /// The specs of every curved layer in print order: the buffer, the `n` model (bottom skin)
 /// layers, then a sandwich's top skin; raster angles cycle through `curved.angles`.
-fn layer_specs(n: usize, sandwich: Option<&Sandwich>, cfg: &Config) -> Vec<LayerSpec> {
+fn layer_specs(n: usize, sandwich: Option<&Sandwich>, cfg: &CurvedParams) -> Vec<LayerSpec> {
     let c = &cfg.curved;
-    let h = cfg.slice.region.layer_height;
-    let region = &cfg.slice.region;
+    let h = cfg.region.layer_height;
+    let region = &cfg.region;
     let mut specs = Vec::new();
     let angle = |i: usize| {
         c.angles
@@ -342,7 +337,7 @@ fn lift_layers(
     specs: Vec<LayerSpec>,
     sandwich: Option<&Sandwich>,
     support: Support<'_>,
-    cfg: &Config,
+    cfg: &CurvedParams,
 ) -> Vec<LiftedLayer> {
     let step = cfg.curved.step;
     specs
@@ -384,10 +379,10 @@ struct Made<'a> {
 
 /// The sections' Program layers: the scaffold's, then the buffer's and the model's curved
 /// layers on their tools (a sandwich's core before its top skin), grouped at long travels.
-fn emit_sections(made: &Made<'_>, tool: usize, cfg: &Config) -> Result<Emitted, ClfffError> {
+fn emit_sections(made: &Made<'_>, tool: usize, cfg: &CurvedParams) -> Result<Emitted, ClfffError> {
     let c = &cfg.curved;
-    let h = cfg.slice.region.layer_height;
-    let params = ProgramParams::from_config(cfg);
+    let h = cfg.region.layer_height;
+    let params = cfg.program.clone();
     let bottom_max = made.shape.shell.bottom_range().map_or(0.0, |r| r.1);
     let mut layer_reports = Vec::new();
     let mut z_limited = 0;
@@ -395,7 +390,7 @@ fn emit_sections(made: &Made<'_>, tool: usize, cfg: &Config) -> Result<Emitted, 
     let mut sections = vec![scaffold_section(
         made.scaffold,
         c.scaffold_tool,
-        cfg.slice.region.infill_width,
+        cfg.region.infill_width,
         &params,
     )];
     for section in [Section::Buffer, Section::Model] {
@@ -412,12 +407,7 @@ fn emit_sections(made: &Made<'_>, tool: usize, cfg: &Config) -> Result<Emitted, 
             h,
             max_z_speed: c.max_z_speed,
         };
-        let mut grouper = Grouper::new(
-            cfg.printer.retract_before_travel,
-            c.travel_clearance,
-            h,
-            None,
-        );
+        let mut grouper = Grouper::new(cfg.retract_before_travel, c.travel_clearance, h, None);
         grouper.check_short = made.sandwich.is_some();
         let mut first = true;
         for layer in made.lifted.iter().filter(|l| l.spec.section == section) {
@@ -450,7 +440,7 @@ fn emit_sections(made: &Made<'_>, tool: usize, cfg: &Config) -> Result<Emitted, 
 
 /// The plan: the sections and the report (placement, scaffold, every curved layer, the head
 /// of `[curved]` replayed over the first Program, the sections, the core).
-fn assemble_plan(made: &Made<'_>, emitted: Emitted, raised: f64, cfg: &Config) -> ClfffPlan {
+fn assemble_plan(made: &Made<'_>, emitted: Emitted, raised: f64, cfg: &CurvedParams) -> ClfffPlan {
     let Emitted {
         sections,
         layers,
@@ -472,7 +462,7 @@ fn assemble_plan(made: &Made<'_>, emitted: Emitted, raised: f64, cfg: &Config) -
 }
 
 /// The head model of `[curved]` replayed over the sections combined into one Program.
-fn replay_head(sections: &[SectionLayers], cfg: &Config) -> Collisions {
+fn replay_head(sections: &[SectionLayers], cfg: &CurvedParams) -> Collisions {
     let c = &cfg.curved;
     let head = Head {
         angle_deg: c.head_angle,
@@ -699,12 +689,12 @@ fn emit_curved(
 fn emit_core(
     ctx: &LayerCtx<'_>,
     s: &Sandwich,
-    cfg: &Config,
+    cfg: &CurvedParams,
     grouper: &mut Grouper,
 ) -> Result<CoreReport, ClfffError> {
     let start = grouper
         .position()
-        .unwrap_or_else(|| Point3::new(cfg.printer.bed_origin[0], cfg.printer.bed_origin[1], 0.0));
+        .unwrap_or_else(|| Point3::new(cfg.bed_origin[0], cfg.bed_origin[1], 0.0));
     let layers = core::layers(ctx.shell, s, cfg, ctx.tool, start, ctx.support)?;
     let mut rep = CoreReport {
         skin_layers: [s.bottom_layers, s.top_layers],

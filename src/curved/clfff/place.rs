@@ -6,14 +6,14 @@
 //! layer below the shell's bottom surface, so the buffer's lowest point lands at
 //! `curved.raise`).
 
-use crate::config::Config;
+use crate::curved::CurvedParams;
 use crate::geom::Transform;
 use crate::mesh::Mesh;
 
 /// How far [`raise`] lifts the shell, mm.
-pub fn raise_height(cfg: &Config) -> f64 {
+pub fn raise_height(cfg: &CurvedParams) -> f64 {
     let buffer = if cfg.curved.buffer {
-        cfg.slice.region.layer_height
+        cfg.region.layer_height
     } else {
         0.0
     };
@@ -21,7 +21,7 @@ pub fn raise_height(cfg: &Config) -> f64 {
 }
 
 /// Lifts meshes already on the bed by [`raise_height`]; returns the lift, mm.
-pub fn raise(meshes: &mut [Mesh], cfg: &Config) -> f64 {
+pub fn raise(meshes: &mut [Mesh], cfg: &CurvedParams) -> f64 {
     let dz = raise_height(cfg);
     if dz != 0.0 {
         let t = Transform::translation(0.0, 0.0, dz);
