@@ -14,7 +14,10 @@
 //! - [`mesh`]: the indexed triangle mesh with validation and repair.
 //! - [`scene`]: every supported file read into a [`scene::Scene`] (or a circuit, a point cloud,
 //!   a G-code listing), and meshes written back out.
-//! - [`program`]: toolpaths and events in print order — what every writer consumes.
+//! - [`program`]: toolpaths and events in print order — what every writer consumes — and the
+//!   machine they run on.
+//! - [`surface`]: height fields and scanned surfaces (mesh queries on parry) that the curved
+//!   and conform stages follow.
 //! - [`config`]: the one TOML configuration (and PrusaSlicer `.ini` import) that the walks turn
 //!   into each stage's parameters.
 //!
@@ -52,6 +55,7 @@ pub mod geom;
 pub mod mesh;
 pub mod scene;
 pub mod program;
+pub mod surface;
 pub mod config;
 
 // Stages.

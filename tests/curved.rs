@@ -7,11 +7,12 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use conduit::config::Config;
+use conduit::curved::LAYER_COMMENT;
 use conduit::curved::collision::{Bead, Head, ReplayHit, ReplayTolerances, replay};
-use conduit::curved::{HeightField, LAYER_COMMENT};
 use conduit::geom::Point3;
 use conduit::pipeline::place_on_bed;
 use conduit::scene::{LoadOptions, load_scene};
+use conduit::surface::HeightField;
 use conduit_gcode::{Firmware, Machine};
 use serde_json::Value;
 

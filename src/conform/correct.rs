@@ -53,8 +53,8 @@
 use super::Corrections;
 use super::nozzle::Nozzle;
 use super::spline::Local;
-use super::surface::Surface;
 use crate::geom::{Point3, Vector3};
+use crate::surface::Surface;
 
 /// Rounds of the clearance pass (lifting a point can bring its segments into contact).
 const CLEAR_ROUNDS: usize = 32;

@@ -17,8 +17,8 @@
 //! thickness counts as 0 (error −d): a path that collides is never scored as a good deposit.
 
 use super::nozzle::Nozzle;
-use super::surface::Surface;
 use crate::geom::{Point3, Vector3};
+use crate::surface::Surface;
 use serde::Serialize;
 
 /// Thresholds of the defect counts, mm.

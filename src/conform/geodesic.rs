@@ -19,8 +19,8 @@
 
 use super::design::PlanarPath;
 use super::project::Projected;
-use super::surface::Surface;
 use crate::geom::Point3;
+use crate::surface::Surface;
 
 /// Bisection steps of one march step: 2⁻⁴⁰ of the step length.
 const BISECTIONS: usize = 40;

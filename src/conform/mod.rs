@@ -36,14 +36,13 @@ pub mod report;
 pub mod scan;
 pub mod settings;
 pub mod spline;
-pub mod surface;
 
+pub use crate::surface::Surface;
 pub use design::Placement;
 pub use nozzle::Nozzle;
 pub use register::{Registration, register};
 pub use report::ConformReport;
 pub use settings::{ConformSettings, Corrections, Mapping};
-pub use surface::Surface;
 
 use crate::emit::gcode::GcodeParams;
 use crate::geom::Point3;

@@ -12,8 +12,8 @@
 //! rings of 16 points plus the centre; the cone on rings every half millimetre, asked only when
 //! the surface anywhere reaches the cone's height.
 
-use super::surface::Surface;
 use crate::geom::Point3;
+use crate::surface::Surface;
 
 /// The nozzle's shape (mm, degrees).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -6,8 +6,8 @@
 //! them split the path: each stretch on the surface becomes its own path.
 
 use super::design::PlanarPath;
-use super::surface::Surface;
 use crate::geom::Point3;
+use crate::surface::Surface;
 
 /// Paths on the surface, and how many design points found no surface under them.
 #[derive(Debug, Clone, Default, PartialEq)]

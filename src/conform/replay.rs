@@ -6,10 +6,10 @@
 //! machine do is checked, not the planner's intent.
 
 use super::nozzle::Nozzle;
-use super::surface::Surface;
 use crate::check::moves;
 use crate::geom::Point3;
 use crate::program::machine::Flavor;
+use crate::surface::Surface;
 use serde::Serialize;
 
 /// The 1-based line range of a conduit G-code file's body: from its first `;LAYER_CHANGE` to

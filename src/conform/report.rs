@@ -14,8 +14,8 @@ use super::project::Projected;
 use super::register::Registration;
 use super::replay::ReplayContacts;
 use super::spline::Local;
-use super::surface::{CloudInfo, Surface};
 use crate::geom::Point3;
+use crate::surface::{CloudInfo, Surface};
 use serde::Serialize;
 
 /// A place where the whole nozzle meets the surface.

@@ -7,10 +7,10 @@
 
 use std::path::{Path, PathBuf};
 
-use super::surface::{CloudInfo, Surface, SurfaceError};
 use crate::geom::Point3;
 use crate::mesh::Mesh;
 use crate::scene::{Content, LoadError, LoadOptions, load, placed_meshes};
+use crate::surface::{CloudInfo, Surface, SurfaceError};
 
 /// A scan read from a file.
 #[derive(Debug)]

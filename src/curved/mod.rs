@@ -29,12 +29,10 @@ pub mod collision;
 pub mod motion;
 pub mod report;
 pub mod settings;
-pub mod surface;
 pub mod tops;
 
 pub use report::{CurvedLayerReport, CurvedReport, RegionReport, Rejection};
 pub use settings::{CurvedMode, CurvedParams, CurvedSettings};
-pub use surface::{HeightField, SurfaceHit};
 
 use crate::geom::{
     ExPolygon, Join, Point2, Point3, Polygon, difference, intersection, offset, scaled, union,
@@ -44,6 +42,7 @@ use crate::program::{Event, LayerItem, Program, Role, Toolpath};
 use crate::region::infill::{InfillPattern, Rectilinear};
 use crate::region::make_perimeters;
 use crate::slice::LayerZ;
+use crate::surface::HeightField;
 use crate::toolpaths::RoleSpeeds;
 use collision::{Head, HeadPart, Material};
 use tops::{

@@ -28,9 +28,9 @@
 //! [`MIN_THICKNESS_FRACTION`]` · h` are dropped (the path is split there), and so are points
 //! over another surface than the region's (a crack in the mesh) or next to a step in it.
 
-use super::surface::{HeightField, densify_path};
 use crate::geom::{ExPolygon, Point2, Point3, Polygon, difference, intersection, union};
 use crate::slice::LayerZ;
+use crate::surface::{HeightField, densify_path};
 
 /// Thinnest curved layer kept on the planar core, as a fraction of the layer height.
 pub const MIN_THICKNESS_FRACTION: f64 = 0.25;

@@ -17,7 +17,6 @@ use crate::conform::orient::{self, OrientParams, OrientationReport};
 use crate::conform::register::RegisterError;
 use crate::conform::replay::{self, ReplayContacts};
 use crate::conform::scan::Scan;
-use crate::conform::surface::SurfaceError;
 use crate::conform::{
     self, ConformError, ConformParams, ConformReport, Placement, Registration, Surface,
 };
@@ -26,6 +25,7 @@ use crate::emit::robot::{Dialect, RobotError, RobotJob, write_robot};
 use crate::geom::Point3;
 use crate::program::Program;
 use crate::program::machine::Tool;
+use crate::surface::SurfaceError;
 
 /// The walk's steps, in order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]

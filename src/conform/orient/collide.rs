@@ -10,8 +10,8 @@
 //! A ring whose lowest point is above a bound of the surface's height around it is skipped.
 
 use super::super::nozzle::Nozzle;
-use super::super::surface::Surface;
 use crate::geom::{Point3, Vector3};
+use crate::surface::Surface;
 
 /// Points per ring on the needle and the tip disk.
 const NEEDLE_ANGLES: usize = 16;

@@ -10,8 +10,8 @@
 //! off by up to half the angle between neighbouring facets. Where a difference reaches past
 //! the surface's edge the normal of the facet under the point is taken.
 
-use super::super::surface::Surface;
 use crate::geom::{Point3, Vector3};
+use crate::surface::Surface;
 
 /// The upward unit normal of the top surface at (x, y), from slopes over ±`half` mm; `None` off
 /// the surface.

@@ -30,11 +30,11 @@ use super::sandwich::{Column, Sandwich};
 use super::shell::Shell;
 use crate::curved::CurvedParams;
 use crate::curved::motion;
-use crate::curved::surface::SurfaceTriangle;
 use crate::geom::{ExPolygon, Point2, Point3, intersection, union};
 use crate::program::Toolpath;
 use crate::region::{RegionError, make_regions_with_heights};
 use crate::slice::LayerZ;
+use crate::surface::SurfaceTriangle;
 use crate::toolpaths::{ObjectLayers, ProgramParams, build_program};
 
 /// One planar core layer as toolpaths in print order.

@@ -6,7 +6,7 @@
 //! segment lies over one surface triangle.
 
 use super::shell::Shell;
-use crate::curved::surface::densify_path;
+use crate::surface::densify_path;
 
 /// The points of `path` (xy, mm) with its crossings of the bottom surface's triangle edges and
 /// subdivisions to at most `step` inserted; a closed path's closing segment is densified too

@@ -38,8 +38,8 @@
 use super::layers::{LayerSpec, LiftedLayer, MAX_THICKNESS_FACTOR, lift_flat_paths};
 pub use super::lift::Lift;
 use super::shell::Shell;
-use crate::curved::surface::densify_path;
 use crate::geom::ExPolygon;
+use crate::surface::densify_path;
 
 /// Rounding allowance of the grid and count tests, in layer heights.
 const EPS: f64 = 1e-9;

@@ -20,10 +20,9 @@
 //! every non-vertical triangle is turned to face up; the top surface is the highest of them.
 //! The bottom surface is the top surface of the mesh mirrored in z (`z → −z`), negated back.
 
-use crate::curved::HeightField;
-use crate::curved::surface::SurfaceTriangle;
 use crate::geom::Point3;
 use crate::mesh::Mesh;
+use crate::surface::{HeightField, SurfaceTriangle};
 
 /// Triangles whose unit normal has a z component below this are vertical walls, not surface.
 const VERTICAL_NZ: f64 = 1e-6;

@@ -8,8 +8,8 @@
 //! through the origin (its top line at z = R), a plane `plane` at z = 0, optionally wavy
 //! (`plane:waviness:A,P`: z = A·sin(2πx/P)). Their normals point out of the solid.
 
-use crate::conform::Surface;
 use crate::geom::{Point3, Vector3};
+use crate::surface::Surface;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 

@@ -2,7 +2,7 @@
 //! of the triangle there.
 //!
 //! Place in the pipeline: built once per object from the placed mesh, before the regions stage;
-//! [`super::tops`] finds the gently sloped top regions with it and projects the flat top layers
+//! the curved tops (`crate::curved::tops`) find the gently sloped top regions with it and projects the flat top layers
 //! onto it.
 //!
 //! # Method

@@ -1,8 +1,8 @@
 //! The scanned surface as a queryable triangle mesh: top height at (x, y), closest point, normal.
 //!
-//! Place in the pipeline: step 1. Built from a triangle mesh (STL, OBJ, 3MF, PLY with faces)
-//! or from a point cloud (XYZ, PLY points), registered into the machine frame
-//! ([`super::register`]), then asked by every later step. Queries go through parry's
+//! Place in the pipeline: the first step of conformal printing. Built from a triangle mesh (STL,
+//! OBJ, 3MF, PLY with faces) or from a point cloud (XYZ, PLY points), registered into the
+//! machine frame ([`crate::conform::register`]), then asked by every later step. Queries go through parry's
 //! bounding-volume hierarchy: a downward ray cast gives the top height (what a 3-axis nozzle
 //! coming from above meets), a point projection the closest point and its triangle.
 //!
@@ -26,7 +26,7 @@
 //! a question that is two-dimensional, about ten times faster on the test scans. Scans are
 //! often wound inconsistently, so every non-vertical triangle takes part whatever its winding.
 
-use crate::curved::HeightField;
+use super::HeightField;
 use crate::geom::{Point3, Vector3};
 use crate::mesh::Mesh;
 use nalgebra::Isometry3;
