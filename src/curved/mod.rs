@@ -93,12 +93,7 @@ pub struct TopsPlan {
 /// Plans the curved tops of every object (see the module docs).
 pub fn plan_tops(objects: &[CurvedObject<'_>], cfg: &CurvedParams) -> TopsPlan {
     let c = &cfg.curved;
-    let head = Head {
-        angle_deg: c.head_angle,
-        height: c.head_height,
-        carriage_radius: c.carriage_radius,
-        carriage_clearance: c.carriage_clearance,
-    };
+    let head = c.head();
     let mut plan = TopsPlan {
         removals: objects
             .iter()

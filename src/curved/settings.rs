@@ -184,6 +184,18 @@ impl CurvedSettings {
     }
 }
 
+impl CurvedSettings {
+    /// The print head these settings describe: the cone and the carriage cylinder.
+    pub fn head(&self) -> crate::curved::collision::Head {
+        crate::curved::collision::Head {
+            angle_deg: self.head_angle,
+            height: self.head_height,
+            carriage_radius: self.carriage_radius,
+            carriage_clearance: self.carriage_clearance,
+        }
+    }
+}
+
 /// What the curved stages read: their own `[curved]` settings and the planar settings they
 /// print beside (built by the config, `Config::curved_params`).
 #[derive(Debug, Clone, PartialEq)]

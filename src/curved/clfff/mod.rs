@@ -51,7 +51,6 @@ pub use report::ClfffReport;
 pub use sections::{Section, SectionLayers};
 
 use crate::curved::CurvedParams;
-use crate::curved::collision::Head;
 use crate::curved::motion;
 use crate::geom::{ExPolygon, Point3};
 use crate::mesh::Mesh;
@@ -464,12 +463,7 @@ fn assemble_plan(made: &Made<'_>, emitted: Emitted, raised: f64, cfg: &CurvedPar
 /// The head model of `[curved]` replayed over the sections combined into one Program.
 fn replay_head(sections: &[SectionLayers], cfg: &CurvedParams) -> Collisions {
     let c = &cfg.curved;
-    let head = Head {
-        angle_deg: c.head_angle,
-        height: c.head_height,
-        carriage_radius: c.carriage_radius,
-        carriage_clearance: c.carriage_clearance,
-    };
+    let head = c.head();
     let combined = sections::programs(sections, false);
     combined
         .first()
