@@ -104,10 +104,7 @@ impl GcodeParams {
         if key.is_empty() || !key.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
             return None;
         }
-        for v in [printer.get(key), self.template_keys.get(key)]
-            .into_iter()
-            .flatten()
-        {
+        if let Some(v) = printer.get(key).or_else(|| self.template_keys.get(key)) {
             return match (v, index) {
                 (toml::Value::Array(a), Some(i)) => a.get(i).and_then(scalar),
                 (v, None) => scalar(v),
