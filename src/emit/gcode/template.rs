@@ -104,9 +104,10 @@ impl GcodeParams {
         if key.is_empty() || !key.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
             return None;
         }
-        for v in [printer.get(key), self.template_keys.get(key)]
+        if let Some(v) = [printer.get(key), self.template_keys.get(key)]
             .into_iter()
             .flatten()
+            .next()
         {
             return match (v, index) {
                 (toml::Value::Array(a), Some(i)) => a.get(i).and_then(scalar),
