@@ -8,7 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Cavities, channels and trace routing (`[route]`). Lengths in mm.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct RouteSettings {
     /// Tool that prints the conductive traces. Default 1.

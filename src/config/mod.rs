@@ -40,11 +40,9 @@
 //! Lengths in millimetres, speeds in mm/s, accelerations in mm/s², temperatures in °C,
 //! fan speeds in percent, densities in g/cm³, volumetric flows in mm³/s.
 
-mod compensate;
 mod defaults;
 mod electronics;
 pub mod prusa_ini;
-mod robot;
 
 pub use crate::conform::{ConformSettings, Corrections, Mapping};
 pub use crate::curved::{CurvedMode, CurvedSettings};
@@ -73,13 +71,14 @@ use crate::region::RegionParams;
 use crate::toolpaths::{ProgramParams, RoleSpeeds, ToolPathParams};
 
 /// Everything a conduit run is configured with. See the [module docs](self) for the file format.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Config {
     /// The machine (`[printer]`).
     pub printer: Printer,
     /// The tools, indexed by tool number (`[tools.0]`, `[tools.1]`, …); never empty.
     #[serde(with = "tools_table")]
+    #[schemars(with = "BTreeMap<String, Tool>")]
     pub tools: Vec<Tool>,
     /// Slicing settings (`[slice]`).
     pub slice: SliceSettings,
@@ -100,7 +99,9 @@ pub struct Config {
 }
 
 /// Pattern of solid (top and bottom) infill.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum SolidPattern {
     /// Parallel lines alternating 90° per layer (the only solid pattern of the regions stage).
@@ -114,7 +115,7 @@ pub enum SolidPattern {
 /// Deserialising reads every key directly (not through `#[serde(flatten)]`, which would lose
 /// the line and key of a wrong value), so a new [`RegionParams`] field must also be added to
 /// the private `SliceSpec`; the defaults round-trip test fails until it is.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, schemars::JsonSchema)]
 pub struct SliceSettings {
     /// Perimeters, infill, widths, layer height and nozzle diameter of the regions stage: the keys
     /// `perimeters`, `external_perimeter_width`, `perimeter_width`, `infill_width`,

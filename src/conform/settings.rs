@@ -9,7 +9,9 @@
 use serde::{Deserialize, Serialize};
 
 /// How the design is laid onto the surface.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Mapping {
     /// Every design point dropped along −z onto the surface (the design's top view is kept;
@@ -22,7 +24,9 @@ pub enum Mapping {
 }
 
 /// Which corrections of the point-cloud-based path planning method are applied.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Corrections {
     /// The tip placed on the deposit model: the back edge (outer going down, inner going up)
@@ -74,7 +78,7 @@ impl Corrections {
 }
 
 /// Conformal printing settings (`[conform]`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct ConformSettings {
     /// Tool that dispenses (a paste tool: its snippets switch the pressure). Default 1.

@@ -12,7 +12,9 @@ use crate::region::RegionParams;
 use crate::toolpaths::ProgramParams;
 
 /// Which curved-layer mode a slice uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum CurvedMode {
     /// Planar layers only.
@@ -27,7 +29,7 @@ pub enum CurvedMode {
 
 /// Non-planar top surfaces (`[curved]`). Lengths in mm, angles in degrees from the horizontal
 /// (slopes) or from the vertical (the head cone), speeds in mm/s.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct CurvedSettings {
     /// `"off"`, `"tops"` or `"clfff"` (also set by `conduit slice --curved tops|clfff`).

@@ -11,7 +11,9 @@
 use serde::{Deserialize, Serialize};
 
 /// How closed outlines of a design are printed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum JetFill {
     /// Every outline is a wall: one line along it.
@@ -26,7 +28,7 @@ pub enum JetFill {
 }
 
 /// Aerosol-jet settings (`[jet]`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct JetSettings {
     /// Tool that jets: a `kind = "paste"` tool (unheated, switched by the shutter snippets

@@ -12,7 +12,9 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 /// G-code dialect of the printer's firmware.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Flavor {
     /// Marlin 1.x / 2.x (also Prusa firmware).
@@ -26,7 +28,7 @@ pub enum Flavor {
 }
 
 /// The printer (`[printer]`): bed, firmware, custom G-code, retraction, travel and fan.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Printer {
     /// G-code dialect: `"marlin"`, `"reprapfirmware"` or `"klipper"`. Default `"marlin"`.
@@ -86,7 +88,9 @@ pub struct Printer {
 }
 
 /// What a tool deposits and therefore how it is driven.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum ToolKind {
     /// A filament extruder: flow is E distance, computed from the cross-section of the
@@ -100,7 +104,7 @@ pub enum ToolKind {
 
 /// One tool (`[tools.N]`). Keys left out take the default of the tool's `kind`:
 /// [`Tool::filament`] or [`Tool::paste`].
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, schemars::JsonSchema)]
 pub struct Tool {
     /// Name shown in comments and reports. Default `"PLA"` (filament) / `"conductive paste"`.
     pub name: String,
@@ -121,6 +125,7 @@ pub struct Tool {
     /// Temperature while the tool is parked during another tool's work, °C; absent = keep
     /// `temperature`. Default absent.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(example = 150.0)]
     pub standby_temperature: Option<f64>,
     /// Offset of this tool's nozzle from tool 0's [X, Y], mm, when the firmware does not apply
     /// it. Default [0, 0].
@@ -139,12 +144,14 @@ pub struct Tool {
     /// This tool's retraction length, mm, overriding `printer.retract_length`; absent = use the
     /// printer's. Default absent.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(example = 1.0)]
     pub retract_length: Option<f64>,
     /// Z lift during this tool's travels longer than `printer.retract_before_travel`, mm,
     /// overriding `printer.retract_lift`; absent = use the printer's. The paste tool's default
     /// is 0.5: a dispensing nozzle dragged from one trace to the next at the layer's top would
     /// smear the paste it just laid. Filament default absent.
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(example = 0.5)]
     pub travel_lift: Option<f64>,
 }
 
@@ -283,7 +290,7 @@ impl fmt::Display for Flavor {
 /// Before either snippet the writer retracts and lifts the nozzle `lift` mm above the layer
 /// about to be printed; after it, it re-selects the active tool and comes back down only once it
 /// is over the next path.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct PnpSettings {
     /// G-code for a part placed by the vacuum tool (`method = "auto"`). Placeholders: `{id}`

@@ -20,7 +20,9 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// Which infill pattern sparse infill uses (solid infill is always rectilinear at 100 %).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum InfillPatternKind {
     /// Parallel lines, direction alternating by 90° layer by layer.
@@ -36,7 +38,7 @@ pub enum InfillPatternKind {
 ///
 /// Defaults (what `RegionParams::default()` gives and what a config section may omit) are noted on
 /// each field; they are PrusaSlicer's for a 0.4 mm nozzle at 0.2 mm layers.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct RegionParams {
     /// Number of perimeter loops per island, the external one included. Default 2.

@@ -19,7 +19,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Robot and multi-axis settings (`[robot]`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct RobotSettings {
     /// Denavit–Hartenberg parameters of the arm, one row per joint from the base:
@@ -72,7 +72,9 @@ pub struct RobotSettings {
 }
 
 /// The machine of five-axis G-code (`five_axis`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum FiveAxis {
     /// `G1 X Y Z I J K`: tip and unit tool vector.
@@ -85,7 +87,9 @@ pub enum FiveAxis {
 }
 
 /// The rotary axes of a five-axis head or table (`rotary_axes`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
 pub enum RotaryAxes {
     /// Tilt A about x, then C about z.
     #[default]

@@ -9,7 +9,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Gap compensation settings (`[compensate]`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct CompensateSettings {
     /// Gap the compensation aims for, mm. Default 0.05.
