@@ -39,7 +39,6 @@ const KNOWN: &[&str] = &[
     "check/machine.rs -> crate::config",
     "check/mod.rs -> crate::config",
     "check/tests.rs -> crate::config",
-    "circuit/stage.rs -> crate::config",
     "curved/clfff/core.rs -> crate::config",
     "curved/clfff/mod.rs -> crate::config",
     "curved/clfff/place.rs -> crate::config",

@@ -279,7 +279,8 @@ fn front(
     };
     if let Some(e) = circuit {
         progress(Stage::Route);
-        let circuit = electronics::place_circuit(e, &model_boxes, &offsets, cfg)?;
+        let params = cfg.electronics_params();
+        let circuit = electronics::place_circuit(e, &model_boxes, &offsets, &params)?;
         let mut r = ElectronicsReport::default();
         for (i, (layers, _)) in sliced.iter_mut().enumerate() {
             let zs: Vec<LayerZ> = layers.iter().map(|l| l.z).collect();
@@ -292,7 +293,7 @@ fn front(
                 &mut islands,
                 &zs,
                 &circuit,
-                cfg,
+                &params,
                 &mut out.extras,
                 &mut r,
             );

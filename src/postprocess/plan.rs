@@ -184,7 +184,8 @@ pub fn plan_circuit(
         .collect();
     let bbox = islands_bbox(&islands, zs.last().map_or(0.0, |z| z.top))
         .ok_or(PostprocessError::NothingPrinted)?;
-    let circuit = place_circuit(electronics, &[bbox], &[[0.0; 3]], cfg)?;
+    let params = cfg.electronics_params();
+    let circuit = place_circuit(electronics, &[bbox], &[[0.0; 3]], &params)?;
     let mut extras = LayerExtras::default();
     let mut report = ElectronicsReport::default();
     let ObjectCuts { cavities, channels } = object_stage(
@@ -192,7 +193,7 @@ pub fn plan_circuit(
         &mut islands,
         &zs,
         &circuit,
-        cfg,
+        &params,
         &mut extras,
         &mut report,
     );
