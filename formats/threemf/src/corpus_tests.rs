@@ -12,15 +12,13 @@ use std::path::Path;
 use crate::{Limits, Model, ObjectContent, read, write};
 
 /// (file name, manifest outcome we knowingly do not meet, why).
-const DISPUTED: &[(&str, &str, &str)] = &[
-    (
-        "dodeca_chain_loop_color.3mf",
-        "load",
-        "two <metadata name=\"Description\">, the same defect as \
+const DISPUTED: &[(&str, &str, &str)] = &[(
+    "dodeca_chain_loop_color.3mf",
+    "load",
+    "two <metadata name=\"Description\">, the same defect as \
          MUSTFAIL_Chapter3.4.1b_DuplicatedMetadataName (two \"Title\"); conduit rejects \
          duplicated metadata names as the core specification requires",
-    ),
-];
+)];
 
 #[test]
 fn corpus() {
