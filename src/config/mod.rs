@@ -43,6 +43,7 @@
 mod compensate;
 mod defaults;
 mod electronics;
+pub mod host;
 pub mod prusa_ini;
 mod robot;
 
@@ -53,6 +54,7 @@ pub use crate::emit::robot::{FiveAxis, RobotSettings, RotaryAxes};
 pub use crate::jet::{JetFill, JetSettings};
 pub use crate::robot::compensate::CompensateSettings;
 pub use defaults::defaults_toml;
+pub use host::{CURA_KEYS, HostSettings, ORCA_KEYS, Setting, SettingSource};
 pub use prusa_ini::from_prusa_pairs;
 
 use std::collections::BTreeMap;

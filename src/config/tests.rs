@@ -230,3 +230,15 @@ fn route_keys_build_the_electronics_params() -> Result<(), ConfigError> {
     assert!(params.pad_drops);
     Ok(())
 }
+
+#[test]
+fn the_default_config_reads_host_layers_as_the_default_layer_params() {
+    let cfg = Config::default();
+    assert_eq!(
+        cfg.host_layer_params(),
+        crate::postprocess::LayerParams::default()
+    );
+    let params = cfg.postprocess_params();
+    assert_eq!(params.electronics, cfg.electronics_params());
+    assert_eq!(params.gcode, cfg.gcode_params());
+}

@@ -3,11 +3,13 @@
 //!
 //! [`Stage`] names the steps in order (for progress reporting); [`slice_scene`] runs them and
 //! returns the G-code bytes with a [`SliceSummary`] for the report; [`slice_scene_with`] adds a
-//! circuit ([`electronics`]).
+//! circuit ([`electronics`]). The other walks are its submodules: [`conform`], [`jet`],
+//! [`compensate`] and [`postprocess`] (another slicer's G-code with a circuit built in).
 
 pub mod compensate;
 pub mod conform;
 pub mod jet;
+pub mod postprocess;
 
 pub use crate::circuit::stage::{self as electronics, Electronics, ElectronicsReport};
 pub use crate::emit::route_svg::RouteViewLayer;
