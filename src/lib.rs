@@ -40,12 +40,13 @@
 //! - [`emit`]: writers — G-code (Marlin, RepRapFirmware, Klipper), robot programs, previews,
 //!   routing views.
 //! - [`check`]: replaying any G-code to find problems and measure it.
+//! - [`postprocess`]: slicer plugin mode — another slicer's G-code read into layers, the circuit
+//!   planned on them, the file rewritten, verified and reported.
 //!
 //! **Walks** — one library call per command:
 //! - [`pipeline`]: scene to G-code (planar, curved tops, curved-layer FFF), scene to routing
-//!   view, scan and design to a conformal program ([`pipeline::conform`]).
-//! - [`postprocess`]: slicer plugin mode — another slicer's G-code read into layers, the circuit
-//!   built into it, the file edited in place.
+//!   view, scan and design to a conformal program ([`pipeline::conform`]), another slicer's
+//!   G-code with its settings read and a circuit built in ([`pipeline::postprocess`]).
 //!
 //! The `conduit` binary (`src/main.rs`, `src/cli/`, behind the default `cli` feature) parses
 //! command lines, calls one walk, writes files and prints.
@@ -70,7 +71,7 @@ pub mod robot;
 pub mod jet;
 pub mod emit;
 pub mod check;
+pub mod postprocess;
 
 // Walks.
 pub mod pipeline;
-pub mod postprocess;

@@ -4,9 +4,9 @@
 //! script run against the binary.
 
 use crate::support::{conduit, corpus, root, sample, stderr, stdout, temp_dir};
-use conduit::postprocess::{
-    EMode, Host, HostPrint, LayerMethod, RegionParams, SettingSource, ZSource, printed_regions,
-};
+use conduit::config::SettingSource;
+use conduit::pipeline::postprocess::HostPrint;
+use conduit::postprocess::{EMode, Host, LayerMethod, RegionParams, ZSource, printed_regions};
 use conduit::program::Role;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -482,8 +482,13 @@ pub(crate) fn check_postprocessed(
     let circuit = conduit::circuit::Circuit::load(circuit).expect("circuit loads");
     let placement = conduit::circuit::Placement::load(placement).expect("placement loads");
     let electronics = conduit::pipeline::Electronics { circuit, placement };
-    let report = conduit::postprocess::verify(&original, &edited, &electronics, &config)
-        .expect("the circuit plans on the original");
+    let report = conduit::postprocess::verify(
+        &original,
+        &edited,
+        &electronics,
+        &config.postprocess_params(),
+    )
+    .expect("the circuit plans on the original");
     assert!(
         report.is_ok(),
         "{} problems:\n{}",
@@ -613,6 +618,7 @@ fn verify_finds_plastic_in_cavities_and_missing_traces_and_events() {
         .expect("corpus file");
     let original = conduit_gcode::parse(&bytes).expect("parses");
     let (_, config) = HostPrint::read(&original, Vec::new()).expect("settings");
+    let params = config.postprocess_params();
     let electronics = conduit::pipeline::Electronics {
         circuit: conduit::circuit::Circuit::load(&sample("postprocess/cube_led.sch"))
             .expect("circuit"),
@@ -622,7 +628,7 @@ fn verify_finds_plastic_in_cavities_and_missing_traces_and_events() {
     // The host's file as it is: every line kept, but plastic fills the cavities and nothing
     // prints the traces or places the parts.
     let report =
-        conduit::postprocess::verify(&original, &original, &electronics, &config).expect("plans");
+        conduit::postprocess::verify(&original, &original, &electronics, &params).expect("plans");
     assert!(!report.is_ok());
     assert_eq!(report.kept_lines, original.lines.len());
     assert!(report.plastic_in_cuts > 0, "{report:?}");
@@ -634,7 +640,7 @@ fn verify_finds_plastic_in_cavities_and_missing_traces_and_events() {
     assert!(text.contains("is not printed by tool 1"), "{text}");
     assert!(text.contains("no event places part R1"), "{text}");
     // The edited file passes; with one line of it changed, the line check names it.
-    let edit = conduit::postprocess::edit_circuit(
+    let edit = conduit::pipeline::postprocess::edit_circuit(
         &original,
         &HostPrint::read(&original, Vec::new()).expect("settings").0,
         &electronics,
@@ -642,7 +648,7 @@ fn verify_finds_plastic_in_cavities_and_missing_traces_and_events() {
     )
     .expect("edits");
     assert!(
-        conduit::postprocess::verify(&original, &edit.gcode, &electronics, &config)
+        conduit::postprocess::verify(&original, &edit.gcode, &electronics, &params)
             .expect("plans")
             .is_ok()
     );
@@ -654,7 +660,7 @@ fn verify_finds_plastic_in_cavities_and_missing_traces_and_events() {
         .expect("a fan line");
     tampered.lines[i] = conduit_gcode::Line::new("M106 S255", conduit_gcode::LineEnding::Lf);
     let report =
-        conduit::postprocess::verify(&original, &tampered, &electronics, &config).expect("plans");
+        conduit::postprocess::verify(&original, &tampered, &electronics, &params).expect("plans");
     assert!(
         report
             .problems

@@ -15,6 +15,7 @@
 mod placed;
 mod placement;
 mod rubberband;
+pub mod settings;
 pub mod stage;
 mod three_de;
 
@@ -27,7 +28,8 @@ pub use placement::{
     PlacingMethod, Problem, Waypoint,
 };
 pub use rubberband::{Rubberband, Rubberbands, rubberbands};
-pub use stage::{Electronics, ElectronicsError, ElectronicsReport};
+pub use settings::RouteSettings;
+pub use stage::{Electronics, ElectronicsError, ElectronicsParams, ElectronicsReport};
 
 /// The copper shape of a pad, in the pad's own frame (before the pad rotation).
 #[derive(Debug, Clone, Copy, PartialEq)]

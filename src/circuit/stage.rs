@@ -10,7 +10,6 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::circuit::{Circuit, PlacedPart, Placement, PlacingMethod, place, rubberbands};
-use crate::config::Config;
 use crate::geom::{BoundingBox, ExPolygon, Point2, Point3, Polygon, scaled};
 use crate::program::{Event, LayerExtras, Role, Toolpath};
 use crate::region::cavity::{Cavity, carve_cavities, carve_channels};
@@ -18,6 +17,27 @@ use crate::route::{
     PadCopper, RouteLayer, RouteParams, RouteResult, Wire, min_trace_spacing, route,
 };
 use crate::slice::LayerZ;
+
+/// What the electronics stage is configured with: the `[route]` settings, the widths and speed
+/// of the conductive tool's traces and the perimeter width of the layers they run through.
+/// Built by the walk from the config (`crate::config::Config::electronics_params`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ElectronicsParams {
+    /// The router's parameters (`[route]` and the perimeter width of `[slice]`).
+    pub route: RouteParams,
+    /// Tool that prints the conductive traces and pad drops (`route.conductive_tool`).
+    pub conductive_tool: usize,
+    /// How many tools the machine has: the conductive tool must be one of them.
+    pub tool_count: usize,
+    /// Height of a conductive trace, mm; 0 = the layer's height (`route.conductive_height`).
+    pub conductive_height: f64,
+    /// Feed of the conductive traces, mm/s (`slice.conductive_speed`).
+    pub conductive_speed: f64,
+    /// How far a part's cavity reaches beyond its pads and body, mm (`route.cavity_offset`).
+    pub cavity_offset: f64,
+    /// Whether every pad gets a conductive drop (`route.pad_drops`).
+    pub pad_drops: bool,
+}
 
 /// A circuit and where its parts go: what `--circuit` and `--placement` give.
 #[derive(Debug, Clone, PartialEq)]
@@ -144,13 +164,13 @@ pub fn place_circuit(
     e: &Electronics,
     bboxes: &[BoundingBox],
     offsets: &[[f64; 3]],
-    cfg: &Config,
+    params: &ElectronicsParams,
 ) -> Result<PlacedCircuit, ElectronicsError> {
     let placement = e.placement.to_model(bboxes)?;
-    if cfg.route.conductive_tool >= cfg.tools.len() {
+    if params.conductive_tool >= params.tool_count {
         return Err(ElectronicsError::NoConductiveTool {
-            tool: cfg.route.conductive_tool,
-            tools: cfg.tools.len(),
+            tool: params.conductive_tool,
+            tools: params.tool_count,
         });
     }
     let mut parts = place(&e.circuit, &placement, bboxes)?;
@@ -223,29 +243,6 @@ fn translate_part(part: &mut PlacedPart, d: [f64; 3]) {
     }
 }
 
-/// The router's parameters from `[route]` and the perimeter width of `[slice]`.
-pub fn route_params(cfg: &Config) -> RouteParams {
-    let r = &cfg.route;
-    RouteParams {
-        perimeters: r.perimeters,
-        perimeter_width: cfg.slice.region.perimeter_width,
-        conductive_width: r.conductive_width,
-        channel_extra: r.channel_extra,
-        perimeter_weights: r.perimeter_weights.clone(),
-        base_weight: r.base_weight,
-        outside_weight: r.outside_weight,
-        squeeze_weight: r.squeeze_weight,
-        grid_step: r.grid_step,
-        interlayer_overlap: r.interlayer_overlap,
-        layer_change_penalty: r.layer_change_penalty,
-        layer_span: r.layer_span,
-        rip_up_rounds: r.rip_up_rounds,
-        max_detour: r.max_detour,
-        detour_slack: r.detour_slack,
-        ..RouteParams::default()
-    }
-}
-
 /// What the electronics stage cut from one object's layers.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ObjectCuts {
@@ -263,7 +260,7 @@ pub fn object_stage(
     islands: &mut [Vec<ExPolygon>],
     zs: &[LayerZ],
     circuit: &PlacedCircuit,
-    cfg: &Config,
+    params: &ElectronicsParams,
     extras: &mut LayerExtras,
     report: &mut ElectronicsReport,
 ) -> ObjectCuts {
@@ -273,7 +270,7 @@ pub fn object_stage(
         .enumerate()
         .filter(|(_, p)| p.object == object)
         .collect();
-    let cavities = carve_part_cavities(&mine, islands, zs, cfg);
+    let cavities = carve_part_cavities(&mine, islands, zs, params.cavity_offset);
     let (mine_wires, between): (Vec<&CircuitWire>, Vec<&CircuitWire>) = circuit
         .wires
         .iter()
@@ -285,10 +282,10 @@ pub fn object_stage(
             .unplaced_pins
             .extend(circuit.unplaced.iter().cloned());
     }
-    let result = route_object(&mine, &mine_wires, islands, zs, cfg, report);
-    let style = TraceStyle::of(cfg);
-    let mut per_layer = trace_paths(&result, &mine_wires, zs, cfg, style, report);
-    if cfg.route.pad_drops {
+    let result = route_object(&mine, &mine_wires, islands, zs, &params.route, report);
+    let style = TraceStyle::of(params);
+    let mut per_layer = trace_paths(&result, &mine_wires, zs, style, report);
+    if params.pad_drops {
         add_pad_drops(&mine, zs, style, &mut per_layer);
     }
     add_traces(per_layer, zs, extras);
@@ -309,15 +306,18 @@ struct TraceStyle {
     speed: f64,
     /// Trace width, mm.
     width: f64,
+    /// Trace height, mm; 0 = the layer's height (pad drops are always a layer high).
+    height: f64,
 }
 
 impl TraceStyle {
-    /// The style `[route]` and `[slice]` give.
-    fn of(cfg: &Config) -> Self {
+    /// The style of the stage's parameters.
+    fn of(params: &ElectronicsParams) -> Self {
         Self {
-            tool: cfg.route.conductive_tool,
-            speed: cfg.slice.conductive_speed,
-            width: cfg.route.conductive_width,
+            tool: params.conductive_tool,
+            speed: params.conductive_speed,
+            width: params.route.conductive_width,
+            height: params.conductive_height,
         }
     }
 }
@@ -328,19 +328,12 @@ fn carve_part_cavities(
     mine: &[(usize, &PlacedPart)],
     islands: &mut [Vec<ExPolygon>],
     zs: &[LayerZ],
-    cfg: &Config,
+    cavity_offset: f64,
 ) -> Vec<Cavity> {
     let spans: Vec<(f64, f64)> = zs.iter().map(|z| (z.bottom, z.top)).collect();
     let cavities: Vec<Cavity> = mine
         .iter()
-        .map(|(_, p)| {
-            Cavity::around(
-                &p.footprint,
-                cfg.route.cavity_offset,
-                p.position.z,
-                p.body_height,
-            )
-        })
+        .map(|(_, p)| Cavity::around(&p.footprint, cavity_offset, p.position.z, p.body_height))
         .collect();
     carve_cavities(islands, &spans, &cavities);
     cavities
@@ -381,7 +374,7 @@ fn route_object(
     mine_wires: &[&CircuitWire],
     islands: &mut [Vec<ExPolygon>],
     zs: &[LayerZ],
-    cfg: &Config,
+    params: &RouteParams,
     report: &mut ElectronicsReport,
 ) -> RouteResult {
     let wires: Vec<Wire> = mine_wires.iter().map(|w| w.wire.clone()).collect();
@@ -403,11 +396,10 @@ fn route_object(
             outline: pad.outline.clone(),
         })
         .collect();
-    let params = route_params(cfg);
     report
         .warnings
-        .extend(mine.iter().filter_map(|(_, p)| pitch_warning(p, &params)));
-    let result = route(&layers, &wires, &pads, &params);
+        .extend(mine.iter().filter_map(|(_, p)| pitch_warning(p, params)));
+    let result = route(&layers, &wires, &pads, params);
     carve_channels(islands, &result.channels);
     result
 }
@@ -418,7 +410,6 @@ fn trace_paths(
     result: &RouteResult,
     mine_wires: &[&CircuitWire],
     zs: &[LayerZ],
-    cfg: &Config,
     style: TraceStyle,
     report: &mut ElectronicsReport,
 ) -> BTreeMap<usize, Vec<Toolpath>> {
@@ -446,8 +437,8 @@ fn trace_paths(
             if points.len() < 2 {
                 continue;
             }
-            let height = if cfg.route.conductive_height > 0.0 {
-                cfg.route.conductive_height
+            let height = if style.height > 0.0 {
+                style.height
             } else {
                 z.height()
             };

@@ -7,12 +7,10 @@ use super::{Failure, args::ConfigSource, args::PostprocessArgs, config::resolve}
 use anyhow::Context;
 use conduit::circuit::Electronics;
 use conduit::circuit::{Circuit, Placement};
-use conduit::config::Config;
+use conduit::config::{Config, HostSettings};
+use conduit::pipeline::postprocess::{Edit, HostPrint, edit, edit_circuit};
 use conduit::postprocess::rewrite::SUMMARY_PREFIX;
-use conduit::postprocess::{
-    Edit, HostPrint, HostSettings, LayerParams, PostprocessReport, detect_host, edit, edit_circuit,
-    output_name_file, read_gcode,
-};
+use conduit::postprocess::{detect_host, output_name_file, read_gcode};
 use conduit::scene::write_atomically;
 use std::io::Write;
 
@@ -25,7 +23,7 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
     let settings = HostSettings::collect(&gcode, host.host, host_environment());
     let config = settings_config(&args.config, &settings)?;
     let electronics = load_electronics(&args)?;
-    let params = LayerParams::from_config(&config).for_host(host.host);
+    let params = config.host_layer_params().for_host(host.host);
     let print = HostPrint::read_with(&gcode, host, settings, &params);
     let (changed, done) = match &electronics {
         None => {
@@ -53,10 +51,7 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
         write_atomically(&target, |f| writeln!(f, "{name}"))
             .with_context(|| format!("{}: cannot write", target.display()))?;
     }
-    let mut report = PostprocessReport::new(&print, changed);
-    if let Some(done) = &done {
-        report = report.with_circuit(done);
-    }
+    let report = print.report(changed, done.as_ref());
     if let Some(report_path) = &args.report {
         let json = serde_json::to_vec_pretty(&report).context("serialising the report")?;
         write_atomically(report_path, |f| f.write_all(&json))

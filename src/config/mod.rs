@@ -42,15 +42,17 @@
 
 mod defaults;
 mod electronics;
+pub mod host;
 pub mod prusa_ini;
 
+pub use crate::circuit::settings::RouteSettings;
 pub use crate::conform::{ConformSettings, Corrections, Mapping};
 pub use crate::curved::{CurvedMode, CurvedSettings};
 pub use crate::emit::robot::{FiveAxis, RobotSettings, RotaryAxes};
 pub use crate::jet::{JetFill, JetSettings};
 pub use crate::robot::compensate::CompensateSettings;
 pub use defaults::defaults_toml;
-pub use electronics::RouteSettings;
+pub use host::{CURA_KEYS, HostSettings, ORCA_KEYS, Setting, SettingSource};
 pub use prusa_ini::from_prusa_pairs;
 
 use std::collections::BTreeMap;

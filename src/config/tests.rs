@@ -234,3 +234,35 @@ fn default_start_and_end_gcode_check_clean() -> Result<(), ConfigError> {
     assert_eq!(r.stats.max_bed_temperature, Some(60.0));
     Ok(())
 }
+
+#[test]
+fn route_keys_build_the_electronics_params() -> Result<(), ConfigError> {
+    // The defaults of `[route]` are the router's own.
+    let params = Config::default().electronics_params();
+    assert_eq!(params.route, crate::route::RouteParams::default());
+    assert_eq!((params.conductive_tool, params.tool_count), (1, 2));
+    let cfg = parse(
+        "[route]\nconductive_tool = 0\nconductive_width = 0.4\nrip_up_rounds = 0\npad_drops = true\n\
+         [slice]\nperimeter_width = 0.5\nconductive_speed = 7\n",
+    )?;
+    let params = cfg.electronics_params();
+    assert_eq!(params.route.conductive_width, 0.4);
+    assert_eq!(params.route.rip_up_rounds, 0);
+    assert_eq!(params.route.perimeter_width, 0.5);
+    assert_eq!(params.conductive_speed, 7.0);
+    assert_eq!(params.conductive_tool, 0);
+    assert!(params.pad_drops);
+    Ok(())
+}
+
+#[test]
+fn the_default_config_reads_host_layers_as_the_default_layer_params() {
+    let cfg = Config::default();
+    assert_eq!(
+        cfg.host_layer_params(),
+        crate::postprocess::LayerParams::default()
+    );
+    let params = cfg.postprocess_params();
+    assert_eq!(params.electronics, cfg.electronics_params());
+    assert_eq!(params.gcode, cfg.gcode_params());
+}

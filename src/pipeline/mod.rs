@@ -3,11 +3,13 @@
 //!
 //! [`Stage`] names the steps in order (for progress reporting); [`slice_scene`] runs them and
 //! returns the G-code bytes with a [`SliceSummary`] for the report; [`slice_scene_with`] adds a
-//! circuit ([`electronics`]).
+//! circuit ([`electronics`]). The other walks are its submodules: [`conform`], [`jet`],
+//! [`compensate`] and [`postprocess`] (another slicer's G-code with a circuit built in).
 
 pub mod compensate;
 pub mod conform;
 pub mod jet;
+pub mod postprocess;
 
 pub use crate::circuit::stage::{self as electronics, Electronics, ElectronicsReport};
 pub use crate::emit::route_svg::RouteViewLayer;
@@ -280,7 +282,8 @@ fn front(
     };
     if let Some(e) = circuit {
         progress(Stage::Route);
-        let circuit = electronics::place_circuit(e, &model_boxes, &offsets, cfg)?;
+        let params = cfg.electronics_params();
+        let circuit = electronics::place_circuit(e, &model_boxes, &offsets, &params)?;
         let mut r = ElectronicsReport::default();
         for (i, (layers, _)) in sliced.iter_mut().enumerate() {
             let zs: Vec<LayerZ> = layers.iter().map(|l| l.z).collect();
@@ -293,7 +296,7 @@ fn front(
                 &mut islands,
                 &zs,
                 &circuit,
-                cfg,
+                &params,
                 &mut out.extras,
                 &mut r,
             );

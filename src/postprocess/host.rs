@@ -1,7 +1,7 @@
 //! Which slicer wrote a G-code file, and which layer comments it carries.
 //!
 //! Place in the pipeline: the first step of post-processing, before the host's settings are read
-//! ([`super::settings`]) and its layers rebuilt ([`super::layers`]). The host decides where its
+//! (`crate::config::HostSettings`) and its layers rebuilt ([`super::layers`]). The host decides where its
 //! settings live (a `; key = value` block, Cura's `;SETTING_3` lines); the markers found decide
 //! how layers are recognised (comments, or Z heights of extrusions when there are none).
 

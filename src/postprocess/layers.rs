@@ -2,7 +2,8 @@
 //! z and height, the machine state it runs in, and its extrusions as polylines with role and
 //! width.
 //!
-//! Place in the pipeline: after [`super::host`] and [`super::settings`]; its [`HostLayer`]s are
+//! Place in the pipeline: after [`super::host`] and the host's settings (which give the run's
+//! config, and with it these [`LayerParams`]); its [`HostLayer`]s are
 //! what the electronics stages work on in post-processing mode (the printed regions per layer
 //! come from [`super::regions`]), and their line ranges tell where to edit the file.
 //!
@@ -46,10 +47,10 @@ use serde::Serialize;
 use super::comments::{HostComment, LayerMarker, read_comment};
 use super::host::Host;
 use super::roles::role_of;
-use crate::config::{Config, Flavor, ToolKind};
 use crate::geom::Point3;
 use crate::program::Role;
 use crate::program::extrusion::{BeadShape, filament_area};
+use crate::program::machine::{Flavor, Printer, Tool, ToolKind};
 
 /// Two extrusion heights closer than this are the same layer (without layer comments), mm.
 pub const Z_TOLERANCE: f64 = 0.000_5;
@@ -61,7 +62,8 @@ const SPIRAL_MAX_STEP: f64 = 1.0;
 /// Feed rate of the replay before the file's first `F`, mm/s (Marlin's 1500 mm/min).
 const DEFAULT_FEEDRATE: f64 = 25.0;
 
-/// What the layer reconstruction needs to know about the printer.
+/// What the layer reconstruction needs to know about the printer. Built by the walk from the
+/// run's config (`crate::config::Config::host_layer_params`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LayerParams {
     /// Firmware dialect, for the effect of `G90`/`G91` on E.
@@ -79,16 +81,17 @@ pub struct LayerParams {
 }
 
 impl LayerParams {
-    /// The flavour, the tools' filament diameters and the perimeter width of `config`.
-    pub fn from_config(config: &Config) -> Self {
+    /// The parameters of a machine with firmware `flavor` and `tools` (filament diameters of
+    /// the filament tools), with `fallback_width` (the perimeter width) for extrusions whose
+    /// width nothing tells, and PrusaSlicer's bead model.
+    pub fn new(flavor: Flavor, tools: &[Tool], fallback_width: f64) -> Self {
         Self {
-            flavor: config.printer.flavor,
-            filament_diameters: config
-                .tools
+            flavor,
+            filament_diameters: tools
                 .iter()
                 .map(|t| (t.kind == ToolKind::Filament).then_some(t.filament_diameter))
                 .collect(),
-            fallback_width: config.slice.region.perimeter_width,
+            fallback_width,
             bead: BeadShape::RoundedRectangle,
         }
     }
@@ -112,9 +115,14 @@ impl LayerParams {
 }
 
 impl Default for LayerParams {
-    /// [`LayerParams::from_config`] of [`Config::default`].
+    /// The default machine (a Marlin printer with a filament tool and a paste tool) and the
+    /// regions stage's default perimeter width: the parameters of the default config.
     fn default() -> Self {
-        Self::from_config(&Config::default())
+        Self::new(
+            Printer::default().flavor,
+            &[Tool::filament(), Tool::paste()],
+            crate::region::RegionParams::default().perimeter_width,
+        )
     }
 }
 

@@ -27,17 +27,16 @@
 
 use crate::circuit::PlacedPart;
 use crate::circuit::stage::{ObjectCuts, object_stage, place_circuit};
-use crate::circuit::{Electronics, ElectronicsReport};
-use crate::config::Config;
+use crate::circuit::{Electronics, ElectronicsParams, ElectronicsReport};
 use crate::geom::{BoundingBox, ExPolygon, FillRule, polygons_to_expolygons};
 use crate::geom::{difference, intersection, scaled, union};
 use crate::program::{Event, LayerExtras, Role, Toolpath};
 use crate::region::cavity::Cavity;
 use crate::slice::LayerZ;
 
-use super::layers::{ExtrusionPath, HostLayer};
+use super::PostprocessError;
+use super::layers::{ExtrusionPath, HostLayer, HostLayers};
 use super::regions::{RegionParams, printed_regions};
-use super::{HostPrint, PostprocessError};
 use rayon::prelude::*;
 
 /// Empty areas inside the external perimeter smaller than this are not holes of the object but
@@ -144,8 +143,8 @@ pub fn host_islands(layer: &HostLayer, params: &RegionParams) -> Vec<ExPolygon> 
     }
 }
 
-/// Places `electronics` in the host's print and runs the electronics stage on its layers (see
-/// the [module docs](self)).
+/// Places `electronics` in the host's print (its `layers`) and runs the electronics stage with
+/// `params` on them (see the [module docs](self)).
 ///
 /// # Errors
 /// [`PostprocessError::NothingPrinted`] when no layer prints anything,
@@ -153,11 +152,11 @@ pub fn host_islands(layer: &HostLayer, params: &RegionParams) -> Vec<ExPolygon> 
 /// (sequential printing of several objects), [`PostprocessError::Electronics`] when the
 /// placement does not fit the circuit or the config has no conductive tool.
 pub fn plan_circuit(
-    print: &HostPrint,
+    layers: &HostLayers,
     electronics: &Electronics,
-    cfg: &Config,
+    params: &ElectronicsParams,
 ) -> Result<CircuitPlan, PostprocessError> {
-    let layers = &print.layers.layers;
+    let layers = &layers.layers;
     let mut zs: Vec<LayerZ> = Vec::with_capacity(layers.len());
     for layer in layers {
         let bottom = zs.last().map_or(0.0, |b: &LayerZ| b.top);
@@ -177,14 +176,12 @@ pub fn plan_circuit(
             slice_z: (bottom + layer.z) / 2.0,
         });
     }
-    let params = RegionParams::default();
-    let mut islands: Vec<Vec<ExPolygon>> = layers
-        .par_iter()
-        .map(|l| host_islands(l, &params))
-        .collect();
+    let beads = RegionParams::default();
+    let mut islands: Vec<Vec<ExPolygon>> =
+        layers.par_iter().map(|l| host_islands(l, &beads)).collect();
     let bbox = islands_bbox(&islands, zs.last().map_or(0.0, |z| z.top))
         .ok_or(PostprocessError::NothingPrinted)?;
-    let circuit = place_circuit(electronics, &[bbox], &[[0.0; 3]], cfg)?;
+    let circuit = place_circuit(electronics, &[bbox], &[[0.0; 3]], params)?;
     let mut extras = LayerExtras::default();
     let mut report = ElectronicsReport::default();
     let ObjectCuts { cavities, channels } = object_stage(
@@ -192,7 +189,7 @@ pub fn plan_circuit(
         &mut islands,
         &zs,
         &circuit,
-        cfg,
+        params,
         &mut extras,
         &mut report,
     );

@@ -1,19 +1,27 @@
 //! What post-processing found and did: the JSON of `conduit postprocess --report` and the
 //! one-line summary on stderr.
 //!
-//! Place in the pipeline: the last step; it reads a [`HostPrint`] and never changes it. Output
-//! is deterministic: the same file and settings give the same report, byte for byte.
+//! Place in the pipeline: the last step; it reads the host's layers and what the edit did, and
+//! changes neither. Output is deterministic: the same file and settings give the same report,
+//! byte for byte.
 
 use std::fmt;
 
 use serde::Serialize;
 
-use super::CircuitEdit;
-use super::layers::{EMode, HostLayer, LayerMethod, RetractionStyle, ZSource};
+use super::layers::{EMode, HostLayer, HostLayers, LayerMethod, RetractionStyle, ZSource};
 use super::rewrite::RewriteStats;
-use super::settings::SettingSource;
-use super::{Host, HostPrint};
+use super::{Host, HostInfo};
 use crate::circuit::ElectronicsReport;
+
+/// How many of the host's settings came from where.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SettingCounts {
+    /// Settings read from the environment of the call (`SLIC3R_<KEY>`).
+    pub environment: usize,
+    /// Settings read from the file.
+    pub gcode: usize,
+}
 
 /// The report of one post-processing run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -141,9 +149,14 @@ impl LayerReport {
 }
 
 impl PostprocessReport {
-    /// The report of `print`; `changed` says whether the file was rewritten.
-    pub fn new(print: &HostPrint, changed: bool) -> Self {
-        let layers = &print.layers;
+    /// The report of a print by `host` read as `layers`, with `settings` of the host;
+    /// `changed` says whether the file was rewritten.
+    pub fn new(
+        host: &HostInfo,
+        layers: &HostLayers,
+        settings: SettingCounts,
+        changed: bool,
+    ) -> Self {
         let (layer_method, layer_markers) = match &layers.method {
             LayerMethod::Comments(markers) => (
                 "comments".to_owned(),
@@ -152,8 +165,8 @@ impl PostprocessReport {
             LayerMethod::ZHeights => ("z heights".to_owned(), Vec::new()),
         };
         Self {
-            host: print.host.host,
-            generator: print.host.generator.clone(),
+            host: host.host,
+            generator: host.generator.clone(),
             layer_method,
             layer_markers,
             layer_count: layers.layers.len(),
@@ -163,8 +176,8 @@ impl PostprocessReport {
             e_modes: layers.e_modes(),
             retraction: layers.retraction(),
             unplaced_extrusions: layers.unplaced_extrusions,
-            settings_from_environment: print.settings.count_from(SettingSource::Environment),
-            settings_from_gcode: print.settings.count_from(SettingSource::Gcode),
+            settings_from_environment: settings.environment,
+            settings_from_gcode: settings.gcode,
             changed,
             layers: layers.layers.iter().map(LayerReport::new).collect(),
             edit: None,
@@ -172,10 +185,11 @@ impl PostprocessReport {
         }
     }
 
-    /// This report with what building a circuit in changed (`done`).
-    pub fn with_circuit(mut self, done: &CircuitEdit) -> Self {
-        self.edit = Some(done.stats.clone());
-        self.electronics = Some(done.plan.report.clone());
+    /// This report with what building a circuit in changed (`stats`) and the electronics
+    /// stage's report of it.
+    pub fn with_circuit(mut self, stats: &RewriteStats, electronics: &ElectronicsReport) -> Self {
+        self.edit = Some(stats.clone());
+        self.electronics = Some(electronics.clone());
         self
     }
 }

@@ -46,13 +46,12 @@ use std::collections::BTreeMap;
 
 use conduit_gcode::{Gcode, Line, LineEnding, Machine, Move, fmt_e, fmt_f, fmt_xyz};
 
+use super::PostprocessError;
 use super::comments::{HostComment, read_comment};
 use super::cut::{CutRegion, Piece, split_move};
-use super::layers::{HostLayer, RetractionStyle};
+use super::layers::{HostLayer, HostLayers, RetractionStyle};
 use super::plan::CircuitPlan;
-use super::{HostPrint, PostprocessError};
-use crate::config::Config;
-use crate::emit::gcode::{Recorder, Resume, write_block};
+use crate::emit::gcode::{GcodeParams, Recorder, Resume, write_block};
 use crate::geom::Point3;
 use crate::program::LayerItem;
 use rayon::prelude::*;
@@ -97,9 +96,8 @@ struct MoveCut {
 }
 
 /// The cut moves of every layer with cuts, by line.
-fn cut_moves(print: &HostPrint, plan: &CircuitPlan) -> BTreeMap<usize, MoveCut> {
-    let per_layer: Vec<Vec<(usize, MoveCut)>> = print
-        .layers
+fn cut_moves(layers: &HostLayers, plan: &CircuitPlan) -> BTreeMap<usize, MoveCut> {
+    let per_layer: Vec<Vec<(usize, MoveCut)>> = layers
         .layers
         .par_iter()
         .zip(&plan.layers)
@@ -192,8 +190,9 @@ impl State {
     }
 }
 
-/// Writes the edited file: see the [module docs](self). `summary` gets the statistics and
-/// returns the summary lines (without line endings).
+/// Writes the edited file: `gcode`, read as `layers`, with `plan` built in and the blocks
+/// written by the G-code writer with `params` (see the [module docs](self)). `summary` gets
+/// the statistics and returns the summary lines (without line endings).
 ///
 /// # Errors
 /// [`PostprocessError::MachineState`] when a layer end where a block goes is in relative
@@ -201,16 +200,16 @@ impl State {
 /// when the block cannot be written (a tool the config lacks, a bad template).
 pub fn rewrite(
     gcode: &Gcode,
-    print: &HostPrint,
+    layers: &HostLayers,
     plan: &CircuitPlan,
-    cfg: &Config,
+    params: &GcodeParams,
     summary: impl FnOnce(&RewriteStats) -> Vec<String>,
 ) -> Result<(Gcode, RewriteStats), PostprocessError> {
     let ending = gcode.line_ending();
-    let cuts = cut_moves(print, plan);
+    let cuts = cut_moves(layers, plan);
     // Insertion points: after each layer's last extrusion (or last line), by line.
     let mut blocks: BTreeMap<usize, usize> = BTreeMap::new();
-    for (layer, p) in print.layers.layers.iter().zip(&plan.layers) {
+    for (layer, p) in layers.layers.iter().zip(&plan.layers) {
         if p.traces.is_empty() && p.events.is_empty() {
             continue;
         }
@@ -222,7 +221,7 @@ pub fn rewrite(
         }
     }
     let mut state = State {
-        machine: Machine::new(cfg.printer.flavor, 25.0),
+        machine: Machine::new(params.printer.flavor, 25.0),
         temps: BTreeMap::new(),
         feature: None,
         width: None,
@@ -231,7 +230,7 @@ pub fn rewrite(
     let mut stats = RewriteStats::default();
     let mut out: Vec<Line> = Vec::with_capacity(gcode.lines.len() + cuts.len() * 4);
     let new_line = |text: String| Line::new(text, ending);
-    let fallback_style = print.layers.retraction();
+    let fallback_style = layers.retraction();
     // Travels inside a cut are written as the host writes its travels: `G0` when it uses `G0`
     // for moves (Cura), else `G1`.
     let travel = if gcode.lines.iter().any(|l| l.is_command(b'G', 0)) {
@@ -247,7 +246,7 @@ pub fn rewrite(
                 if let Some(what) = state.unsupported() {
                     return Err(PostprocessError::MachineState { line: i + 1, what });
                 }
-                let layer = print.layers.layers.iter().find(|l| l.lines.contains(&i));
+                let layer = layers.layers.iter().find(|l| l.lines.contains(&i));
                 let style = layer.and_then(|l| l.retraction).or(fallback_style);
                 let pieces = Pieces {
                     line,
@@ -258,7 +257,7 @@ pub fn rewrite(
                     feed: m.feed,
                     feed_changed: line.get(b'F').is_some(),
                     style,
-                    retract_before_travel: cfg.printer.retract_before_travel,
+                    retract_before_travel: params.printer.retract_before_travel,
                     travel,
                 };
                 let lines = pieces.write();
@@ -273,11 +272,10 @@ pub fn rewrite(
             _ => out.push(line.clone()),
         }
         if let Some(&index) = blocks.get(&i) {
-            let (Some(layer), Some(p)) = (print.layers.layers.get(index), plan.layers.get(index))
-            else {
+            let (Some(layer), Some(p)) = (layers.layers.get(index), plan.layers.get(index)) else {
                 continue;
             };
-            let lines = block(gcode, layer, p, &state, cfg, fallback_style)?;
+            let lines = block(gcode, layer, p, &state, params, fallback_style)?;
             stats.blocks += 1;
             stats.added_lines += lines.len() as isize;
             out.extend(lines.into_iter().map(new_line));
@@ -409,7 +407,7 @@ fn block(
     layer: &HostLayer,
     plan: &super::plan::LayerPlan,
     state: &State,
-    cfg: &Config,
+    params: &GcodeParams,
     fallback_style: Option<RetractionStyle>,
 ) -> Result<Vec<String>, PostprocessError> {
     let at = layer
@@ -425,24 +423,24 @@ fn block(
     };
     let tool = state.machine.tool();
     // The block retracts, heats and resumes the host's tool the way the host does.
-    let mut cfg = cfg.gcode_params();
+    let mut writer = params.clone();
     match layer.retraction.or(fallback_style) {
-        Some(RetractionStyle::Firmware) => cfg.printer.use_firmware_retraction = true,
+        Some(RetractionStyle::Firmware) => writer.printer.use_firmware_retraction = true,
         Some(RetractionStyle::Extruder { length, speed }) => {
-            cfg.printer.use_firmware_retraction = false;
-            cfg.printer.retract_speed = speed;
-            cfg.printer.deretract_speed = 0.0;
-            if let Some(t) = cfg.tools.get_mut(tool) {
+            writer.printer.use_firmware_retraction = false;
+            writer.printer.retract_speed = speed;
+            writer.printer.deretract_speed = 0.0;
+            if let Some(t) = writer.tools.get_mut(tool) {
                 t.retract_length = Some(length);
             }
         }
         None => {
-            if let Some(t) = cfg.tools.get_mut(tool) {
+            if let Some(t) = writer.tools.get_mut(tool) {
                 t.retract_length = Some(0.0);
             }
         }
     }
-    if let (Some(&temp), Some(t)) = (state.temps.get(&tool), cfg.tools.get_mut(tool)) {
+    if let (Some(&temp), Some(t)) = (state.temps.get(&tool), writer.tools.get_mut(tool)) {
         if temp > 0.0 {
             t.temperature = temp;
             t.first_layer_temperature = temp;
@@ -465,7 +463,7 @@ fn block(
         layer_z: layer.z,
     };
     let mut rec = Recorder::default();
-    write_block(&items, &cfg, &resume, &mut rec)?;
+    write_block(&items, &writer, &resume, &mut rec)?;
     let mark = if plan.traces.is_empty() {
         PARTS_MARK
     } else {
@@ -494,6 +492,8 @@ mod tests {
     use crate::circuit::ElectronicsReport;
     use crate::geom::{BoundingBox, ExPolygon, Point2, Polygon};
     use crate::postprocess::plan::LayerPlan;
+    use crate::postprocess::{LayerParams, detect_host, read_layers};
+    use crate::program::machine::{Printer, Tool};
 
     fn square(x0: f64, x1: f64) -> ExPolygon {
         ExPolygon {
@@ -513,9 +513,16 @@ mod tests {
             Ok(g) => g,
             Err(e) => panic!("{e}"),
         };
-        let (print, cfg) = match HostPrint::read(&g, Vec::new()) {
-            Ok(r) => r,
-            Err(e) => panic!("{e}"),
+        let host = detect_host(&g);
+        let layers = read_layers(
+            &g,
+            &host.markers,
+            &LayerParams::default().for_host(host.host),
+        );
+        let params = GcodeParams {
+            printer: Printer::default(),
+            tools: vec![Tool::filament(), Tool::paste()],
+            ..GcodeParams::default()
         };
         let plan = CircuitPlan {
             layers: vec![LayerPlan {
@@ -531,10 +538,11 @@ mod tests {
                 max: [0.0; 3],
             },
         };
-        let (edited, stats) = match rewrite(&g, &print, &plan, &cfg, |_| vec!["; summary".into()]) {
-            Ok(r) => r,
-            Err(e) => panic!("{e}"),
-        };
+        let (edited, stats) =
+            match rewrite(&g, &layers, &plan, &params, |_| vec!["; summary".into()]) {
+                Ok(r) => r,
+                Err(e) => panic!("{e}"),
+            };
         assert_eq!(stats.cut_moves, 1);
         edited
             .lines

@@ -23,11 +23,11 @@ use conduit_gcode::{Gcode, Line, LineEnding, Machine, Position};
 use super::cut::CutRegion;
 use super::plan::plan_circuit;
 use super::rewrite::{END_MARK, PARTS_MARK, SUMMARY_PREFIX, TRACES_MARK};
-use super::{HostPrint, HostSettings, LayerParams, PostprocessError, detect_host};
-use crate::check::{CheckParams, check};
+use super::{PostprocessError, PostprocessParams, detect_host, read_layers};
+use crate::check::check;
 use crate::circuit::Electronics;
-use crate::config::Config;
 use crate::geom::{Join, offset};
+use crate::program::machine::Flavor;
 
 /// How closely [`verify`] looks.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -92,9 +92,10 @@ impl VerifyReport {
     }
 }
 
-/// Checks `edited` against `original` for the circuit `electronics` built in with `config`
-/// (the config `conduit postprocess` used: the host's settings, or the `-c` file), with the
-/// default [`VerifyParams`]. See the [module docs](self) for what is checked.
+/// Checks `edited` against `original` for the circuit `electronics` built in with `params`
+/// (those of the config `conduit postprocess` used: the host's settings, or the `-c` file;
+/// `crate::config::Config::postprocess_params`), with the default [`VerifyParams`]. See the
+/// [module docs](self) for what is checked.
 ///
 /// # Errors
 /// The errors of [`plan_circuit`] when the circuit cannot be planned on the original.
@@ -102,13 +103,13 @@ pub fn verify(
     original: &Gcode,
     edited: &Gcode,
     electronics: &Electronics,
-    config: &Config,
+    params: &PostprocessParams,
 ) -> Result<VerifyReport, PostprocessError> {
     verify_with(
         original,
         edited,
         electronics,
-        config,
+        params,
         &VerifyParams::default(),
     )
 }
@@ -121,21 +122,21 @@ pub fn verify_with(
     original: &Gcode,
     edited: &Gcode,
     electronics: &Electronics,
-    config: &Config,
+    run: &PostprocessParams,
     params: &VerifyParams,
 ) -> Result<VerifyReport, PostprocessError> {
     let host = detect_host(original);
-    let settings = HostSettings::collect(original, host.host, Vec::new());
-    let layer_params = LayerParams::from_config(config).for_host(host.host);
-    let print = HostPrint::read_with(original, host, settings, &layer_params);
-    let plan = plan_circuit(&print, electronics, config)?;
+    let layer_params = run.layers.clone().for_host(host.host);
+    let layers = read_layers(original, &host.markers, &layer_params);
+    let plan = plan_circuit(&layers, electronics, &run.electronics)?;
+    let flavor = run.gcode.printer.flavor;
     let mut report = VerifyReport::default();
     let mut problems = Problems::new(params.max_listed);
-    let blocks = match_lines(original, edited, config, &mut report, &mut problems);
+    let blocks = match_lines(original, edited, flavor, &mut report, &mut problems);
 
     // Replay the edited file once; classify every move.
-    let conductive = config.route.conductive_tool;
-    let offset_of = |tool: usize| config.tools.get(tool).map_or([0.0, 0.0], |t| t.offset);
+    let conductive = run.electronics.conductive_tool;
+    let offset_of = |tool: usize| run.gcode.tools.get(tool).map_or([0.0, 0.0], |t| t.offset);
     let regions: Vec<Option<CutRegion>> = plan
         .layers
         .iter()
@@ -144,7 +145,7 @@ pub fn verify_with(
                 .then(|| CutRegion::new(&offset(&l.cuts, -params.tolerance, Join::Miter(2.0))))
         })
         .collect();
-    let mut machine = Machine::new(config.printer.flavor, 25.0);
+    let mut machine = Machine::new(flavor, 25.0);
     let mut block_points: Vec<[f64; 2]> = Vec::new();
     let mut host_top: f64 = f64::NEG_INFINITY;
     let mut events: Vec<(String, f64, usize)> = Vec::new();
@@ -258,7 +259,7 @@ pub fn verify_with(
     }
     report.events = events.into_iter().map(|(n, z, _)| (n, z)).collect();
 
-    let checked = check(edited, &CheckParams::from_config(config));
+    let checked = check(edited, &run.check);
     report.check_errors = checked.errors;
     for f in checked
         .findings
@@ -375,12 +376,12 @@ const LOOKAHEAD: usize = 256;
 fn match_lines(
     original: &Gcode,
     edited: &Gcode,
-    config: &Config,
+    flavor: Flavor,
     report: &mut VerifyReport,
     problems: &mut Problems,
 ) -> Vec<std::ops::Range<usize>> {
     let (orig, ed) = (&original.lines, &edited.lines);
-    let mut machine = Machine::new(config.printer.flavor, 25.0);
+    let mut machine = Machine::new(flavor, 25.0);
     let extruding: Vec<bool> = orig
         .iter()
         .map(|l| machine.step(l).is_some_and(|m| m.extruding))

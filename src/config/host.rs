@@ -1,9 +1,13 @@
 //! The host slicer's settings for the print being post-processed, so the user configures
-//! nothing twice.
+//! nothing twice, and the post-processing stages' parameters built from a config.
 //!
-//! Place in the pipeline: after [`super::host`], before [`super::layers`]: the settings give the
-//! firmware flavour and filament diameters the layer reconstruction needs, and the
-//! [`Config`] of later stages ([`HostSettings::to_config`]).
+//! Place in the pipeline: the configuration of post-processing (plugin mode). After the host is
+//! detected ([`crate::postprocess::detect_host`]), its settings are collected
+//! ([`HostSettings::collect`]) and turned into the run's [`Config`]
+//! ([`HostSettings::to_config`]); the walk (`crate::pipeline::postprocess`) builds the stages'
+//! parameters from that config (or the user's `-c` file): the layer reconstruction's
+//! ([`Config::host_layer_params`]: firmware flavour, filament diameters) and everything an edit
+//! and its check need ([`Config::postprocess_params`]).
 //!
 //! # Sources, later ones winning
 //!
@@ -28,9 +32,10 @@ use std::collections::BTreeMap;
 use conduit_gcode::Gcode;
 use serde::Serialize;
 
-use super::host::Host;
-use crate::config::prusa_ini::{from_prusa_pairs, pairs_from_gcode, unescape};
-use crate::config::{Config, ConfigError};
+use super::prusa_ini::{from_prusa_pairs, pairs_from_gcode, unescape};
+use super::{Config, ConfigError};
+use crate::check::CheckParams;
+use crate::postprocess::{Host, LayerParams, PostprocessParams};
 
 /// Where a setting's value came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
@@ -115,7 +120,8 @@ impl HostSettings {
     /// starting with `SLIC3R_` are skipped).
     ///
     /// ```
-    /// use conduit::postprocess::{Host, HostSettings, SettingSource};
+    /// use conduit::config::{HostSettings, SettingSource};
+    /// use conduit::postprocess::Host;
     /// let g = conduit_gcode::parse(b"G1 X1\n; layer_height = 0.3\n; perimeters = 3\n")?;
     /// let env = [("SLIC3R_LAYER_HEIGHT".to_owned(), "0.2".to_owned()),
     ///            ("HOME".to_owned(), "/root".to_owned())];
@@ -288,6 +294,32 @@ impl HostSettings {
                 .filter(|(k, _)| !ORCA_KEYS.iter().any(|(orca, _)| orca == k))
                 .map(|(k, v)| (k.clone(), v.value.clone())),
         )
+    }
+}
+
+impl Config {
+    /// The layer reconstruction's parameters: the firmware flavour, the tools' filament
+    /// diameters and the perimeter width. Give them the host's bead model with
+    /// [`LayerParams::for_host`].
+    pub fn host_layer_params(&self) -> LayerParams {
+        LayerParams::new(
+            self.printer.flavor,
+            &self.tools,
+            self.slice.region.perimeter_width,
+        )
+    }
+
+    /// Everything post-processing needs of this config: the layer reconstruction's parameters
+    /// ([`Config::host_layer_params`]), the electronics stage's ([`Config::electronics_params`]),
+    /// the G-code writer's for the inserted blocks ([`Config::gcode_params`]) and the checker's
+    /// for verifying an edited file.
+    pub fn postprocess_params(&self) -> PostprocessParams {
+        PostprocessParams {
+            layers: self.host_layer_params(),
+            electronics: self.electronics_params(),
+            gcode: self.gcode_params(),
+            check: CheckParams::from_config(self),
+        }
     }
 }
 
