@@ -8,7 +8,6 @@
 //! - `program/` (the model) names no stage;
 //! - `emit/` (the writers) names only `program` and `geom` (and format crates, which are not
 //!   `crate::` paths).
-//!
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
