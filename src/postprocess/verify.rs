@@ -21,7 +21,7 @@
 use conduit_gcode::{Gcode, Line, LineEnding, Machine, Position};
 
 use super::cut::CutRegion;
-use super::plan::plan_circuit;
+use super::plan::{CircuitPlan, plan_circuit};
 use super::rewrite::{END_MARK, PARTS_MARK, SUMMARY_PREFIX, TRACES_MARK};
 use super::{PostprocessError, PostprocessParams, detect_host, read_layers};
 use crate::check::check;
@@ -135,6 +135,51 @@ pub fn verify_with(
     let blocks = match_lines(original, edited, flavor, &mut report, &mut problems);
 
     // Replay the edited file once; classify every move.
+    let (block_points, events) = replay_edited(
+        edited,
+        &plan,
+        &blocks,
+        run,
+        params,
+        &mut report,
+        &mut problems,
+    );
+
+    // Traces: every planned point is a conductive move's end.
+    check_traces(
+        &plan,
+        &block_points,
+        run,
+        params,
+        &mut report,
+        &mut problems,
+    );
+
+    // Events: each part once, after its cavity is complete.
+    check_events(&plan, &events, &mut problems);
+    report.events = events.into_iter().map(|(n, z, _)| (n, z)).collect();
+
+    check_findings(edited, run, &mut report, &mut problems);
+    report.problems = problems.finish();
+    Ok(report)
+}
+
+/// A part's event seen while replaying: the part's name, the host's top z so far, the line number.
+type Event = (String, f64, usize);
+
+/// Replays the edited file once, classifying every move: counts conductive moves inside blocks
+/// (returning their ends, tool offsets undone), flags extrusion inside blocks and plastic inside
+/// the cuts, and collects the events with the host's top z at the time.
+fn replay_edited(
+    edited: &Gcode,
+    plan: &CircuitPlan,
+    blocks: &[std::ops::Range<usize>],
+    run: &PostprocessParams,
+    params: &VerifyParams,
+    report: &mut VerifyReport,
+    problems: &mut Problems,
+) -> (Vec<[f64; 2]>, Vec<Event>) {
+    let flavor = run.gcode.printer.flavor;
     let conductive = run.electronics.conductive_tool;
     let offset_of = |tool: usize| run.gcode.tools.get(tool).map_or([0.0, 0.0], |t| t.offset);
     let regions: Vec<Option<CutRegion>> = plan
@@ -148,7 +193,7 @@ pub fn verify_with(
     let mut machine = Machine::new(flavor, 25.0);
     let mut block_points: Vec<[f64; 2]> = Vec::new();
     let mut host_top: f64 = f64::NEG_INFINITY;
-    let mut events: Vec<(String, f64, usize)> = Vec::new();
+    let mut events: Vec<Event> = Vec::new();
     let mut in_block = blocks.iter().peekable();
     for (i, line) in edited.lines.iter().enumerate() {
         while in_block.peek().is_some_and(|b| b.end <= i) {
@@ -207,8 +252,19 @@ pub fn verify_with(
             );
         }
     }
+    (block_points, events)
+}
 
-    // Traces: every planned point is a conductive move's end.
+/// Checks that every point of every planned trace is the end of a conductive move in a block.
+fn check_traces(
+    plan: &CircuitPlan,
+    block_points: &[[f64; 2]],
+    run: &PostprocessParams,
+    params: &VerifyParams,
+    report: &mut VerifyReport,
+    problems: &mut Problems,
+) {
+    let conductive = run.electronics.conductive_tool;
     let tol2 = params.trace_tolerance * params.trace_tolerance;
     for (layer, p) in plan.layers.iter().enumerate() {
         for trace in &p.traces {
@@ -231,12 +287,13 @@ pub fn verify_with(
             }
         }
     }
+}
 
-    // Events: each part once, after its cavity is complete.
+/// Checks that every part's event appears once, after the host has reached its cavity's top.
+fn check_events(plan: &CircuitPlan, events: &[Event], problems: &mut Problems) {
     for part in &plan.parts {
         let top = part.position.z + part.body_height;
-        let found: Vec<&(String, f64, usize)> =
-            events.iter().filter(|(n, _, _)| *n == part.name).collect();
+        let found: Vec<&Event> = events.iter().filter(|(n, _, _)| *n == part.name).collect();
         match found.as_slice() {
             [] => problems.push("event", format!("no event places part {}", part.name)),
             [(_, printed, line)] => {
@@ -257,8 +314,15 @@ pub fn verify_with(
             ),
         }
     }
-    report.events = events.into_iter().map(|(n, z, _)| (n, z)).collect();
+}
 
+/// Runs `conduit check` on the edited file and lists its error-level findings.
+fn check_findings(
+    edited: &Gcode,
+    run: &PostprocessParams,
+    report: &mut VerifyReport,
+    problems: &mut Problems,
+) {
     let checked = check(edited, &run.check);
     report.check_errors = checked.errors;
     for f in checked
@@ -271,8 +335,6 @@ pub fn verify_with(
             format!("conduit check: line {}: {}", f.line, f.message),
         );
     }
-    report.problems = problems.finish();
-    Ok(report)
 }
 
 /// Problems, at most `max` listed per kind.
