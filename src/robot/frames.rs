@@ -232,7 +232,17 @@ pub fn register_frames(
     }
     let n = a.len();
     let poses = n > 0 && a.iter().chain(b).all(|m| m.rotation.is_some());
-    let (kind, axis) = if poses {
+    let (kind, axis) = pair_kind(a, poses);
+    let groups = Groups::new(a, b, poses, axis, rule);
+    let rounds = groups.rounds(n)?;
+    Ok(frame_fit(a, b, poses, kind, axis, rule, rounds))
+}
+
+/// Whether the pairs are poses or points, and for poses the axis length (the spread of `a`
+/// about its centroid, at least [`MIN_AXIS_LENGTH`]).
+fn pair_kind(a: &[Measured], poses: bool) -> (PairKind, Option<f64>) {
+    if poses {
+        let n = a.len();
         let c = a
             .iter()
             .fold(Vector3::zeros(), |s, m| s + m.position.coords)
@@ -246,21 +256,51 @@ pub fn register_frames(
         (PairKind::Poses, Some(spread.max(MIN_AXIS_LENGTH)))
     } else {
         (PairKind::Points, None)
-    };
-    let strip = |m: &Measured| Measured {
-        rotation: if poses { m.rotation } else { None },
-        ..*m
-    };
-    let pa: Vec<Vec<Point3>> = a
-        .iter()
-        .map(|m| expand(&strip(m), axis.unwrap_or(0.0)))
-        .collect();
-    let pb: Vec<Vec<Point3>> = b
-        .iter()
-        .map(|m| expand(&strip(m), axis.unwrap_or(0.0)))
-        .collect();
+    }
+}
 
-    let fit = |used: &[bool]| -> Result<Isometry3<f64>, RegisterError> {
+/// The outcome of the fitting rounds: the transform, each pair's residual, which pairs were
+/// used, and the outlier threshold.
+struct Rounds {
+    g: Isometry3<f64>,
+    r: Vec<f64>,
+    used: Vec<bool>,
+    tau: f64,
+}
+
+/// Every pair expanded into its point group in both frames, with the outlier rule.
+struct Groups {
+    pa: Vec<Vec<Point3>>,
+    pb: Vec<Vec<Point3>>,
+    rule: OutlierRule,
+}
+
+impl Groups {
+    /// Expands every measurement into its points (rotations kept only for poses).
+    fn new(
+        a: &[Measured],
+        b: &[Measured],
+        poses: bool,
+        axis: Option<f64>,
+        rule: OutlierRule,
+    ) -> Self {
+        let strip = |m: &Measured| Measured {
+            rotation: if poses { m.rotation } else { None },
+            ..*m
+        };
+        let pa: Vec<Vec<Point3>> = a
+            .iter()
+            .map(|m| expand(&strip(m), axis.unwrap_or(0.0)))
+            .collect();
+        let pb: Vec<Vec<Point3>> = b
+            .iter()
+            .map(|m| expand(&strip(m), axis.unwrap_or(0.0)))
+            .collect();
+        Self { pa, pb, rule }
+    }
+
+    /// The least-squares transform over the used pairs.
+    fn fit(&self, used: &[bool]) -> Result<Isometry3<f64>, RegisterError> {
         let pick = |p: &[Vec<Point3>]| -> Vec<Point3> {
             p.iter()
                 .zip(used)
@@ -268,11 +308,14 @@ pub fn register_frames(
                 .flat_map(|(g, _)| g.iter().copied())
                 .collect()
         };
-        Ok(least_squares(&pick(&pa), &pick(&pb))?.transform)
-    };
-    let residuals = |g: &Isometry3<f64>| -> Vec<f64> {
-        pa.iter()
-            .zip(&pb)
+        Ok(least_squares(&pick(&self.pa), &pick(&self.pb))?.transform)
+    }
+
+    /// Each pair's RMS distance between its transformed `a` points and its `b` points.
+    fn residuals(&self, g: &Isometry3<f64>) -> Vec<f64> {
+        self.pa
+            .iter()
+            .zip(&self.pb)
             .map(|(ga, gb)| {
                 let ss: f64 = ga
                     .iter()
@@ -282,37 +325,59 @@ pub fn register_frames(
                 (ss / ga.len() as f64).sqrt()
             })
             .collect()
-    };
-    let threshold = |r: &[f64], used: &[bool]| match rule {
-        OutlierRule::Fixed(t) => t,
-        OutlierRule::Median => {
-            let kept: Vec<f64> = r
-                .iter()
-                .zip(used)
-                .filter(|(_, u)| **u)
-                .map(|(v, _)| *v)
-                .collect();
-            (MEDIAN_FACTOR * median(kept)).max(THRESHOLD_FLOOR)
-        }
-    };
-
-    let mut used = vec![true; n];
-    let mut g = fit(&used)?;
-    let mut r = residuals(&g);
-    let mut tau = threshold(&r, &used);
-    for _ in 1..MAX_ROUNDS {
-        let next: Vec<bool> = r.iter().map(|v| *v <= tau).collect();
-        if next == used {
-            break;
-        }
-        // Too few pairs left, or a degenerate set: keep the last fit.
-        let Ok(g2) = fit(&next) else { break };
-        used = next;
-        g = g2;
-        r = residuals(&g);
-        tau = threshold(&r, &used);
     }
 
+    /// The outlier threshold given the residuals and the pairs used.
+    fn threshold(&self, r: &[f64], used: &[bool]) -> f64 {
+        match self.rule {
+            OutlierRule::Fixed(t) => t,
+            OutlierRule::Median => {
+                let kept: Vec<f64> = r
+                    .iter()
+                    .zip(used)
+                    .filter(|(_, u)| **u)
+                    .map(|(v, _)| *v)
+                    .collect();
+                (MEDIAN_FACTOR * median(kept)).max(THRESHOLD_FLOOR)
+            }
+        }
+    }
+
+    /// Fits, drops the outliers and fits again until the used set is stable (at most
+    /// [`MAX_ROUNDS`] rounds).
+    fn rounds(&self, n: usize) -> Result<Rounds, RegisterError> {
+        let mut used = vec![true; n];
+        let mut g = self.fit(&used)?;
+        let mut r = self.residuals(&g);
+        let mut tau = self.threshold(&r, &used);
+        for _ in 1..MAX_ROUNDS {
+            let next: Vec<bool> = r.iter().map(|v| *v <= tau).collect();
+            if next == used {
+                break;
+            }
+            // Too few pairs left, or a degenerate set: keep the last fit.
+            let Ok(g2) = self.fit(&next) else { break };
+            used = next;
+            g = g2;
+            r = self.residuals(&g);
+            tau = self.threshold(&r, &used);
+        }
+        Ok(Rounds { g, r, used, tau })
+    }
+}
+
+/// The report of a fit: the transform in its forms, each pair's residuals, the RMS.
+fn frame_fit(
+    a: &[Measured],
+    b: &[Measured],
+    poses: bool,
+    kind: PairKind,
+    axis: Option<f64>,
+    rule: OutlierRule,
+    rounds: Rounds,
+) -> FrameFit {
+    let Rounds { g, r, used, tau } = rounds;
+    let n = a.len();
     let rot = g.rotation;
     let q = if rot.w < 0.0 {
         -rot.into_inner()
@@ -349,7 +414,7 @@ pub fn register_frames(
         .map(|(v, _)| v * v)
         .collect();
     let rms = (kept.iter().sum::<f64>() / kept.len().max(1) as f64).sqrt();
-    Ok(FrameFit {
+    FrameFit {
         kind,
         pairs: n,
         used: kept.len(),
@@ -363,7 +428,7 @@ pub fn register_frames(
         threshold: tau,
         residuals: pairs,
         transform: g,
-    })
+    }
 }
 
 #[cfg(test)]
