@@ -78,23 +78,19 @@ fn unit(from: [f64; 2], to: [f64; 2]) -> [f64; 2] {
     }
 }
 
-/// Fillets and splits the corners of `points` for line width `width` (mm) by `rules`.
-pub fn fillet(points: &[[f64; 2]], closed: bool, width: f64, rules: &CornerRules) -> Filleted {
-    let pts = clean(points, closed);
+/// Per vertex: the corner angle, the rules' requirement, the wanted tangent length, and the
+/// factor that fits the tangent lengths to the segments they share.
+struct Wanted {
+    angle: Vec<f64>,
+    req: Vec<Requirement>,
+    t_want: Vec<f64>,
+    factor: Vec<f64>,
+}
+
+/// Measures every corner, asks `rules` for its requirement, and fits the wanted tangent lengths
+/// to the segments they share.
+fn wanted(pts: &[[f64; 2]], closed: bool, width: f64, rules: &CornerRules) -> Wanted {
     let n = pts.len();
-    if n < 2 || (closed && n < 3) {
-        let segs = pts
-            .windows(2)
-            .map(|w| Seg::Line { a: w[0], b: w[1] })
-            .collect();
-        return Filleted {
-            chains: vec![Chain {
-                segs,
-                closed: false,
-            }],
-            corners: Vec::new(),
-        };
-    }
     let is_corner = |i: usize| closed || (i > 0 && i + 1 < n);
     let prev = |i: usize| (i + n - 1) % n;
     let next = |i: usize| (i + 1) % n;
@@ -125,6 +121,26 @@ pub fn fillet(points: &[[f64; 2]], closed: bool, width: f64, rules: &CornerRules
             factor[j] = factor[j].min(f);
         }
     }
+    Wanted {
+        angle,
+        req,
+        t_want,
+        factor,
+    }
+}
+
+/// Decides each corner's action and returns the corners with the tangent length and radius
+/// per vertex.
+fn corner_actions(
+    pts: &[[f64; 2]],
+    closed: bool,
+    angle: &[f64],
+    req: &[Requirement],
+    t_want: &[f64],
+    factor: &[f64],
+) -> (Vec<Corner>, Vec<f64>, Vec<f64>) {
+    let n = pts.len();
+    let is_corner = |i: usize| closed || (i > 0 && i + 1 < n);
     let mut corners = Vec::new();
     let mut t = vec![0.0; n];
     let mut radius = vec![0.0; n];
@@ -148,6 +164,36 @@ pub fn fillet(points: &[[f64; 2]], closed: bool, width: f64, rules: &CornerRules
             shrunk: action == CornerAction::Fillet && factor[i] < 1.0 - 1e-6,
         });
     }
+    (corners, t, radius)
+}
+
+/// Fillets and splits the corners of `points` for line width `width` (mm) by `rules`.
+pub fn fillet(points: &[[f64; 2]], closed: bool, width: f64, rules: &CornerRules) -> Filleted {
+    let pts = clean(points, closed);
+    let n = pts.len();
+    if n < 2 || (closed && n < 3) {
+        let segs = pts
+            .windows(2)
+            .map(|w| Seg::Line { a: w[0], b: w[1] })
+            .collect();
+        return Filleted {
+            chains: vec![Chain {
+                segs,
+                closed: false,
+            }],
+            corners: Vec::new(),
+        };
+    }
+    let is_corner = |i: usize| closed || (i > 0 && i + 1 < n);
+    let prev = |i: usize| (i + n - 1) % n;
+    let next = |i: usize| (i + 1) % n;
+    let Wanted {
+        angle,
+        req,
+        t_want,
+        factor,
+    } = wanted(&pts, closed, width, rules);
+    let (corners, t, radius) = corner_actions(&pts, closed, &angle, &req, &t_want, &factor);
     let split = |i: usize| is_corner(i) && req[i] == Requirement::Split;
     // Tangent points and arcs of each filleted vertex.
     let p_in = |i: usize| {
