@@ -50,6 +50,39 @@ fn points(pts: &[[f64; 2]]) -> String {
     s
 }
 
+/// Writes the layer's extrusions and travels, each kind in its own group.
+fn write_strokes(s: &mut String, preview: &Preview, layer: &super::LayerStrokes) {
+    let _ = writeln!(
+        s,
+        r#"<g class="extrusions" fill="none" stroke-linecap="round" stroke-linejoin="round">"#
+    );
+    for stroke in &layer.strokes {
+        if let StrokeKind::Extrusion { role, tool, width } = stroke.kind {
+            let _ = writeln!(
+                s,
+                r#"<polyline data-role="{}" data-tool="{tool}" stroke="{}" stroke-width="{}" points="{}"/>"#,
+                escape(&preview.roles[role]),
+                hex(preview.colour(role, tool)),
+                num(width),
+                points(&stroke.points)
+            );
+        }
+    }
+    let _ = writeln!(s, "</g>");
+    let _ = writeln!(
+        s,
+        r#"<g class="travels" fill="none" stroke="{}" stroke-width="{}" stroke-linecap="round" stroke-linejoin="round">"#,
+        hex(TRAVEL_COLOUR),
+        num(TRAVEL_WIDTH)
+    );
+    for stroke in &layer.strokes {
+        if stroke.kind == StrokeKind::Travel {
+            let _ = writeln!(s, r#"<polyline points="{}"/>"#, points(&stroke.points));
+        }
+    }
+    let _ = writeln!(s, "</g>");
+}
+
 /// The SVG of layer `index` (0-based) of `preview`.
 ///
 /// # Panics
@@ -100,35 +133,7 @@ pub fn layer(preview: &Preview, index: usize) -> String {
         num(w),
         num(vh)
     );
-    let _ = writeln!(
-        s,
-        r#"<g class="extrusions" fill="none" stroke-linecap="round" stroke-linejoin="round">"#
-    );
-    for stroke in &layer.strokes {
-        if let StrokeKind::Extrusion { role, tool, width } = stroke.kind {
-            let _ = writeln!(
-                s,
-                r#"<polyline data-role="{}" data-tool="{tool}" stroke="{}" stroke-width="{}" points="{}"/>"#,
-                escape(&preview.roles[role]),
-                hex(preview.colour(role, tool)),
-                num(width),
-                points(&stroke.points)
-            );
-        }
-    }
-    let _ = writeln!(s, "</g>");
-    let _ = writeln!(
-        s,
-        r#"<g class="travels" fill="none" stroke="{}" stroke-width="{}" stroke-linecap="round" stroke-linejoin="round">"#,
-        hex(TRAVEL_COLOUR),
-        num(TRAVEL_WIDTH)
-    );
-    for stroke in &layer.strokes {
-        if stroke.kind == StrokeKind::Travel {
-            let _ = writeln!(s, r#"<polyline points="{}"/>"#, points(&stroke.points));
-        }
-    }
-    let _ = writeln!(s, "</g>");
+    write_strokes(&mut s, preview, layer);
 
     // Legend.
     let top = -y0 + MARGIN;
