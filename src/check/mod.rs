@@ -63,20 +63,6 @@ mod time;
 
 pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves};
 
-/// [`Machine`] under the name the checker uses for it.
-pub type Replay = Machine;
-
-impl From<Flavor> for Firmware {
-    /// The firmware dialect of a printer's `flavor`.
-    fn from(flavor: Flavor) -> Self {
-        match flavor {
-            Flavor::Marlin => Firmware::Marlin,
-            Flavor::Klipper => Firmware::Klipper,
-            Flavor::RepRapFirmware => Firmware::RepRapFirmware,
-        }
-    }
-}
-
 use std::collections::BTreeMap;
 use std::fmt;
 

@@ -275,6 +275,17 @@ impl Default for Tool {
     }
 }
 
+impl From<Flavor> for conduit_gcode::Firmware {
+    /// The firmware dialect a G-code replay follows for a printer's `flavor`.
+    fn from(flavor: Flavor) -> Self {
+        match flavor {
+            Flavor::Marlin => conduit_gcode::Firmware::Marlin,
+            Flavor::Klipper => conduit_gcode::Firmware::Klipper,
+            Flavor::RepRapFirmware => conduit_gcode::Firmware::RepRapFirmware,
+        }
+    }
+}
+
 impl fmt::Display for Flavor {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
