@@ -49,3 +49,20 @@ impl GcodeParams {
         }
     }
 }
+
+#[cfg(test)]
+impl GcodeParams {
+    /// The default two-tool machine (a PLA extruder and a paste dispenser) with the `[slice]`
+    /// keys the default start G-code names (`layer_height`, `first_layer_height`, both 0.2).
+    pub(crate) fn for_tests() -> Self {
+        let mut template_keys = toml::Table::new();
+        template_keys.insert("layer_height".to_owned(), toml::Value::Float(0.2));
+        template_keys.insert("first_layer_height".to_owned(), toml::Value::Float(0.2));
+        Self {
+            printer: Printer::default(),
+            tools: vec![Tool::filament(), Tool::paste()],
+            template_keys,
+            ..Self::default()
+        }
+    }
+}

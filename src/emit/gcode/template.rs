@@ -131,24 +131,9 @@ fn scalar(v: &toml::Value) -> Option<String> {
 mod tests {
     use super::*;
 
-    use crate::program::machine::{Printer, Tool};
-
-    /// The default two-tool machine with the `[slice]` key `layer_height` = 0.2.
-    fn params() -> GcodeParams {
-        let mut template_keys = toml::Table::new();
-        template_keys.insert("layer_height".to_owned(), toml::Value::Float(0.2));
-        template_keys.insert("first_layer_height".to_owned(), toml::Value::Float(0.2));
-        GcodeParams {
-            printer: Printer::default(),
-            tools: vec![Tool::filament(), Tool::paste()],
-            template_keys,
-            ..GcodeParams::default()
-        }
-    }
-
     #[test]
     fn placeholders_are_filled_from_every_section() -> Result<(), UnknownPlaceholder> {
-        let cfg = params();
+        let cfg = GcodeParams::for_tests();
         let t = "M140 S{first_layer_bed_temperature}\nM104 T1 S{first_layer_temperature[1]}\n\
                  ; {name} {layer_height} [temperature] {bed_size[0]} {next_tool} [unknown] a[0]";
         let out = cfg.render_template(t, 0, &[("next_tool", "1".to_owned())])?;
@@ -166,7 +151,7 @@ mod tests {
 
     #[test]
     fn default_start_and_end_gcode_render() -> Result<(), UnknownPlaceholder> {
-        let cfg = params();
+        let cfg = GcodeParams::for_tests();
         let start = cfg.render_template(&cfg.printer.start_gcode, 0, &[])?;
         assert!(start.contains("M109 T0 S210"), "{start}");
         assert!(start.contains("M190 S60"), "{start}");

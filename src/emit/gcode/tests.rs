@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::geom::Point3;
-use crate::program::machine::{Flavor, Printer, Tool};
+use crate::program::machine::{Flavor, Tool};
 use crate::program::{Event, Layer, LayerItem, Role, Toolpath, e_per_mm};
 
 /// One replayed move.
@@ -103,22 +103,8 @@ fn one_layer_program() -> Program {
     }
 }
 
-/// The default two-tool machine (a PLA extruder and a paste dispenser), with the `[slice]`
-/// keys the default start G-code names.
-fn default_params() -> GcodeParams {
-    let mut template_keys = toml::Table::new();
-    template_keys.insert("first_layer_height".to_owned(), toml::Value::Float(0.2));
-    template_keys.insert("layer_height".to_owned(), toml::Value::Float(0.2));
-    GcodeParams {
-        printer: Printer::default(),
-        tools: vec![Tool::filament(), Tool::paste()],
-        template_keys,
-        ..GcodeParams::default()
-    }
-}
-
 fn test_config() -> GcodeParams {
-    let mut cfg = default_params();
+    let mut cfg = GcodeParams::for_tests();
     cfg.printer.retract_length = 0.8;
     cfg.printer.retract_before_travel = 2.0;
     cfg.printer.retract_lift = 0.4;
