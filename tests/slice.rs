@@ -9,7 +9,7 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use conduit::check::{CheckParams, FindingKind, check};
+use conduit::check::{FindingKind, check};
 use conduit::config::Config;
 use conduit::geom::Transform;
 use conduit::scene::{LoadOptions, MeshFormat, Scene, load_scene, save};
@@ -366,7 +366,7 @@ fn by_layer(moves: &[Move]) -> BTreeMap<i64, Vec<&Move>> {
 /// The library's checker on `text` with `config`'s printer.
 fn check_text(text: &str, config: &Config) -> conduit::check::CheckReport {
     let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
-    check(&g, &CheckParams::from_config(config))
+    check(&g, &config.check_params())
 }
 
 /// `conduit check --json FILE [-c CONFIG]`: exit code and the JSON report.
@@ -1258,7 +1258,7 @@ fn built_program_round_trips_through_the_writer() {
     use conduit::program::e_per_mm;
     use conduit::region::{RegionParams, make_regions};
     use conduit::slice::{SliceParams, layer_schedule};
-    use conduit::toolpaths::{ObjectLayers, ProgramParams, build_program};
+    use conduit::toolpaths::{ObjectLayers, build_program};
     let island = ExPolygon {
         contour: Polygon::new(vec![
             Point2::from_mm(100.0, 100.0),
@@ -1278,7 +1278,7 @@ fn built_program_round_trips_through_the_writer() {
     cfg.printer.retract_length = 0.8;
     cfg.printer.retract_before_travel = 2.0;
     cfg.printer.retract_lift = 0.4;
-    let program = build_program(&[obj], &ProgramParams::from_config(&Config::default()));
+    let program = build_program(&[obj], &Config::default().program_params());
     let mut out = Vec::new();
     let stats = conduit::emit::gcode::write_gcode(&program, &cfg.gcode_params(), &mut out)
         .expect("G-code written");

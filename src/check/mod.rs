@@ -3,7 +3,7 @@
 //!
 //! Place in the pipeline: the last station, after `emit` (or after any other slicer): it reads a
 //! parsed [`conduit_gcode::Gcode`] and a [`CheckParams`] (built from the config with
-//! [`CheckParams::from_config`]) and never reaches back into the pipeline. The test suites use it
+//! `Config::check_params`) and never reaches back into the pipeline. The test suites use it
 //! on conduit's own output, as PrusaSlicer's tests re-parse their G-code and check the machine
 //! state; the CLI exits 1 when [`CheckReport::has_errors`].
 //!
@@ -71,7 +71,7 @@ use serde::Serialize;
 use crate::program::machine::{Flavor, Printer, Tool, ToolKind};
 
 /// What the checker needs to know about the printer. Build it with
-/// [`CheckParams::from_config`]; [`Default`] is the default config's.
+/// `Config::check_params`; [`Default`] is the default config's.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CheckParams {
     /// Firmware dialect, for the `G90`/`G91` effect on E (see the module docs).

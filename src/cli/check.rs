@@ -2,14 +2,14 @@
 
 use super::{Failure, args::CheckArgs, config::resolve};
 use anyhow::Context;
-use conduit::check::{CheckParams, check};
+use conduit::check::check;
 
 pub(crate) fn run(args: CheckArgs) -> Result<(), Failure> {
     let cfg = resolve(&args.config)?;
     let bytes = std::fs::read(&args.file)
         .with_context(|| format!("{}: cannot read file", args.file.display()))?;
     let gcode = conduit_gcode::parse(&bytes).with_context(|| format!("{}", args.file.display()))?;
-    let report = check(&gcode, &CheckParams::from_config(&cfg));
+    let report = check(&gcode, &cfg.check_params());
     if args.json {
         println!(
             "{}",

@@ -34,7 +34,6 @@ use serde::Serialize;
 
 use super::prusa_ini::{from_prusa_pairs, pairs_from_gcode, unescape};
 use super::{Config, ConfigError};
-use crate::check::CheckParams;
 use crate::postprocess::{Host, LayerParams, PostprocessParams};
 
 /// Where a setting's value came from.
@@ -318,7 +317,7 @@ impl Config {
             layers: self.host_layer_params(),
             electronics: self.electronics_params(),
             gcode: self.gcode_params(),
-            check: CheckParams::from_config(self),
+            check: self.check_params(),
         }
     }
 }

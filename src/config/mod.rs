@@ -512,10 +512,54 @@ impl Config {
             curved: self.curved.clone(),
             region: self.slice.region.clone(),
             first_layer_height: self.slice.first_layer_height,
-            program: ProgramParams::from_config(self),
+            program: self.program_params(),
             bed_origin: self.printer.bed_origin,
             retract_before_travel: self.printer.retract_before_travel,
             tool_count: self.tools.len(),
+        }
+    }
+
+    /// The toolpaths stage's parameters: role speeds and the first-layer speed from `[slice]`
+    /// limited to `printer.max_print_speed`; paste tools print every path as [`Role::ConductiveTrace`] at `slice.conductive_speed`
+    /// (also on the first layer, if that is slower than `first_layer_speed`). Ordering and
+    /// start position take their defaults.
+    pub fn program_params(&self) -> ProgramParams {
+        let s = &self.slice;
+        let max = self.printer.max_print_speed;
+        let speeds = RoleSpeeds {
+            external_perimeter: s.external_perimeter_speed,
+            perimeter: s.perimeter_speed,
+            solid_infill: s.solid_infill_speed,
+            top_solid_infill: s.top_solid_infill_speed,
+            sparse_infill: s.infill_speed,
+            bridge: s.bridge_speed,
+            gap_fill: s.gap_fill_speed,
+            skirt: s.skirt_speed,
+            conductive: s.conductive_speed,
+        }
+        .clamped(max);
+        let tools = self
+            .tools
+            .iter()
+            .map(|t| {
+                let base = ToolPathParams {
+                    speeds,
+                    first_layer_speed: s.first_layer_speed.min(max),
+                    ..ToolPathParams::default()
+                };
+                match t.kind {
+                    ToolKind::Filament => base,
+                    ToolKind::Paste => ToolPathParams {
+                        role: Some(Role::ConductiveTrace),
+                        first_layer_speed: base.first_layer_speed.min(speeds.conductive),
+                        ..base
+                    },
+                }
+            })
+            .collect();
+        ProgramParams {
+            tools,
+            ..ProgramParams::default()
         }
     }
 
@@ -801,56 +845,3 @@ mod tools_table {
 
 #[cfg(test)]
 mod tests;
-
-impl CheckParams {
-    /// The replay checker's parameters for `config` ([`Config::check_params`]).
-    pub fn from_config(config: &Config) -> Self {
-        config.check_params()
-    }
-}
-
-impl ProgramParams {
-    /// Parameters from a run's configuration: role speeds and the first-layer speed from `[slice]` limited to `printer.max_print_speed`;
-    /// paste tools print every path as [`Role::ConductiveTrace`] at `slice.conductive_speed`
-    /// (also on the first layer, if that is slower than `first_layer_speed`). Ordering and
-    /// start position take their defaults.
-    pub fn from_config(cfg: &Config) -> Self {
-        let s = &cfg.slice;
-        let max = cfg.printer.max_print_speed;
-        let speeds = RoleSpeeds {
-            external_perimeter: s.external_perimeter_speed,
-            perimeter: s.perimeter_speed,
-            solid_infill: s.solid_infill_speed,
-            top_solid_infill: s.top_solid_infill_speed,
-            sparse_infill: s.infill_speed,
-            bridge: s.bridge_speed,
-            gap_fill: s.gap_fill_speed,
-            skirt: s.skirt_speed,
-            conductive: s.conductive_speed,
-        }
-        .clamped(max);
-        let tools = cfg
-            .tools
-            .iter()
-            .map(|t| {
-                let base = ToolPathParams {
-                    speeds,
-                    first_layer_speed: s.first_layer_speed.min(max),
-                    ..ToolPathParams::default()
-                };
-                match t.kind {
-                    ToolKind::Filament => base,
-                    ToolKind::Paste => ToolPathParams {
-                        role: Some(Role::ConductiveTrace),
-                        first_layer_speed: base.first_layer_speed.min(speeds.conductive),
-                        ..base
-                    },
-                }
-            })
-            .collect();
-        Self {
-            tools,
-            ..Self::default()
-        }
-    }
-}

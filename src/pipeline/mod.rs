@@ -22,7 +22,7 @@ use crate::program::{LayerExtras, Program};
 use crate::region::{RegionError, make_regions_with_heights};
 use crate::scene::{Scene, placed_meshes};
 use crate::slice::{LayerZ, SliceParams, SliceReport, slice_mesh};
-use crate::toolpaths::{ObjectLayers, ProgramParams, build_program_with};
+use crate::toolpaths::{ObjectLayers, build_program_with};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -439,7 +439,7 @@ pub fn slice_scene_with(
     laps.lap(Stage::Regions);
 
     progress(Stage::Program);
-    let mut program = build_program_with(&objects, &extras, &ProgramParams::from_config(cfg));
+    let mut program = build_program_with(&objects, &extras, &cfg.program_params());
     drop(objects);
     let curved = curved.map(|(inserts, report)| {
         crate::curved::insert_curved(&mut program, &inserts);
