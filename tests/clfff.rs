@@ -611,7 +611,7 @@ fn clfff_sandwich_of_a_thick_dish_has_skins_on_its_surfaces_and_a_planar_core_be
             .expect("report is JSON");
 
     let defaults = conduit::config::Config::default();
-    let h = defaults.slice.region.layer_height;
+    let h = defaults.slice.layer_height;
     let first_top = defaults.slice.first_layer_height;
     let filament = defaults.tools[0].filament_diameter;
     let (nb, nt) = (3usize, 3usize);

@@ -17,7 +17,7 @@ impl Config {
     pub fn electronics_params(&self) -> ElectronicsParams {
         let r = &self.route;
         ElectronicsParams {
-            route: r.router_params(self.slice.region.perimeter_width),
+            route: r.router_params(self.slice.perimeter_width),
             conductive_tool: r.conductive_tool,
             tool_count: self.tools.len(),
             conductive_height: r.conductive_height,

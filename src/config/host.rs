@@ -301,11 +301,7 @@ impl Config {
     /// diameters and the perimeter width. Give them the host's bead model with
     /// [`LayerParams::for_host`].
     pub fn host_layer_params(&self) -> LayerParams {
-        LayerParams::new(
-            self.printer.flavor,
-            &self.tools,
-            self.slice.region.perimeter_width,
-        )
+        LayerParams::new(self.printer.flavor, &self.tools, self.slice.perimeter_width)
     }
 
     /// Everything post-processing needs of this config: the layer reconstruction's parameters
@@ -418,8 +414,8 @@ mod tests {
         assert_eq!(s.count_from(SettingSource::Environment), 2);
         assert!(s.get("path").is_none());
         let (cfg, _warnings) = s.to_config()?;
-        assert_eq!(cfg.slice.region.layer_height, 0.2);
-        assert_eq!(cfg.slice.region.perimeters, 3);
+        assert_eq!(cfg.slice.layer_height, 0.2);
+        assert_eq!(cfg.slice.perimeters, 3);
         Ok(())
     }
 
@@ -441,7 +437,7 @@ mod tests {
         assert_eq!(s.temperatures(), vec![205.0]);
         assert!(s.get("speed_wall").is_none());
         let (cfg, _) = s.to_config()?;
-        assert!((cfg.slice.region.infill_density - 0.25).abs() < 1e-12);
+        assert!((cfg.slice.infill_density - 0.25).abs() < 1e-12);
         Ok(())
     }
 }

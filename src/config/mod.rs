@@ -69,7 +69,7 @@ use crate::program::Role;
 pub use crate::program::machine::{
     DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, PnpSettings, Printer, Tool, ToolKind,
 };
-use crate::region::RegionParams;
+use crate::region::{InfillPatternKind, RegionParams};
 use crate::toolpaths::{ProgramParams, RoleSpeeds, ToolPathParams};
 
 /// Everything a conduit run is configured with. See the [module docs](self) for the file format.
@@ -111,23 +111,69 @@ pub enum SolidPattern {
     Rectilinear,
 }
 
-/// Slicing settings (`[slice]`): the regions stage's parameters ([`RegionParams`], flattened
-/// into the same table) plus first-layer, solid-fill and speed settings.
-///
-/// Deserialising reads every key directly (not through `#[serde(flatten)]`, which would lose
-/// the line and key of a wrong value), so a new [`RegionParams`] field must also be added to
-/// the private `SliceSpec`; the defaults round-trip test fails until it is.
-#[derive(Debug, Clone, PartialEq, Serialize, schemars::JsonSchema)]
+/// Slicing settings (`[slice]`): perimeters, infill, widths and layer height (from which
+/// [`Config::region_params`] builds the regions stage's [`RegionParams`]), first-layer,
+/// solid-fill and speed settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
 pub struct SliceSettings {
-    /// Perimeters, infill, widths, layer height and nozzle diameter of the regions stage: the keys
-    /// `perimeters`, `external_perimeter_width`, `perimeter_width`, `infill_width`,
-    /// `solid_infill_width`, `top_solid_infill_width`, `first_layer_width`, `top_solid_layers`,
-    /// `bottom_solid_layers`, `infill_density`, `infill_pattern`, `infill_angle_deg`,
-    /// `infill_overlap`, `solid_infill_margin`, `solid_infill_below_area`, `gap_fill`,
-    /// `external_perimeters_first`, `skirt_loops`, `skirt_distance`, `nozzle_diameter`,
-    /// `layer_height` sit directly in `[slice]`.
-    #[serde(flatten)]
-    pub region: RegionParams,
+    /// Number of perimeter loops per island, the external one included. Default 2.
+    pub perimeters: usize,
+    /// Extrusion width of the external (outermost) loop, mm. Default 0.45.
+    pub external_perimeter_width: f64,
+    /// Extrusion width of the inner loops, mm. Default 0.45.
+    pub perimeter_width: f64,
+    /// Extrusion width of sparse infill lines, mm. Default 0.45.
+    pub infill_width: f64,
+    /// Extrusion width of solid (bottom and internal solid) infill lines, mm. Default 0.45.
+    pub solid_infill_width: f64,
+    /// Extrusion width of top solid infill lines (the visible upper surfaces), mm. Default 0.45.
+    pub top_solid_infill_width: f64,
+    /// Extrusion width of every extrusion on the first layer (loops, infill, gap fill, skirt),
+    /// mm; a wider first layer sticks better and evens out an uneven bed. Default 0.45.
+    pub first_layer_width: f64,
+    /// Number of solid layers under every upward-facing surface. Default 3.
+    pub top_solid_layers: usize,
+    /// Number of solid layers over every downward-facing surface (and at the bed). Default 3.
+    pub bottom_solid_layers: usize,
+    /// Density of sparse infill, 0 (none) to 1 (solid). Lines are `spacing / density` apart.
+    /// Default 0.2.
+    pub infill_density: f64,
+    /// Pattern of sparse infill. Default `rectilinear`.
+    pub infill_pattern: InfillPatternKind,
+    /// Base direction of infill lines, degrees counter-clockwise from +X. Default 45.
+    pub infill_angle_deg: f64,
+    /// How far infill reaches into the innermost perimeter, as a fraction of `perimeter_width`, so
+    /// the two bond. Default 0.25 (solid and sparse infill share it, as in PrusaSlicer).
+    pub infill_overlap: f64,
+    /// How far solid areas are grown into the neighbouring sparse area (mm) so they are anchored
+    /// on the infill around them. Internal solid zones are grown by the perimeter band width on
+    /// top of this, so they reach under the perimeters of a part standing on them (see
+    /// `region::skins`). Default 3, PrusaSlicer's `EXTERNAL_INFILL_MARGIN`: a top skin that
+    /// ends flush with the sparse infill below it sags into the gaps at its edge, and a bridge
+    /// needs its lines anchored well beyond the edge of the air it spans.
+    pub solid_infill_margin: f64,
+    /// Sparse areas smaller than this (mm²) are filled solid instead: in a small area sparse
+    /// lines are short, mostly turns and anchors, and add little stiffness, while a solid fill
+    /// is barely more material. Default 70 (PrusaSlicer's `solid_infill_below_area`); 0 = off.
+    pub solid_infill_below_area: f64,
+    /// Fill the strips left between perimeter loops that are too narrow for another loop with
+    /// variable-width centrelines ([`crate::region::gapfill`]), so thin walls and the corners of
+    /// the perimeter band are solid. Default true.
+    pub gap_fill: bool,
+    /// Print the external loop of each island first (better dimensional accuracy, worse
+    /// overhangs). Default false: inner loops first.
+    pub external_perimeters_first: bool,
+    /// Number of skirt loops around the first layer. Default 0 (no skirt).
+    pub skirt_loops: usize,
+    /// Clear gap between the first layer's islands and the inner edge of the skirt, mm. Default 6.
+    pub skirt_distance: f64,
+    /// Nozzle diameter, mm. Default 0.4. Used by [`RegionParams::validate`]: widths below it are
+    /// rejected.
+    pub nozzle_diameter: f64,
+    /// Layer height, mm, used in the spacing formula when no per-layer heights are given.
+    /// Default 0.2.
+    pub layer_height: f64,
     /// Height of the first layer, mm. Default 0.2.
     pub first_layer_height: f64,
     /// Pattern of top solid infill. Default `"rectilinear"`.
@@ -163,27 +209,65 @@ pub struct SliceSettings {
     pub object_tools: Vec<usize>,
 }
 
+/// Calls `$then!` with the names of the `[slice]` keys that are fields of [`RegionParams`]
+/// under the same name: the one list behind [`SliceSettings::default`] and
+/// [`Config::region_params`].
+macro_rules! with_region_keys {
+    ($then:ident) => {
+        $then!(
+            perimeters,
+            external_perimeter_width,
+            perimeter_width,
+            infill_width,
+            solid_infill_width,
+            top_solid_infill_width,
+            first_layer_width,
+            top_solid_layers,
+            bottom_solid_layers,
+            infill_density,
+            infill_pattern,
+            infill_angle_deg,
+            infill_overlap,
+            solid_infill_margin,
+            solid_infill_below_area,
+            gap_fill,
+            external_perimeters_first,
+            skirt_loops,
+            skirt_distance,
+            nozzle_diameter,
+            layer_height
+        )
+    };
+}
+
 impl Default for SliceSettings {
+    /// The regions stage's defaults ([`RegionParams::default`]) and conduit's for the rest.
     fn default() -> Self {
-        Self {
-            region: RegionParams::default(),
-            first_layer_height: 0.2,
-            top_fill_pattern: SolidPattern::Rectilinear,
-            bottom_fill_pattern: SolidPattern::Rectilinear,
-            support_material: false,
-            brim_width: 0.0,
-            perimeter_speed: 45.0,
-            external_perimeter_speed: 25.0,
-            infill_speed: 80.0,
-            solid_infill_speed: 40.0,
-            top_solid_infill_speed: 30.0,
-            bridge_speed: 60.0,
-            gap_fill_speed: 20.0,
-            first_layer_speed: 20.0,
-            skirt_speed: 30.0,
-            conductive_speed: 10.0,
-            object_tools: Vec::new(),
+        let region = RegionParams::default();
+        macro_rules! build {
+            ($($key:ident),+) => {
+                Self {
+                    $($key: region.$key,)+
+                    first_layer_height: 0.2,
+                    top_fill_pattern: SolidPattern::Rectilinear,
+                    bottom_fill_pattern: SolidPattern::Rectilinear,
+                    support_material: false,
+                    brim_width: 0.0,
+                    perimeter_speed: 45.0,
+                    external_perimeter_speed: 25.0,
+                    infill_speed: 80.0,
+                    solid_infill_speed: 40.0,
+                    top_solid_infill_speed: 30.0,
+                    bridge_speed: 60.0,
+                    gap_fill_speed: 20.0,
+                    first_layer_speed: 20.0,
+                    skirt_speed: 30.0,
+                    conductive_speed: 10.0,
+                    object_tools: Vec::new(),
+                }
+            };
         }
+        with_region_keys!(build)
     }
 }
 
@@ -234,13 +318,21 @@ pub enum ConfigError {
     /// The TOML is malformed, has an unknown key or a value of the wrong type.
     ///
     /// How to fix: compare with `conduit config --defaults`, which lists every key.
-    #[error("{}{}: {message}", file_label(path), line.map(|l| format!(":{l}")).unwrap_or_default())]
+    #[error(
+        "{}{}: {}{message}",
+        file_label(path),
+        line.map(|l| format!(":{l}")).unwrap_or_default(),
+        key.as_ref().map(|k| format!("{k}: ")).unwrap_or_default()
+    )]
     Toml {
         /// The file, if the TOML came from one.
         path: Option<PathBuf>,
         /// 1-based line of the problem, when known.
         line: Option<usize>,
-        /// What is wrong, naming the key.
+        /// The dotted key the problem is at (`slice.layer_height`, `tools.1`), when inside a
+        /// table; an unknown key is named in the message, under the table that holds it.
+        key: Option<String>,
+        /// What is wrong.
         message: String,
     },
     /// A `--set KEY=VALUE` could not be applied.
@@ -297,19 +389,64 @@ fn file_label(path: &Option<PathBuf>) -> String {
 }
 
 impl ConfigError {
-    fn from_toml(err: &toml::de::Error, src: Option<&str>, path: Option<&Path>) -> Self {
-        let line = match (err.span(), src) {
-            (Some(span), Some(src)) => {
-                Some(src[..span.start.min(src.len())].matches('\n').count() + 1)
-            }
-            _ => None,
-        };
+    /// The error of reading `src` (from the file `path`, if any) as a config: the line from the
+    /// TOML span, the key from the path serde was at.
+    fn from_toml(err: &KeyedTomlError, src: &str, path: Option<&Path>) -> Self {
+        let line = err
+            .error
+            .span()
+            .map(|span| src[..span.start.min(src.len())].matches('\n').count() + 1);
         Self::Toml {
             path: path.map(Path::to_path_buf),
             line,
-            message: err.message().trim().to_owned(),
+            key: err.key.clone(),
+            message: explain_unknown_key(err.error.message().trim()),
         }
     }
+}
+
+/// serde's "unknown field `x`, expected one of `a`, `b`, …" as "unknown key `x`", with the
+/// closest known key of that table when one is close enough to be a typo; other messages as
+/// they are.
+fn explain_unknown_key(message: &str) -> String {
+    let Some(rest) = message.strip_prefix("unknown field `") else {
+        return message.to_owned();
+    };
+    let Some((unknown, expected)) = rest.split_once('`') else {
+        return message.to_owned();
+    };
+    let closest = expected
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(|known| (strsim::damerau_levenshtein(unknown, known), known))
+        .min();
+    match closest {
+        // A typo changes a few letters; two thirds of a key changed is another word.
+        Some((distance, known)) if distance <= 2.max(unknown.len() / 3) => {
+            format!("unknown key `{unknown}`; did you mean `{known}`?")
+        }
+        _ => format!("unknown key `{unknown}` (`conduit config --defaults` lists every key)"),
+    }
+}
+
+/// A TOML error and the dotted key serde was reading when it happened.
+struct KeyedTomlError {
+    error: toml::de::Error,
+    key: Option<String>,
+}
+
+/// Deserialises a config from TOML, keeping the dotted key of an error.
+fn read_toml(src: &str) -> Result<Config, KeyedTomlError> {
+    let deserializer =
+        toml::Deserializer::parse(src).map_err(|error| KeyedTomlError { error, key: None })?;
+    serde_path_to_error::deserialize(deserializer).map_err(|e| {
+        let key = e.path().to_string();
+        KeyedTomlError {
+            key: (key != ".").then_some(key),
+            error: e.into_inner(),
+        }
+    })
 }
 
 /// Loads a config file by extension: `.toml` is a conduit config, `.ini` a PrusaSlicer profile
@@ -329,8 +466,8 @@ pub fn load(path: &Path) -> Result<(Config, Vec<String>), ConfigError> {
     match ext.as_deref() {
         Some("toml") => {
             let src = text()?;
-            let config = Config::from_toml_str(&src)
-                .map_err(|e| ConfigError::from_toml(&e, Some(&src), Some(path)))?;
+            let config =
+                read_toml(&src).map_err(|e| ConfigError::from_toml(&e, &src, Some(path)))?;
             let warnings = config.validate()?;
             Ok((config, warnings))
         }
@@ -369,8 +506,7 @@ impl Config {
     /// Parses and validates a conduit TOML config, with errors carrying the line. Returns the
     /// config and its warnings.
     pub fn parse(src: &str) -> Result<(Config, Vec<String>), ConfigError> {
-        let config =
-            Self::from_toml_str(src).map_err(|e| ConfigError::from_toml(&e, Some(src), None))?;
+        let config = read_toml(src).map_err(|e| ConfigError::from_toml(&e, src, None))?;
         let warnings = config.validate()?;
         Ok((config, warnings))
     }
@@ -410,8 +546,7 @@ impl Config {
             problems.push(format!("pnp.lift must be ≥ 0, got {}", self.pnp.lift));
         }
         problems.extend(
-            self.slice
-                .region
+            self.region_params()
                 .validate()
                 .into_iter()
                 .map(|e| format!("slice.{e}")),
@@ -454,10 +589,10 @@ impl Config {
             }
         }
         if let Some(t0) = self.tools.first() {
-            if (t0.nozzle_diameter - s.region.nozzle_diameter).abs() > 1e-9 {
+            if (t0.nozzle_diameter - s.nozzle_diameter).abs() > 1e-9 {
                 warnings.push(format!(
                     "slice.nozzle_diameter = {} differs from tools.0.nozzle_diameter = {}",
-                    s.region.nozzle_diameter, t0.nozzle_diameter
+                    s.nozzle_diameter, t0.nozzle_diameter
                 ));
             }
         }
@@ -506,11 +641,22 @@ impl Config {
         }
     }
 
+    /// The regions stage's parameters: the `[slice]` keys of the same names.
+    pub fn region_params(&self) -> RegionParams {
+        let s = &self.slice;
+        macro_rules! build {
+            ($($key:ident),+) => {
+                RegionParams { $($key: s.$key,)+ }
+            };
+        }
+        with_region_keys!(build)
+    }
+
     /// The curved stages' parameters: `[curved]` and the planar settings they print beside.
     pub fn curved_params(&self) -> CurvedParams {
         CurvedParams {
             curved: self.curved.clone(),
-            region: self.slice.region.clone(),
+            region: self.region_params(),
             first_layer_height: self.slice.first_layer_height,
             program: self.program_params(),
             bed_origin: self.printer.bed_origin,
@@ -644,7 +790,7 @@ impl Config {
         }
         let new: Config = tree
             .try_into()
-            .map_err(|e: toml::de::Error| set_err(e.message().trim().to_owned()))?;
+            .map_err(|e: toml::de::Error| set_err(explain_unknown_key(e.message().trim())))?;
         *self = new;
         Ok(())
     }
@@ -695,91 +841,6 @@ impl<'de> Deserialize<'de> for Tool {
             retract_length: s.retract_length.or(d.retract_length),
             travel_lift: s.travel_lift.or(d.travel_lift),
         })
-    }
-}
-
-/// Every key of `[slice]`, optional: what is left out keeps its default.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SliceSpec {
-    perimeters: Option<usize>,
-    external_perimeter_width: Option<f64>,
-    perimeter_width: Option<f64>,
-    infill_width: Option<f64>,
-    solid_infill_width: Option<f64>,
-    top_solid_infill_width: Option<f64>,
-    first_layer_width: Option<f64>,
-    top_solid_layers: Option<usize>,
-    bottom_solid_layers: Option<usize>,
-    infill_density: Option<f64>,
-    infill_pattern: Option<crate::region::InfillPatternKind>,
-    infill_angle_deg: Option<f64>,
-    infill_overlap: Option<f64>,
-    solid_infill_margin: Option<f64>,
-    solid_infill_below_area: Option<f64>,
-    gap_fill: Option<bool>,
-    external_perimeters_first: Option<bool>,
-    skirt_loops: Option<usize>,
-    skirt_distance: Option<f64>,
-    nozzle_diameter: Option<f64>,
-    layer_height: Option<f64>,
-    first_layer_height: Option<f64>,
-    top_fill_pattern: Option<SolidPattern>,
-    bottom_fill_pattern: Option<SolidPattern>,
-    support_material: Option<bool>,
-    brim_width: Option<f64>,
-    perimeter_speed: Option<f64>,
-    external_perimeter_speed: Option<f64>,
-    infill_speed: Option<f64>,
-    solid_infill_speed: Option<f64>,
-    top_solid_infill_speed: Option<f64>,
-    bridge_speed: Option<f64>,
-    gap_fill_speed: Option<f64>,
-    first_layer_speed: Option<f64>,
-    skirt_speed: Option<f64>,
-    conductive_speed: Option<f64>,
-    object_tools: Option<Vec<usize>>,
-}
-
-impl<'de> Deserialize<'de> for SliceSettings {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let s = SliceSpec::deserialize(deserializer)?;
-        let mut out = SliceSettings::default();
-        macro_rules! take {
-            ($target:ident: $($field:ident),+) => {
-                $(if let Some(v) = s.$field { out.$target.$field = v; })+
-            };
-        }
-        take!(region: perimeters, external_perimeter_width, perimeter_width, infill_width,
-            solid_infill_width, top_solid_infill_width, first_layer_width, top_solid_layers,
-            bottom_solid_layers, infill_density, infill_pattern, infill_angle_deg,
-            infill_overlap, solid_infill_margin, solid_infill_below_area, gap_fill,
-            external_perimeters_first, skirt_loops, skirt_distance, nozzle_diameter,
-            layer_height);
-        macro_rules! take_top {
-            ($($field:ident),+) => {
-                $(if let Some(v) = s.$field { out.$field = v; })+
-            };
-        }
-        take_top!(
-            first_layer_height,
-            top_fill_pattern,
-            bottom_fill_pattern,
-            support_material,
-            brim_width,
-            perimeter_speed,
-            external_perimeter_speed,
-            infill_speed,
-            solid_infill_speed,
-            top_solid_infill_speed,
-            bridge_speed,
-            gap_fill_speed,
-            first_layer_speed,
-            skirt_speed,
-            conductive_speed,
-            object_tools
-        );
-        Ok(out)
     }
 }
 

@@ -356,39 +356,30 @@ const RULES: &[(&str, Rule)] = &[
         Rule::Flag(|c| &mut c.printer.use_firmware_retraction),
     ),
     // Slicing.
-    (
-        "layer_height",
-        Rule::Num(|c| &mut c.slice.region.layer_height),
-    ),
+    ("layer_height", Rule::Num(|c| &mut c.slice.layer_height)),
     (
         "first_layer_height",
         Rule::Percent(
-            |c| c.slice.region.layer_height,
+            |c| c.slice.layer_height,
             |c| &mut c.slice.first_layer_height,
         ),
     ),
-    (
-        "perimeters",
-        Rule::Count(|c| &mut c.slice.region.perimeters),
-    ),
+    ("perimeters", Rule::Count(|c| &mut c.slice.perimeters)),
     (
         "top_solid_layers",
-        Rule::Count(|c| &mut c.slice.region.top_solid_layers),
+        Rule::Count(|c| &mut c.slice.top_solid_layers),
     ),
     (
         "bottom_solid_layers",
-        Rule::Count(|c| &mut c.slice.region.bottom_solid_layers),
+        Rule::Count(|c| &mut c.slice.bottom_solid_layers),
     ),
-    ("skirts", Rule::Count(|c| &mut c.slice.region.skirt_loops)),
+    ("skirts", Rule::Count(|c| &mut c.slice.skirt_loops)),
     ("fill_density", Rule::Custom(fill_density)),
     (
         "solid_infill_below_area",
-        Rule::Num(|c| &mut c.slice.region.solid_infill_below_area),
+        Rule::Num(|c| &mut c.slice.solid_infill_below_area),
     ),
-    (
-        "gap_fill_enabled",
-        Rule::Flag(|c| &mut c.slice.region.gap_fill),
-    ),
+    ("gap_fill_enabled", Rule::Flag(|c| &mut c.slice.gap_fill)),
     ("fill_pattern", Rule::Custom(fill_pattern)),
     (
         "top_fill_pattern",
@@ -406,23 +397,17 @@ const RULES: &[(&str, Rule)] = &[
         "bottom_infill_pattern",
         Rule::Solid(|c| &mut c.slice.bottom_fill_pattern),
     ),
-    (
-        "fill_angle",
-        Rule::Num(|c| &mut c.slice.region.infill_angle_deg),
-    ),
+    ("fill_angle", Rule::Num(|c| &mut c.slice.infill_angle_deg)),
     ("infill_overlap", Rule::Custom(infill_overlap)),
     (
         "external_perimeters_first",
-        Rule::Flag(|c| &mut c.slice.region.external_perimeters_first),
+        Rule::Flag(|c| &mut c.slice.external_perimeters_first),
     ),
     (
         "support_material",
         Rule::Flag(|c| &mut c.slice.support_material),
     ),
-    (
-        "skirt_distance",
-        Rule::Num(|c| &mut c.slice.region.skirt_distance),
-    ),
+    ("skirt_distance", Rule::Num(|c| &mut c.slice.skirt_distance)),
     ("brim_width", Rule::Num(|c| &mut c.slice.brim_width)),
     ("perimeter_generator", Rule::Custom(perimeter_generator)),
     // Widths (every role width is read with the generic one).
@@ -472,19 +457,19 @@ const RULES: &[(&str, Rule)] = &[
 /// Role widths: key, automatic width (× nozzle) and field. Read after `extrusion_width`.
 const WIDTHS: &[(&str, f64, Field<f64>)] = &[
     ("perimeter_extrusion_width", 1.125, |c| {
-        &mut c.slice.region.perimeter_width
+        &mut c.slice.perimeter_width
     }),
     ("external_perimeter_extrusion_width", 1.125, |c| {
-        &mut c.slice.region.external_perimeter_width
+        &mut c.slice.external_perimeter_width
     }),
     ("infill_extrusion_width", 1.125, |c| {
-        &mut c.slice.region.infill_width
+        &mut c.slice.infill_width
     }),
     ("solid_infill_extrusion_width", 1.125, |c| {
-        &mut c.slice.region.solid_infill_width
+        &mut c.slice.solid_infill_width
     }),
     ("top_infill_extrusion_width", 1.0, |c| {
-        &mut c.slice.region.top_solid_infill_width
+        &mut c.slice.top_solid_infill_width
     }),
 ];
 
@@ -627,7 +612,7 @@ fn read_tools(imp: &mut Import) -> Result<(), ConfigError> {
     let nozzle = tools[0].nozzle_diameter;
     imp.cfg.tools = tools;
     imp.cfg.tools.push(Tool::paste());
-    imp.cfg.slice.region.nozzle_diameter = nozzle;
+    imp.cfg.slice.nozzle_diameter = nozzle;
     Ok(())
 }
 
@@ -750,8 +735,7 @@ fn fill_density(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
                 .parse::<f64>()
                 .map(|v| if v > 1.0 { v / 100.0 } else { v }),
         };
-        imp.cfg.slice.region.infill_density =
-            d.map_err(|_| imp.p.err(key, "expected a percentage"))?;
+        imp.cfg.slice.infill_density = d.map_err(|_| imp.p.err(key, "expected a percentage"))?;
     }
     Ok(())
 }
@@ -760,7 +744,7 @@ fn fill_density(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
 /// warning.
 fn fill_pattern(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     if let Some(pat) = imp.p.raw(key).map(str::to_owned) {
-        imp.cfg.slice.region.infill_pattern = match pat.trim() {
+        imp.cfg.slice.infill_pattern = match pat.trim() {
             "rectilinear" => InfillPatternKind::Rectilinear,
             "grid" => InfillPatternKind::Grid,
             "triangles" => InfillPatternKind::Triangles,
@@ -778,10 +762,10 @@ fn fill_pattern(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
 /// `infill_overlap`: PrusaSlicer gives mm, or % of the perimeter extrusion width; conduit a
 /// fraction of it (the perimeter width as it stands before the widths are read).
 fn infill_overlap(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
-    let region = &mut imp.cfg.slice.region;
-    let perimeter_width_guess = region.perimeter_width;
+    let slice = &mut imp.cfg.slice;
+    let perimeter_width_guess = slice.perimeter_width;
     if let Some(v) = imp.p.abs_or_percent(key, perimeter_width_guess)? {
-        region.infill_overlap = v / perimeter_width_guess;
+        slice.infill_overlap = v / perimeter_width_guess;
     }
     Ok(())
 }
@@ -805,7 +789,7 @@ fn perimeter_generator(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
 fn extrusion_widths(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     let (p, cfg) = (&mut imp.p, &mut imp.cfg);
     // The first tool's nozzle, as `read_tools` set it.
-    let nozzle = cfg.slice.region.nozzle_diameter;
+    let nozzle = cfg.slice.nozzle_diameter;
     let generic = p.abs_or_percent(key, nozzle)?.filter(|w| *w > 0.0);
     for (role, auto, field) in WIDTHS {
         *field(cfg) = match p.abs_or_percent(role, nozzle)? {
@@ -813,10 +797,10 @@ fn extrusion_widths(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
             _ => generic.unwrap_or(auto * nozzle),
         };
     }
-    let region = &mut cfg.slice.region;
+    let slice = &mut cfg.slice;
     match p.abs_or_percent("first_layer_extrusion_width", nozzle)? {
-        Some(w) if w > 0.0 => region.first_layer_width = w,
-        _ => region.first_layer_width = region.perimeter_width,
+        Some(w) if w > 0.0 => slice.first_layer_width = w,
+        _ => slice.first_layer_width = slice.perimeter_width,
     }
     Ok(())
 }
@@ -899,29 +883,29 @@ mod tests {
         assert_eq!(p.max_height, 250.0);
         assert_eq!(p.flavor, Flavor::Marlin);
         assert_eq!(t.nozzle_diameter, 0.4);
-        assert_eq!(s.region.nozzle_diameter, 0.4);
+        assert_eq!(s.nozzle_diameter, 0.4);
         assert_eq!(t.filament_diameter, 1.75);
         assert_eq!(t.temperature, 210.0);
         assert_eq!(t.first_layer_temperature, 210.0);
         assert_eq!(p.bed_temperature, 60.0);
         assert_eq!(p.first_layer_bed_temperature, 60.0);
-        assert_eq!(s.region.layer_height, 0.2);
+        assert_eq!(s.layer_height, 0.2);
         assert_eq!(s.first_layer_height, 0.2);
-        assert_eq!(s.region.first_layer_width, 0.45);
-        assert_eq!(s.region.perimeter_width, 0.45);
-        assert_eq!(s.region.external_perimeter_width, 0.45);
-        assert_eq!(s.region.infill_width, 0.45);
-        assert_eq!(s.region.solid_infill_width, 0.45);
-        assert_eq!(s.region.top_solid_infill_width, 0.45);
-        assert_eq!(s.region.perimeters, 2);
-        assert_eq!(s.region.top_solid_layers, 3);
-        assert_eq!(s.region.bottom_solid_layers, 3);
-        assert!((s.region.infill_density - 0.2).abs() < 1e-12);
-        assert_eq!(s.region.infill_pattern, InfillPatternKind::Rectilinear);
+        assert_eq!(s.first_layer_width, 0.45);
+        assert_eq!(s.perimeter_width, 0.45);
+        assert_eq!(s.external_perimeter_width, 0.45);
+        assert_eq!(s.infill_width, 0.45);
+        assert_eq!(s.solid_infill_width, 0.45);
+        assert_eq!(s.top_solid_infill_width, 0.45);
+        assert_eq!(s.perimeters, 2);
+        assert_eq!(s.top_solid_layers, 3);
+        assert_eq!(s.bottom_solid_layers, 3);
+        assert!((s.infill_density - 0.2).abs() < 1e-12);
+        assert_eq!(s.infill_pattern, InfillPatternKind::Rectilinear);
         assert_eq!(s.top_fill_pattern, SolidPattern::Rectilinear);
         assert_eq!(s.bottom_fill_pattern, SolidPattern::Rectilinear);
         assert!(!s.support_material);
-        assert_eq!(s.region.skirt_loops, 0);
+        assert_eq!(s.skirt_loops, 0);
         assert_eq!(s.brim_width, 0.0);
         // One filament extruder from the profile, plus conduit's paste tool.
         assert_eq!(cfg.tools.len(), 2);
@@ -986,15 +970,15 @@ gcode_comments = 0
         assert_eq!(cfg.tools[0].retract_length, None);
         assert_eq!(cfg.printer.retract_length, 0.8);
         let s = &cfg.slice;
-        assert!((s.region.perimeter_width - 0.72).abs() < 1e-12);
-        assert!((s.region.external_perimeter_width - 0.675).abs() < 1e-12);
-        assert!((s.region.top_solid_infill_width - 0.6).abs() < 1e-12);
-        assert_eq!(s.region.first_layer_width, s.region.perimeter_width);
+        assert!((s.perimeter_width - 0.72).abs() < 1e-12);
+        assert!((s.external_perimeter_width - 0.675).abs() < 1e-12);
+        assert!((s.top_solid_infill_width - 0.6).abs() < 1e-12);
+        assert_eq!(s.first_layer_width, s.perimeter_width);
         assert_eq!(s.external_perimeter_speed, 30.0);
         assert_eq!(s.solid_infill_speed, 40.0);
         assert_eq!(s.top_solid_infill_speed, 20.0);
         assert_eq!(s.first_layer_speed, 30.0);
-        assert!((s.region.infill_density - 0.15).abs() < 1e-12);
+        assert!((s.infill_density - 0.15).abs() < 1e-12);
         assert_eq!(
             cfg.printer.start_gcode,
             "G28 ; home\nM109 S[first_layer_temperature]\n{if x}"
@@ -1029,10 +1013,10 @@ gcode_comments = 0
             let (cfg, warnings) = from_prusa_pairs(pairs)?;
             println!("{file}: {warnings:#?}");
             let s = &cfg.slice;
-            assert_eq!(s.region.layer_height, 0.2, "{file}");
-            assert_eq!(s.region.perimeters, 2);
-            assert_eq!(s.region.perimeter_width, 0.45);
-            assert!((s.region.infill_density - 0.2).abs() < 1e-12);
+            assert_eq!(s.layer_height, 0.2, "{file}");
+            assert_eq!(s.perimeters, 2);
+            assert_eq!(s.perimeter_width, 0.45);
+            assert!((s.infill_density - 0.2).abs() < 1e-12);
             assert_eq!(s.perimeter_speed, 60.0);
             assert_eq!(s.external_perimeter_speed, 30.0);
             assert_eq!(s.top_solid_infill_speed, 15.0);
@@ -1059,7 +1043,7 @@ gcode_comments = 0
             ("HOME".to_owned(), "/root".to_owned()),
         ];
         let (cfg, warnings) = from_slic3r_env(env)?;
-        assert_eq!(cfg.slice.region.layer_height, 0.3);
+        assert_eq!(cfg.slice.layer_height, 0.3);
         assert!((cfg.slice.first_layer_height - 0.45).abs() < 1e-12);
         assert!(warnings.is_empty(), "{warnings:?}");
         let err = from_ini_str("# c\n\nperimeters = two\n").err();

@@ -13,7 +13,7 @@ fn empty_file_is_the_default_two_tool_printer() -> Result<(), ConfigError> {
     assert_eq!(cfg.tools.len(), 2);
     assert_eq!(cfg.tools[0].kind, ToolKind::Filament);
     assert_eq!(cfg.tools[1].kind, ToolKind::Paste);
-    assert_eq!(cfg.slice.region.layer_height, 0.2);
+    assert_eq!(cfg.slice.layer_height, 0.2);
     assert_eq!(cfg.slice.perimeter_speed, 45.0);
     assert_eq!(cfg.printer.bed_size, [250.0, 250.0]);
     assert!(Config::default().validate()?.is_empty());
@@ -52,10 +52,10 @@ fn slice_keys_of_the_regions_stage_sit_in_the_slice_table() -> Result<(), Config
         "[slice]\nlayer_height = 0.3\nperimeters = 3\ninfill_pattern = \"grid\"\n\
          first_layer_height = 0.25\nconductive_speed = 8\nobject_tools = [0, 1]\n",
     )?;
-    assert_eq!(cfg.slice.region.layer_height, 0.3);
-    assert_eq!(cfg.slice.region.perimeters, 3);
+    assert_eq!(cfg.slice.layer_height, 0.3);
+    assert_eq!(cfg.slice.perimeters, 3);
     assert_eq!(
-        cfg.slice.region.infill_pattern,
+        cfg.slice.infill_pattern,
         crate::region::InfillPatternKind::Grid
     );
     assert_eq!(cfg.slice.first_layer_height, 0.25);
@@ -124,7 +124,7 @@ fn set_edits_any_key_by_dotted_path() -> Result<(), ConfigError> {
     cfg.apply_set("tools.0.standby_temperature=150")?;
     cfg.apply_set("tools.2.kind=paste")?;
     cfg.apply_set("printer.start_gcode=\"G28\"")?;
-    assert_eq!(cfg.slice.region.layer_height, 0.3);
+    assert_eq!(cfg.slice.layer_height, 0.3);
     assert_eq!(cfg.tools[1].temperature, 25.0);
     assert_eq!(cfg.printer.flavor, Flavor::Klipper);
     assert_eq!(cfg.printer.bed_size, [200.0, 210.5]);
@@ -174,12 +174,12 @@ fn load_picks_the_format_by_extension() -> Result<(), Box<dyn std::error::Error>
     let toml_path = dir.path().join("c.toml");
     std::fs::write(&toml_path, "[slice]\nlayer_height = 0.1\n")?;
     let (cfg, warnings) = load(&toml_path)?;
-    assert_eq!(cfg.slice.region.layer_height, 0.1);
+    assert_eq!(cfg.slice.layer_height, 0.1);
     assert!(warnings.is_empty());
     let ini_path = dir.path().join("p.ini");
     std::fs::write(&ini_path, "layer_height = 0.15\nbogus = 1\n")?;
     let (cfg, warnings) = load(&ini_path)?;
-    assert_eq!(cfg.slice.region.layer_height, 0.15);
+    assert_eq!(cfg.slice.layer_height, 0.15);
     assert_eq!(
         warnings,
         vec!["ignored PrusaSlicer settings (no conduit equivalent): bogus".to_owned()]
@@ -265,4 +265,54 @@ fn the_default_config_reads_host_layers_as_the_default_layer_params() {
     let params = cfg.postprocess_params();
     assert_eq!(params.electronics, cfg.electronics_params());
     assert_eq!(params.gcode, cfg.gcode_params());
+}
+
+#[test]
+fn slice_settings_round_trip_through_json_with_defaults_filled_in() -> Result<(), serde_json::Error>
+{
+    let s: SliceSettings = serde_json::from_str(r#"{"perimeters": 3, "infill_pattern": "grid"}"#)?;
+    assert_eq!(s.perimeters, 3);
+    assert_eq!(s.infill_pattern, crate::region::InfillPatternKind::Grid);
+    assert_eq!(s.skirt_distance, 6.0);
+    let back: SliceSettings = serde_json::from_str(&serde_json::to_string(&s)?)?;
+    assert_eq!(back, s);
+    assert!(serde_json::from_str::<SliceSettings>(r#"{"perimetres": 3}"#).is_err());
+    let region = Config {
+        slice: s,
+        ..Config::default()
+    }
+    .region_params();
+    assert_eq!(region.perimeters, 3);
+    assert_eq!(region.skirt_distance, 6.0);
+    Ok(())
+}
+
+#[test]
+fn errors_name_the_key_and_suggest_the_closest() {
+    let text = |src: &str| parse(src).err().map(|e| e.to_string()).unwrap_or_default();
+    assert_eq!(
+        text("[slice]\nlayer_height = \"x\"\n"),
+        "config:2: slice.layer_height: invalid type: string \"x\", expected f64"
+    );
+    assert_eq!(
+        text("[tools.1]\nnozzle_diameter = true\n"),
+        "config:2: tools.1.nozzle_diameter: invalid type: boolean `true`, expected f64"
+    );
+    assert_eq!(
+        text("[slice]\nlayerheight = 0.3\n"),
+        "config:2: slice.layerheight: unknown key `layerheight`; did you mean `layer_height`?"
+    );
+    assert!(
+        text("[slice]\nfoo = 1\n")
+            .ends_with("unknown key `foo` (`conduit config --defaults` lists every key)"),
+    );
+    let mut cfg = Config::default();
+    let err = cfg
+        .apply_set("curved.max_anlge=30")
+        .err()
+        .map(|e| e.to_string());
+    assert_eq!(
+        err.as_deref(),
+        Some("--set curved.max_anlge: unknown key `max_anlge`; did you mean `max_angle`?")
+    );
 }

@@ -255,7 +255,7 @@ fn front(
     laps.lap(Stage::Place);
 
     progress(Stage::Slice);
-    let params = SliceParams::new(cfg.slice.region.layer_height, cfg.slice.first_layer_height)?;
+    let params = SliceParams::new(cfg.slice.layer_height, cfg.slice.first_layer_height)?;
     let mut sliced: Vec<_> = meshes.iter().map(|m| slice_mesh(m, &params)).collect();
     // The meshes are not needed past slicing (unless curved tops follow their surface): keep
     // only what the report says about them.
@@ -423,7 +423,7 @@ pub fn slice_scene_with(
         }
         let heights: Vec<f64> = layers.iter().map(|l| l.z.height()).collect();
         let (zs, islands): (Vec<_>, Vec<_>) = layers.into_iter().map(|l| (l.z, l.islands)).unzip();
-        let regions = make_regions_with_heights(&islands, &heights, &cfg.slice.region)?;
+        let regions = make_regions_with_heights(&islands, &heights, &cfg.region_params())?;
         drop(islands);
         objects.push(ObjectLayers {
             tool,

@@ -36,67 +36,53 @@ pub enum InfillPatternKind {
 
 /// Parameters of perimeter, skin, infill and skirt generation. Lengths in millimetres.
 ///
-/// Defaults (what `RegionParams::default()` gives and what a config section may omit) are noted on
-/// each field; they are PrusaSlicer's for a 0.4 mm nozzle at 0.2 mm layers.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(default, deny_unknown_fields)]
+/// The config builds it from the `[slice]` keys of the same names, whose documentation gives
+/// each one's reasons and default. [`RegionParams::default`] gives PrusaSlicer's values for a
+/// 0.4 mm nozzle at 0.2 mm layers.
+#[derive(Debug, Clone, PartialEq)]
 pub struct RegionParams {
-    /// Number of perimeter loops per island, the external one included. Default 2.
+    /// Number of perimeter loops per island, the external one included.
     pub perimeters: usize,
-    /// Extrusion width of the external (outermost) loop, mm. Default 0.45.
+    /// Extrusion width of the external (outermost) loop, mm.
     pub external_perimeter_width: f64,
-    /// Extrusion width of the inner loops, mm. Default 0.45.
+    /// Extrusion width of the inner loops, mm.
     pub perimeter_width: f64,
-    /// Extrusion width of sparse infill lines, mm. Default 0.45.
+    /// Extrusion width of sparse infill lines, mm.
     pub infill_width: f64,
-    /// Extrusion width of solid (bottom and internal solid) infill lines, mm. Default 0.45.
+    /// Extrusion width of solid (bottom and internal solid) infill lines, mm.
     pub solid_infill_width: f64,
-    /// Extrusion width of top solid infill lines (the visible upper surfaces), mm. Default 0.45.
+    /// Extrusion width of top solid infill lines (the visible upper surfaces), mm.
     pub top_solid_infill_width: f64,
-    /// Extrusion width of every extrusion on the first layer (loops, infill, gap fill, skirt),
-    /// mm; a wider first layer sticks better and evens out an uneven bed. Default 0.45.
+    /// Extrusion width of every extrusion on the first layer, mm.
     pub first_layer_width: f64,
-    /// Number of solid layers under every upward-facing surface. Default 3.
+    /// Number of solid layers under every upward-facing surface.
     pub top_solid_layers: usize,
-    /// Number of solid layers over every downward-facing surface (and at the bed). Default 3.
+    /// Number of solid layers over every downward-facing surface (and at the bed).
     pub bottom_solid_layers: usize,
-    /// Density of sparse infill, 0 (none) to 1 (solid). Lines are `spacing / density` apart.
-    /// Default 0.2.
+    /// Density of sparse infill, 0 (none) to 1 (solid).
     pub infill_density: f64,
-    /// Pattern of sparse infill. Default `rectilinear`.
+    /// Pattern of sparse infill.
     pub infill_pattern: InfillPatternKind,
-    /// Base direction of infill lines, degrees counter-clockwise from +X. Default 45.
+    /// Base direction of infill lines, degrees counter-clockwise from +X.
     pub infill_angle_deg: f64,
-    /// How far infill reaches into the innermost perimeter, as a fraction of `perimeter_width`, so
-    /// the two bond. Default 0.25 (solid and sparse infill share it, as in PrusaSlicer).
+    /// How far infill reaches into the innermost perimeter, a fraction of `perimeter_width`.
     pub infill_overlap: f64,
-    /// How far solid areas are grown into the neighbouring sparse area (mm) so they are anchored
-    /// on the infill around them. Internal solid zones are grown by the perimeter band width on
-    /// top of this, so they reach under the perimeters of a part standing on them (see
-    /// `region::skins`). Default 3, PrusaSlicer's `EXTERNAL_INFILL_MARGIN`: a top skin that
-    /// ends flush with the sparse infill below it sags into the gaps at its edge, and a bridge
-    /// needs its lines anchored well beyond the edge of the air it spans.
+    /// How far solid areas are grown into the neighbouring sparse area, mm.
     pub solid_infill_margin: f64,
-    /// Sparse areas smaller than this (mm²) are filled solid instead: in a small area sparse
-    /// lines are short, mostly turns and anchors, and add little stiffness, while a solid fill
-    /// is barely more material. Default 70 (PrusaSlicer's `solid_infill_below_area`); 0 = off.
+    /// Sparse areas smaller than this (mm²) are filled solid instead; 0 = off.
     pub solid_infill_below_area: f64,
-    /// Fill the strips left between perimeter loops that are too narrow for another loop with
-    /// variable-width centrelines ([`crate::region::gapfill`]), so thin walls and the corners of
-    /// the perimeter band are solid. Default true.
+    /// Fill the strips between perimeter loops too narrow for another loop
+    /// ([`crate::region::gapfill`]).
     pub gap_fill: bool,
-    /// Print the external loop of each island first (better dimensional accuracy, worse
-    /// overhangs). Default false: inner loops first.
+    /// Print the external loop of each island first (better dimensional accuracy, worse overhangs).
     pub external_perimeters_first: bool,
-    /// Number of skirt loops around the first layer. Default 0 (no skirt).
+    /// Number of skirt loops around the first layer.
     pub skirt_loops: usize,
-    /// Clear gap between the first layer's islands and the inner edge of the skirt, mm. Default 6.
+    /// Clear gap between the first layer's islands and the inner edge of the skirt, mm.
     pub skirt_distance: f64,
-    /// Nozzle diameter, mm. Default 0.4. Used by [`RegionParams::validate`]: widths below it are
-    /// rejected.
+    /// Nozzle diameter, mm.
     pub nozzle_diameter: f64,
     /// Layer height, mm, used in the spacing formula when no per-layer heights are given.
-    /// Default 0.2.
     pub layer_height: f64,
 }
 
@@ -345,18 +331,5 @@ mod tests {
                 ..
             }
         ));
-    }
-
-    #[test]
-    fn params_round_trip_through_json_with_defaults_filled_in() -> Result<(), serde_json::Error> {
-        let p: RegionParams =
-            serde_json::from_str(r#"{"perimeters": 3, "infill_pattern": "grid"}"#)?;
-        assert_eq!(p.perimeters, 3);
-        assert_eq!(p.infill_pattern, InfillPatternKind::Grid);
-        assert_eq!(p.skirt_distance, 6.0);
-        let back: RegionParams = serde_json::from_str(&serde_json::to_string(&p)?)?;
-        assert_eq!(back, p);
-        assert!(serde_json::from_str::<RegionParams>(r#"{"perimetres": 3}"#).is_err());
-        Ok(())
     }
 }
