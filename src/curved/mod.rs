@@ -21,7 +21,8 @@
 //!
 //! The pipeline removes the planar areas ([`TopsPlan::removals`]) from the islands before the
 //! regions stage and appends each region's curved layers, lowest first, after the planar layer
-//! holding the region's highest point ([`insert_curved`]). Everything is sequential and
+//! holding the region's highest point (a [`CurvedInsert`] the walk hands to the toolpaths stage
+//! as a `program::LayerInsert`). Everything is sequential and
 //! ordered, so the output is deterministic.
 
 pub mod clfff;
@@ -35,10 +36,10 @@ pub use report::{CurvedLayerReport, CurvedReport, RegionReport, Rejection};
 pub use settings::{CurvedMode, CurvedParams, CurvedSettings};
 
 use crate::geom::{
-    ExPolygon, Join, Point2, Point3, Polygon, difference, intersection, offset, scaled, union,
+    ExPolygon, Join, Point2, Point3, Polygon, difference, intersection, offset, union,
 };
 use crate::mesh::Mesh;
-use crate::program::{Event, LayerItem, Program, Role, Toolpath};
+use crate::program::{Event, LayerItem, Role, Toolpath};
 use crate::region::infill::{InfillPattern, Rectilinear};
 use crate::region::make_perimeters;
 use crate::slice::LayerZ;
@@ -858,28 +859,4 @@ fn ring_bbox(ex: &ExPolygon) -> [f64; 4] {
         bb = [bb[0].min(x), bb[1].min(y), bb[2].max(x), bb[3].max(y)];
     }
     bb
-}
-
-/// Appends each insert's curved layers to the Program layer whose top is its `after_z`, with
-/// tool changes to its tool and back when the layer ended on another tool.
-pub fn insert_curved(program: &mut Program, inserts: &[CurvedInsert]) {
-    for ins in inserts {
-        let key = scaled(ins.after_z);
-        let Some(layer) = program.layers.iter_mut().find(|l| scaled(l.z) == key) else {
-            continue;
-        };
-        let last_tool = layer.paths().last().map(|p| p.tool);
-        let switch = last_tool.is_some_and(|t| t != ins.tool);
-        if switch {
-            layer
-                .items
-                .push(LayerItem::Event(Event::ToolChange { tool: ins.tool }));
-        }
-        layer.items.extend(ins.items.iter().cloned());
-        if let (true, Some(t)) = (switch, last_tool) {
-            layer
-                .items
-                .push(LayerItem::Event(Event::ToolChange { tool: t }));
-        }
-    }
 }

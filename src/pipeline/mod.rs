@@ -18,7 +18,7 @@ use crate::config::{Config, CurvedMode};
 use crate::emit::gcode::{GcodeStats, write_gcode};
 use crate::geom::{BoundingBox, ExPolygon, Transform, scaled};
 use crate::mesh::Mesh;
-use crate::program::{LayerExtras, Program};
+use crate::program::{LayerExtras, LayerInsert, Program};
 use crate::region::{RegionError, make_regions_with_heights};
 use crate::scene::{Scene, placed_meshes};
 use crate::slice::{LayerZ, SliceParams, SliceReport, slice_mesh};
@@ -406,8 +406,21 @@ pub fn slice_scene_with(
         cuts: _,
         meshes,
     } = front(scene, cfg, circuit, &mut progress, &mut laps)?;
-    let curved =
-        (cfg.curved.mode == CurvedMode::Tops).then(|| curved_tops(&mut sliced, &meshes, cfg));
+    let mut extras = extras;
+    let curved = (cfg.curved.mode == CurvedMode::Tops).then(|| {
+        let (inserts, report) = curved_tops(&mut sliced, &meshes, cfg);
+        for ins in inserts {
+            extras
+                .inserts_after
+                .entry(crate::geom::scaled(ins.after_z))
+                .or_default()
+                .push(LayerInsert {
+                    tool: ins.tool,
+                    items: ins.items,
+                });
+        }
+        report
+    });
 
     progress(Stage::Regions);
     let mut objects = Vec::with_capacity(sliced.len());
@@ -439,12 +452,8 @@ pub fn slice_scene_with(
     laps.lap(Stage::Regions);
 
     progress(Stage::Program);
-    let mut program = build_program_with(&objects, &extras, &cfg.program_params());
+    let program = build_program_with(&objects, &extras, &cfg.program_params());
     drop(objects);
-    let curved = curved.map(|(inserts, report)| {
-        crate::curved::insert_curved(&mut program, &inserts);
-        report
-    });
     laps.lap(Stage::Program);
 
     progress(Stage::Emit);

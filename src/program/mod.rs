@@ -16,4 +16,4 @@ pub mod machine;
 pub mod toolpath;
 
 pub use extrusion::{BeadShape, Feed, bead_area, e_per_mm, filament_area};
-pub use toolpath::{Event, Layer, LayerExtras, LayerItem, Program, Role, Toolpath};
+pub use toolpath::{Event, Layer, LayerExtras, LayerInsert, LayerItem, Program, Role, Toolpath};

@@ -280,8 +280,9 @@ impl Program {
     }
 }
 
-/// What a layer gets besides its objects' regions: the part events that come before it and
-/// the paths printed after them (conductive traces, drops), keyed by the layer's print height on
+/// What a layer gets besides its objects' regions, from the other stages: the part events that
+/// come before it, the paths printed after them (conductive traces, drops), the events after
+/// those, and whole inserts at its end (curved layers), keyed by the layer's print height on
 /// the nanometre grid (`scaled(z)`). Heights no object layer has are ignored.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LayerExtras {
@@ -293,6 +294,19 @@ pub struct LayerExtras {
     /// Events at the end of the layer, after its paths (e.g. placing a part that stands above
     /// the last layer).
     pub events_after: BTreeMap<i64, Vec<Event>>,
+    /// Item sequences appended at the very end of the layer, each printed with its own tool
+    /// (e.g. the curved layers of a region whose highest point this layer holds), in order.
+    pub inserts_after: BTreeMap<i64, Vec<LayerInsert>>,
+}
+
+/// A sequence of items a stage appends to a layer as it is (see [`LayerExtras::inserts_after`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayerInsert {
+    /// The tool printing the insert's paths: selected before them when another tool is active,
+    /// and the active tool selected again after them.
+    pub tool: usize,
+    /// Comments and toolpaths, in print order.
+    pub items: Vec<LayerItem>,
 }
 
 #[cfg(test)]

@@ -35,7 +35,7 @@ use std::collections::BTreeMap;
 use super::order::{Group, OrderParams, order_groups};
 use crate::geom::{Point2, Point3, Polygon, scaled, segment_distance2, unscaled};
 use crate::program::extrusion::BeadShape;
-use crate::program::{Event, Layer, LayerExtras, LayerItem, Program, Role, Toolpath};
+use crate::program::{Event, Layer, LayerExtras, LayerInsert, LayerItem, Program, Role, Toolpath};
 use crate::region::gapfill::split_by_width;
 use crate::region::{LayerRegions, SolidRole};
 use crate::slice::LayerZ;
@@ -468,6 +468,9 @@ pub fn build_program_with(
         if let Some(events) = extras.events_after.get(&z_key) {
             items.extend(events.iter().cloned().map(LayerItem::Event));
         }
+        for insert in extras.inserts_after.get(&z_key).into_iter().flatten() {
+            append_insert(&mut items, insert, current_tool);
+        }
         layers.push(Layer {
             index,
             z,
@@ -476,6 +479,20 @@ pub fn build_program_with(
         });
     }
     Program { layers }
+}
+
+/// Appends `insert` to a layer's items, between tool changes to its tool and back to `active`
+/// (the tool the layer ends on) when they differ. The builder's position and tool are left as
+/// they were: the next layer starts from the layer's planar end, with `active` selected.
+fn append_insert(items: &mut Vec<LayerItem>, insert: &LayerInsert, active: Option<usize>) {
+    let switch = active.filter(|&t| t != insert.tool);
+    if switch.is_some() {
+        items.push(LayerItem::Event(Event::ToolChange { tool: insert.tool }));
+    }
+    items.extend(insert.items.iter().cloned());
+    if let Some(tool) = switch {
+        items.push(LayerItem::Event(Event::ToolChange { tool }));
+    }
 }
 
 #[cfg(test)]
@@ -644,6 +661,53 @@ mod tests {
             .filter(|i| matches!(i, LayerItem::Event(Event::ToolChange { .. })))
             .count();
         assert_eq!(changes, 2);
+    }
+
+    #[test]
+    fn inserts_end_the_layer_between_tool_changes_and_leave_the_next_layer_as_it_was() {
+        let plastic = object(0, vec![square(0.0, 0.0, 20.0)], 3, &RegionParams::default());
+        let z1 = plastic.layers[1].0.top;
+        let curved = |tool: usize, y: f64| Toolpath {
+            points: vec![Point3::new(2.0, y, z1 + 0.1), Point3::new(18.0, y, z1 + 0.3)],
+            closed: false,
+            role: Role::TopSolidInfill,
+            tool,
+            width: 0.45,
+            height: 0.2,
+            speed: 20.0,
+            tool_axis: None,
+        };
+        let plain = build_program(std::slice::from_ref(&plastic), &ProgramParams::default());
+        let mut extras = LayerExtras::default();
+        extras.inserts_after.insert(
+            scaled(z1),
+            vec![
+                LayerInsert {
+                    tool: 0,
+                    items: vec![LayerItem::Path(curved(0, 5.0))],
+                },
+                LayerInsert {
+                    tool: 1,
+                    items: vec![LayerItem::Path(curved(1, 15.0))],
+                },
+            ],
+        );
+        let program = build_program_with(&[plastic], &extras, &ProgramParams::default());
+        let items = &program.layers[1].items;
+        let planar = plain.layers[1].items.len();
+        assert_eq!(items[..planar], plain.layers[1].items[..]);
+        assert_eq!(
+            items[planar..],
+            [
+                LayerItem::Path(curved(0, 5.0)),
+                LayerItem::Event(Event::ToolChange { tool: 1 }),
+                LayerItem::Path(curved(1, 15.0)),
+                LayerItem::Event(Event::ToolChange { tool: 0 }),
+            ]
+        );
+        // The layers around are untouched: the next starts where the planar layer ended.
+        assert_eq!(program.layers[0], plain.layers[0]);
+        assert_eq!(program.layers[2], plain.layers[2]);
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! The toolpaths stage: each layer's regions, and what the other stages add to a layer
-//! ([`LayerExtras`]: part events, conductive traces), become a [`Program`] — toolpaths with
+//! ([`LayerExtras`]: part events, conductive traces, curved layers), become a [`Program`] — toolpaths with
 //! roles, widths, heights and speeds in print order, with tool changes between tools.
 //!
 //! Place in the pipeline: slice → regions (→ electronics) → **toolpaths** → emit. It takes its
