@@ -392,7 +392,8 @@ fn simulated(job: &Job, spec: &str) -> Result<(), Failure> {
     write_table(output, &done.comments, &done.poses)?;
     write_program(job, &done.poses)?;
     if let Some(r) = &args.readings_out {
-        write_atomically(r, |f| f.write_all(sim.readings.as_bytes()))
+        let table = sim.readings_table().map_err(anyhow::Error::from)?;
+        write_atomically(r, |f| f.write_all(table.as_bytes()))
             .with_context(|| format!("{}: cannot write", r.display()))?;
     }
     if let Some(r) = &args.report {

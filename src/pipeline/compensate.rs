@@ -92,14 +92,30 @@ pub struct SimulatedReport {
     pub variation_um: Vec<f64>,
 }
 
-/// A simulation's outcome: the compensated path and, for `--readings-out`, the first pass's
-/// simulated readings as a table.
+/// A simulation's outcome: the compensated path and the first pass's simulated readings.
 #[derive(Debug, Clone)]
 pub struct Simulated {
     /// The compensated path and the report.
     pub path: Compensated<SimulatedReport>,
-    /// `index,s,reading` rows of the first pass, after a `#` line.
-    pub readings: String,
+    /// The first pass's readings: pose index, arc length along the path (mm), simulated gap
+    /// reading (mm).
+    pub first_readings: Vec<[f64; 3]>,
+}
+
+impl Simulated {
+    /// The first pass's readings as a gap table (`index,s,reading` rows after a `#` line), the
+    /// form `conduit compensate --gaps` reads.
+    pub fn readings_table(&self) -> Result<String, CompensateWalkError> {
+        let rows: Vec<Vec<f64>> = self.first_readings.iter().map(|r| r.to_vec()).collect();
+        let mut buf = Vec::new();
+        conduit_poses::write_table(&["index", "s", "reading"], &rows, 6, &mut buf)
+            .map_err(CompensateWalkError::Readings)?;
+        Ok([
+            "# simulated gap readings, mm".to_owned(),
+            String::from_utf8_lossy(&buf).into_owned(),
+        ]
+        .join("\n"))
+    }
 }
 
 /// Why a compensation walk failed.
@@ -200,20 +216,13 @@ pub fn simulated(
         variation_um: variation,
     };
     let s = path.arc_lengths();
-    let rows: Vec<Vec<f64>> = sim
+    let first_readings = sim
         .first_readings
         .iter()
+        .zip(s)
         .enumerate()
-        .map(|(i, r)| vec![i as f64, s[i], *r])
+        .map(|(i, (r, s))| [i as f64, s, *r])
         .collect();
-    let mut buf = Vec::new();
-    conduit_poses::write_table(&["index", "s", "reading"], &rows, 6, &mut buf)
-        .map_err(CompensateWalkError::Readings)?;
-    let readings = [
-        "# simulated gap readings, mm".to_owned(),
-        String::from_utf8_lossy(&buf).into_owned(),
-    ]
-    .join("\n");
     let mut comments = header.to_vec();
     comments.push(format!(
         "# compensated by conduit compensate: {passes} simulated pass(es) on {spec}, target {} mm",
@@ -225,7 +234,7 @@ pub fn simulated(
             poses: sim.poses,
             report,
         },
-        readings,
+        first_readings,
     })
 }
 

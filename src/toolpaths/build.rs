@@ -668,7 +668,10 @@ mod tests {
         let plastic = object(0, vec![square(0.0, 0.0, 20.0)], 3, &RegionParams::default());
         let z1 = plastic.layers[1].0.top;
         let curved = |tool: usize, y: f64| Toolpath {
-            points: vec![Point3::new(2.0, y, z1 + 0.1), Point3::new(18.0, y, z1 + 0.3)],
+            points: vec![
+                Point3::new(2.0, y, z1 + 0.1),
+                Point3::new(18.0, y, z1 + 0.3),
+            ],
             closed: false,
             role: Role::TopSolidInfill,
             tool,
