@@ -279,73 +279,13 @@ impl<'x> Parser<'x, '_, '_, '_> {
             self.slicestack_uses.push((at.clone(), sid));
         }
         if let Some(thumb) = Self::get(&attrs, Ns::None, "thumbnail") {
-            let target = opc::resolve_target(self.part(), thumb);
-            match target {
-                Some(t) if self.ar.exists(&t) => {
-                    if !self.thumbnail_targets.contains(&opc::key(&t)) {
-                        self.warn(format_args!(
-                            "object {id} thumbnail {thumb} is not the target of a thumbnail relationship"
-                        ));
-                    }
-                }
-                _ => self.warn(format_args!(
-                    "object {id} thumbnail {thumb} does not exist in the package"
-                )),
-            }
+            self.object_thumbnail(id, thumb);
         }
-        let mut content: Option<ObjectContent> = None;
-        if !empty {
-            let mut groups = MetaScope::default();
-            self.children(|p, e, empty| {
-                let ns = p.x.element_ns(&e);
-                match (ns, e.local_name().as_ref()) {
-                    (Ns::Core, "mesh") => {
-                        if content.is_some() {
-                            return Err(p.rule(
-                                "object",
-                                "an object has one mesh or one components element",
-                            ));
-                        }
-                        p.attrs(&e)?;
-                        let mesh = if empty {
-                            Mesh::default()
-                        } else {
-                            p.mesh(id, kind, pid)?
-                        };
-                        content = Some(ObjectContent::Mesh(mesh));
-                        Ok(())
-                    }
-                    (Ns::Core, "components") => {
-                        if content.is_some() {
-                            return Err(p.rule(
-                                "object",
-                                "an object has one mesh or one components element",
-                            ));
-                        }
-                        p.attrs(&e)?;
-                        let comps = if empty { Vec::new() } else { p.components()? };
-                        content = Some(ObjectContent::Components(comps));
-                        Ok(())
-                    }
-                    (Ns::Core, "metadatagroup") => {
-                        if empty {
-                            return Ok(());
-                        }
-                        groups = MetaScope::default();
-                        p.children(|p, e, empty| {
-                            if p.x.element_ns(&e) == Ns::Core
-                                && e.local_name().as_ref() == "metadata"
-                            {
-                                p.metadata(&e, empty, &mut groups)
-                            } else {
-                                p.unknown(&e, empty)
-                            }
-                        })
-                    }
-                    _ => p.unknown(&e, empty),
-                }
-            })?;
-        }
+        let content = if empty {
+            None
+        } else {
+            self.object_content(id, kind, pid)?
+        };
         let content = content.unwrap_or(ObjectContent::Mesh(Mesh::default()));
         if let ObjectContent::Components(c) = &content
             && c.is_empty()
@@ -365,6 +305,82 @@ impl<'x> Parser<'x, '_, '_, '_> {
             content,
         });
         Ok(())
+    }
+
+    /// Warns when object `id`'s `thumbnail` is missing or not the target of a thumbnail
+    /// relationship.
+    fn object_thumbnail(&mut self, id: u32, thumb: &str) {
+        let target = opc::resolve_target(self.part(), thumb);
+        match target {
+            Some(t) if self.ar.exists(&t) => {
+                if !self.thumbnail_targets.contains(&opc::key(&t)) {
+                    self.warn(format_args!(
+                        "object {id} thumbnail {thumb} is not the target of a thumbnail relationship"
+                    ));
+                }
+            }
+            _ => self.warn(format_args!(
+                "object {id} thumbnail {thumb} does not exist in the package"
+            )),
+        }
+    }
+
+    /// Reads the children of object `id`: its one mesh or components element (`None` when it
+    /// has neither) and its metadata groups.
+    fn object_content(
+        &mut self,
+        id: u32,
+        kind: ObjectType,
+        pid: Option<u32>,
+    ) -> Result<Option<ObjectContent>, ThreeMfError> {
+        let mut content: Option<ObjectContent> = None;
+        let mut groups = MetaScope::default();
+        self.children(|p, e, empty| {
+            let ns = p.x.element_ns(&e);
+            match (ns, e.local_name().as_ref()) {
+                (Ns::Core, "mesh") => {
+                    if content.is_some() {
+                        return Err(
+                            p.rule("object", "an object has one mesh or one components element")
+                        );
+                    }
+                    p.attrs(&e)?;
+                    let mesh = if empty {
+                        Mesh::default()
+                    } else {
+                        p.mesh(id, kind, pid)?
+                    };
+                    content = Some(ObjectContent::Mesh(mesh));
+                    Ok(())
+                }
+                (Ns::Core, "components") => {
+                    if content.is_some() {
+                        return Err(
+                            p.rule("object", "an object has one mesh or one components element")
+                        );
+                    }
+                    p.attrs(&e)?;
+                    let comps = if empty { Vec::new() } else { p.components()? };
+                    content = Some(ObjectContent::Components(comps));
+                    Ok(())
+                }
+                (Ns::Core, "metadatagroup") => {
+                    if empty {
+                        return Ok(());
+                    }
+                    groups = MetaScope::default();
+                    p.children(|p, e, empty| {
+                        if p.x.element_ns(&e) == Ns::Core && e.local_name().as_ref() == "metadata" {
+                            p.metadata(&e, empty, &mut groups)
+                        } else {
+                            p.unknown(&e, empty)
+                        }
+                    })
+                }
+                _ => p.unknown(&e, empty),
+            }
+        })?;
+        Ok(content)
     }
 
     pub(super) fn mesh(
