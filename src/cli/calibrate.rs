@@ -174,7 +174,30 @@ struct RegisterReport<'a> {
 }
 
 fn run_register(args: RegisterArgs) -> Result<(), Failure> {
-    let rule = match args.outlier {
+    let rule = outlier_rule(args.outlier)?;
+    let (fa, fb) = (args.a.display().to_string(), args.b.display().to_string());
+    let a = frames::read_measured(&read(&args.a)?).map_err(|e| anyhow!("{fa}: {e}"))?;
+    let b = frames::read_measured(&read(&args.b)?).map_err(|e| anyhow!("{fb}: {e}"))?;
+    let f = frames::register_frames(&a, &b, rule).map_err(|e| anyhow!("{fa} and {fb}: {e}"))?;
+    print_transform(&fa, &fb, &f);
+    print_residuals(&f);
+    warn_outliers(&f);
+    if let Some(path) = &args.report {
+        write_report(
+            path,
+            &RegisterReport {
+                a: fa,
+                b: fb,
+                result: &f,
+            },
+        )?;
+    }
+    Ok(())
+}
+
+/// The outlier rule of `--outlier MM` (a positive distance), or the median rule.
+fn outlier_rule(outlier: Option<f64>) -> Result<OutlierRule, Failure> {
+    Ok(match outlier {
         Some(mm) if !(mm.is_finite() && mm > 0.0) => {
             return Err(Failure::Usage(format!(
                 "--outlier {mm}: expected a positive distance in mm"
@@ -182,12 +205,13 @@ fn run_register(args: RegisterArgs) -> Result<(), Failure> {
         }
         Some(mm) => OutlierRule::Fixed(mm),
         None => OutlierRule::Median,
-    };
-    let (fa, fb) = (args.a.display().to_string(), args.b.display().to_string());
-    let a = frames::read_measured(&read(&args.a)?).map_err(|e| anyhow!("{fa}: {e}"))?;
-    let b = frames::read_measured(&read(&args.b)?).map_err(|e| anyhow!("{fb}: {e}"))?;
-    let f = frames::register_frames(&a, &b, rule).map_err(|e| anyhow!("{fa} and {fb}: {e}"))?;
+    })
+}
 
+/// Prints the transform from frame A (file `fa`) to frame B (file `fb`): the pairs, the 4×4
+/// matrix, translation with quaternion and Euler angles, and the `[robot] workpiece_frame`
+/// line.
+fn print_transform(fa: &str, fb: &str, f: &FrameFit) {
     let kind = match f.kind {
         PairKind::Points => "point",
         PairKind::Poses => "pose",
@@ -226,6 +250,10 @@ fn run_register(args: RegisterArgs) -> Result<(), Failure> {
         list(&f.translation, 4, ", "),
         list(&[ec, eb, ea], 6, ", ")
     );
+}
+
+/// Prints the residuals: their rms and outlier threshold, then one row per pair.
+fn print_residuals(f: &FrameFit) {
     let rule = match f.rule {
         OutlierRule::Fixed(_) => "--outlier".to_owned(),
         OutlierRule::Median => format!(
@@ -262,6 +290,10 @@ fn run_register(args: RegisterArgs) -> Result<(), Failure> {
             if r.outlier { "\toutlier" } else { "" }
         );
     }
+}
+
+/// Warns about the outliers left out of the fit and those kept in it.
+fn warn_outliers(f: &FrameFit) {
     let named = |used: bool| -> Vec<String> {
         f.residuals
             .iter()
@@ -282,15 +314,4 @@ fn run_register(args: RegisterArgs) -> Result<(), Failure> {
             );
         }
     }
-    if let Some(path) = &args.report {
-        write_report(
-            path,
-            &RegisterReport {
-                a: fa,
-                b: fb,
-                result: &f,
-            },
-        )?;
-    }
-    Ok(())
 }

@@ -5,13 +5,13 @@
 
 use super::{Failure, args::ConformArgs, config::resolve};
 use anyhow::{Context, anyhow};
-use conduit::config::{Corrections, Mapping};
+use conduit::config::{Config, Corrections, Mapping};
 use conduit::conform::orient::{OrientParams, OrientationReport, ToolAxis};
 use conduit::conform::scan::load_scan;
 use conduit::conform::{ConformParams, ConformReport, Placement};
 use conduit::emit::robot::Dialect;
 use conduit::geom::Point3;
-use conduit::pipeline::conform::{self as walk, ConformJob, ConformWalkError, Refs};
+use conduit::pipeline::conform::{self as walk, ConformJob, ConformOutput, ConformWalkError, Refs};
 use conduit::scene::{Content, LoadOptions, load, write_atomically};
 use serde::Serialize;
 use std::io::Write;
@@ -24,59 +24,16 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         None => {}
     }
     let params = ConformParams::from_settings(&cfg.conform).context("invalid configuration")?;
-    let dialect_name = match &args.output_dialect {
-        Some(name) => {
-            eprintln!("warning: `--output {name}` is now spelled `--dialect {name}`");
-            name.clone()
-        }
-        None => args.dialect.clone(),
-    };
+    let dialect_name = dialect_name(&args);
     let dialect = Dialect::from_name(&dialect_name);
-    let axis = args
-        .tool_axis
-        .as_deref()
-        .map(ToolAxis::parse)
-        .transpose()
-        .map_err(|e| Failure::Usage(e.to_string()))?
-        .unwrap_or(ToolAxis::Vertical);
-    if dialect.is_none() && axis != ToolAxis::Vertical {
-        return Err(Failure::Usage(format!(
-            "--tool-axis {} tilts the tool, which 3-axis G-code cannot do: choose --dialect \
-             urscript, krl, rapid, poses-csv or gcode-5axis",
-            args.tool_axis.as_deref().unwrap_or_default()
-        )));
-    }
-    let orient = OrientParams::new(
-        axis,
-        args.max_tilt.unwrap_or(cfg.robot.max_tilt),
-        cfg.robot.axis_smoothing,
-    )
-    .map_err(|e| Failure::Usage(e.to_string()))?;
+    let orient = orientation(&args, &cfg, dialect)?;
     let place = args.place.as_deref().map(parse_place).transpose()?;
     let scan = load_scan(&args.surface, args.as_cloud, cfg.conform.fold_gap)
         .map_err(anyhow::Error::from)?;
     for w in &scan.warnings {
         eprintln!("warning: {}: {w}", args.surface.display());
     }
-    let machine = args
-        .refs_machine
-        .as_deref()
-        .map(|s| parse_points(s, "--refs-machine"))
-        .transpose()?;
-    let refs = match (&args.refs_scan, args.refs_auto, machine) {
-        (Some(scan), _, Some(machine)) => Refs::Points {
-            scan: parse_points(scan, "--refs-scan")?,
-            machine,
-        },
-        (None, true, Some(machine)) => Refs::Markers { machine },
-        (None, false, Some(_)) => {
-            return Err(Failure::Usage(
-                "--refs-machine needs --refs-scan (the same points in the scan) or --refs-auto"
-                    .to_owned(),
-            ));
-        }
-        _ => Refs::None,
-    };
+    let refs = refs(&args)?;
     let design = match load(&args.design, &LoadOptions::default())
         .map_err(anyhow::Error::from)?
         .content
@@ -101,52 +58,131 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
             .unwrap_or_default(),
     };
     let out = walk::run(job, &cfg, |_| {}).map_err(|e| located(e, &args))?;
+    write_outputs(&args, &out, dialect.is_some())?;
+    match out.moves {
+        Some(moves) => print_program_summary(&args, &dialect_name, &out, moves),
+        None => print_gcode_summary(&args, cfg.conform.corrections, &out.report),
+    }
+    warnings(&args, &out.report)
+}
+
+/// The output dialect's name: `--dialect`, or the old spelling `--output` (with a warning).
+fn dialect_name(args: &ConformArgs) -> String {
+    match &args.output_dialect {
+        Some(name) => {
+            eprintln!("warning: `--output {name}` is now spelled `--dialect {name}`");
+            name.clone()
+        }
+        None => args.dialect.clone(),
+    }
+}
+
+/// The tool axis options; a tilted axis needs a robot or five-axis `dialect`.
+fn orientation(
+    args: &ConformArgs,
+    cfg: &Config,
+    dialect: Option<Dialect>,
+) -> Result<OrientParams, Failure> {
+    let axis = args
+        .tool_axis
+        .as_deref()
+        .map(ToolAxis::parse)
+        .transpose()
+        .map_err(|e| Failure::Usage(e.to_string()))?
+        .unwrap_or(ToolAxis::Vertical);
+    if dialect.is_none() && axis != ToolAxis::Vertical {
+        return Err(Failure::Usage(format!(
+            "--tool-axis {} tilts the tool, which 3-axis G-code cannot do: choose --dialect \
+             urscript, krl, rapid, poses-csv or gcode-5axis",
+            args.tool_axis.as_deref().unwrap_or_default()
+        )));
+    }
+    OrientParams::new(
+        axis,
+        args.max_tilt.unwrap_or(cfg.robot.max_tilt),
+        cfg.robot.axis_smoothing,
+    )
+    .map_err(|e| Failure::Usage(e.to_string()))
+}
+
+/// How the scan is registered: `--refs-machine` with `--refs-scan` or `--refs-auto`, or not at
+/// all.
+fn refs(args: &ConformArgs) -> Result<Refs, Failure> {
+    let machine = args
+        .refs_machine
+        .as_deref()
+        .map(|s| parse_points(s, "--refs-machine"))
+        .transpose()?;
+    Ok(match (&args.refs_scan, args.refs_auto, machine) {
+        (Some(scan), _, Some(machine)) => Refs::Points {
+            scan: parse_points(scan, "--refs-scan")?,
+            machine,
+        },
+        (None, true, Some(machine)) => Refs::Markers { machine },
+        (None, false, Some(_)) => {
+            return Err(Failure::Usage(
+                "--refs-machine needs --refs-scan (the same points in the scan) or --refs-auto"
+                    .to_owned(),
+            ));
+        }
+        _ => Refs::None,
+    })
+}
+
+/// Writes the program and, when asked for, the JSON report.
+fn write_outputs(args: &ConformArgs, out: &ConformOutput, robot: bool) -> Result<(), Failure> {
     write_atomically(&args.out, |f| f.write_all(&out.program)).with_context(|| {
-        let what = if dialect.is_some() {
-            "the program"
-        } else {
-            "G-code"
-        };
+        let what = if robot { "the program" } else { "G-code" };
         format!("{}: cannot write {what}", args.out.display())
     })?;
-    let report = &out.report;
     if let Some(path) = &args.report {
         let full = FullReport {
-            conform: report,
+            conform: &out.report,
             orientation: &out.orientation,
         };
         let json = serde_json::to_vec_pretty(&full).context("serialising the report")?;
         write_atomically(path, |f| f.write_all(&json))
             .with_context(|| format!("{}: cannot write report", path.display()))?;
     }
-    if let Some(moves) = out.moves {
-        let o = &out.orientation;
-        eprintln!(
-            "{}: {} program, {} path(s), {} points, {moves} moves, {:.1} mm on the surface; tool \
-             axis {}: largest tilt {:.1}°, largest angle to the surface normal {:.1}°{}; {} \
-             nozzle contact(s)",
-            args.out.display(),
-            dialect_name,
-            report.paths,
-            report.points,
-            report.geometry.length_3d,
-            o.tool_axis,
-            o.max_tilt_deg,
-            o.max_normal_deviation_deg,
-            if o.limited > 0 {
-                format!(
-                    " ({} axes held at the {}° limit)",
-                    o.limited, o.max_tilt_limit_deg
-                )
-            } else {
-                String::new()
-            },
-            o.contacts
-        );
-        return warnings(&args, report);
-    }
+    Ok(())
+}
+
+/// The summary line of a robot or five-axis program of `moves` moves.
+fn print_program_summary(
+    args: &ConformArgs,
+    dialect_name: &str,
+    out: &ConformOutput,
+    moves: usize,
+) {
+    let (report, o) = (&out.report, &out.orientation);
+    eprintln!(
+        "{}: {} program, {} path(s), {} points, {moves} moves, {:.1} mm on the surface; tool \
+         axis {}: largest tilt {:.1}°, largest angle to the surface normal {:.1}°{}; {} \
+         nozzle contact(s)",
+        args.out.display(),
+        dialect_name,
+        report.paths,
+        report.points,
+        report.geometry.length_3d,
+        o.tool_axis,
+        o.max_tilt_deg,
+        o.max_normal_deviation_deg,
+        if o.limited > 0 {
+            format!(
+                " ({} axes held at the {}° limit)",
+                o.limited, o.max_tilt_limit_deg
+            )
+        } else {
+            String::new()
+        },
+        o.contacts
+    );
+}
+
+/// The summary line of a G-code run, with the deposit error of the `corrections` used and of
+/// the other modes on the same path.
+fn print_gcode_summary(args: &ConformArgs, corrections: Corrections, report: &ConformReport) {
     let replay = report.replay.as_ref().map_or(0, |r| r.printing + r.travel);
-    let corrections = cfg.conform.corrections;
     // The other modes on the same path, for comparison.
     let others: Vec<String> = Corrections::ALL
         .iter()
@@ -167,7 +203,6 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         others.join(", "),
         replay
     );
-    warnings(&args, report)
 }
 
 /// A walk error with the file names it concerns.

@@ -239,98 +239,14 @@ fn parse(
 ) -> Result<(Content, Vec<String>), LoadErrorKind> {
     let mut warnings = Vec::new();
     let content = match kind {
-        FileKind::Stl => {
-            let stl = conduit_stl::read(bytes)?;
-            let name = stl
-                .name
-                .clone()
-                .filter(|n| !n.is_empty())
-                .unwrap_or_else(|| stem(path));
-            let mesh = Mesh::from_triangle_soup(
-                name.clone(),
-                stl.triangles
-                    .iter()
-                    .map(|t| t.map(|v| Point3::new(v[0] as f64, v[1] as f64, v[2] as f64))),
-            );
-            let encoding = match stl.encoding {
-                conduit_stl::Encoding::Ascii => "ascii",
-                conduit_stl::Encoding::Binary => "binary",
-            };
-            Content::Mesh {
-                scene: Scene {
-                    objects: vec![object(name, mesh)],
-                },
-                details: MeshDetails::Stl {
-                    encoding,
-                    name: stl.name,
-                },
-            }
-        }
-        FileKind::ThreeMf => {
-            let package = conduit_3mf::read(bytes, &opts.threemf_limits)?;
-            let flat = package.flatten()?;
-            let root = package.root();
-            let objects = flat
-                .iter()
-                .map(|f| {
-                    let name = if f.name.is_empty() {
-                        format!("object {}", f.object_id)
-                    } else {
-                        f.name.clone()
-                    };
-                    object(name.clone(), indexed_mesh(&name, &f.vertices, &f.triangles))
-                })
-                .collect();
-            warnings.extend(package.warnings.iter().cloned());
-            let details = ThreeMfDetails {
-                unit: format!("{:?}", root.unit).to_lowercase(),
-                model_parts: package.models.len(),
-                objects: package.models.values().map(|m| m.objects.len()).sum(),
-                build_items: root.build.len(),
-                base_material_groups: root.base_materials.len(),
-                color_groups: root.color_groups.len(),
-                metadata: root
-                    .metadata
-                    .iter()
-                    .map(|m| (m.name.clone(), m.value.clone()))
-                    .collect(),
-                required_extensions: root.required_extensions.clone(),
-            };
-            Content::Mesh {
-                scene: Scene { objects },
-                details: MeshDetails::ThreeMf(details),
-            }
-        }
-        FileKind::Obj => {
-            let obj = conduit_obj::read(bytes, path.parent())?;
-            warnings.extend(obj.warnings);
-            let objects = obj
-                .objects
-                .iter()
-                .map(|o| {
-                    let name = if o.name.is_empty() {
-                        stem(path)
-                    } else {
-                        o.name.clone()
-                    };
-                    object(name.clone(), indexed_mesh(&name, &o.vertices, &o.triangles))
-                })
-                .collect();
-            Content::Mesh {
-                scene: Scene { objects },
-                details: MeshDetails::Obj,
-            }
-        }
+        FileKind::Stl => stl_content(path, bytes)?,
+        FileKind::ThreeMf => threemf_content(bytes, opts, &mut warnings)?,
+        FileKind::Obj => obj_content(path, bytes, &mut warnings)?,
         FileKind::Off => {
             let off = conduit_off::read(bytes)?;
             let name = stem(path);
             let mesh = indexed_mesh(&name, &off.vertices, &off.triangles);
-            Content::Mesh {
-                scene: Scene {
-                    objects: vec![object(name, mesh)],
-                },
-                details: MeshDetails::Off,
-            }
+            single_mesh(name, mesh, MeshDetails::Off)
         }
         FileKind::Ply => {
             let cloud = conduit_pointcloud::read_ply(bytes)?;
@@ -339,12 +255,7 @@ fn parse(
             } else {
                 let name = stem(path);
                 let mesh = indexed_mesh(&name, &cloud.points, &cloud.triangles);
-                Content::Mesh {
-                    scene: Scene {
-                        objects: vec![object(name, mesh)],
-                    },
-                    details: MeshDetails::Ply,
-                }
+                single_mesh(name, mesh, MeshDetails::Ply)
             }
         }
         FileKind::Xyz => Content::PointCloud(conduit_pointcloud::read_xyz(bytes)?),
@@ -353,6 +264,110 @@ fn parse(
         FileKind::Svg => Content::Design(conduit_svg::read(bytes, opts.svg_tolerance_mm)?),
     };
     Ok((content, warnings))
+}
+
+/// A mesh file's content of one object.
+fn single_mesh(name: String, mesh: Mesh, details: MeshDetails) -> Content {
+    Content::Mesh {
+        scene: Scene {
+            objects: vec![object(name, mesh)],
+        },
+        details,
+    }
+}
+
+/// An STL file: one object named after its solid, or after the file when the solid has none.
+fn stl_content(path: &Path, bytes: &[u8]) -> Result<Content, LoadErrorKind> {
+    let stl = conduit_stl::read(bytes)?;
+    let name = stl
+        .name
+        .clone()
+        .filter(|n| !n.is_empty())
+        .unwrap_or_else(|| stem(path));
+    let mesh = Mesh::from_triangle_soup(
+        name.clone(),
+        stl.triangles
+            .iter()
+            .map(|t| t.map(|v| Point3::new(v[0] as f64, v[1] as f64, v[2] as f64))),
+    );
+    let encoding = match stl.encoding {
+        conduit_stl::Encoding::Ascii => "ascii",
+        conduit_stl::Encoding::Binary => "binary",
+    };
+    let details = MeshDetails::Stl {
+        encoding,
+        name: stl.name,
+    };
+    Ok(single_mesh(name, mesh, details))
+}
+
+/// A 3MF package: one object per flattened build object (named `object <id>` when nameless);
+/// the reader's warnings are added to `warnings`.
+fn threemf_content(
+    bytes: &[u8],
+    opts: &LoadOptions,
+    warnings: &mut Vec<String>,
+) -> Result<Content, LoadErrorKind> {
+    let package = conduit_3mf::read(bytes, &opts.threemf_limits)?;
+    let flat = package.flatten()?;
+    let root = package.root();
+    let objects = flat
+        .iter()
+        .map(|f| {
+            let name = if f.name.is_empty() {
+                format!("object {}", f.object_id)
+            } else {
+                f.name.clone()
+            };
+            object(name.clone(), indexed_mesh(&name, &f.vertices, &f.triangles))
+        })
+        .collect();
+    warnings.extend(package.warnings.iter().cloned());
+    let details = ThreeMfDetails {
+        unit: format!("{:?}", root.unit).to_lowercase(),
+        model_parts: package.models.len(),
+        objects: package.models.values().map(|m| m.objects.len()).sum(),
+        build_items: root.build.len(),
+        base_material_groups: root.base_materials.len(),
+        color_groups: root.color_groups.len(),
+        metadata: root
+            .metadata
+            .iter()
+            .map(|m| (m.name.clone(), m.value.clone()))
+            .collect(),
+        required_extensions: root.required_extensions.clone(),
+    };
+    Ok(Content::Mesh {
+        scene: Scene { objects },
+        details: MeshDetails::ThreeMf(details),
+    })
+}
+
+/// An OBJ file: one object per model (nameless ones named after the file); the reader's
+/// warnings are added to `warnings`.
+fn obj_content(
+    path: &Path,
+    bytes: &[u8],
+    warnings: &mut Vec<String>,
+) -> Result<Content, LoadErrorKind> {
+    let obj = conduit_obj::read(bytes, path.parent())?;
+    warnings.extend(obj.warnings);
+    let objects = obj
+        .objects
+        .iter()
+        .map(|o| {
+            let name = if o.name.is_empty() {
+                stem(path)
+            } else {
+                o.name.clone()
+            };
+            object(name.clone(), indexed_mesh(&name, &o.vertices, &o.triangles))
+        })
+        .collect();
+    Ok(Content::Mesh {
+        scene: Scene { objects },
+        details: MeshDetails::Obj,
+    })
 }
 
 impl From<conduit_3mf::ThreeMfError> for LoadErrorKind {

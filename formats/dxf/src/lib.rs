@@ -265,13 +265,57 @@ pub fn read(bytes: &[u8], tolerance_mm: f64) -> Result<Design, DxfError> {
         return Err(DxfError::InvalidTolerance { tolerance_mm });
     }
     let pairs = pairs(bytes)?;
-    // Entities: spans from one `0` pair to the next, with the section they are in.
+    let (entities, units) = entities_and_units(&pairs)?;
+    let mm_per_unit = mm_per_unit(units)?;
+    let tol = tolerance_mm / mm_per_unit;
+    let mut design = Design {
+        mm_per_unit,
+        ..Design::default()
+    };
+    let mut k = 0;
+    while k < entities.len() {
+        let e = &entities[k];
+        k += 1;
+        let (entity, points, closed) = match e.kind {
+            "LINE" => line(e)?,
+            "CIRCLE" => circle(e, tol)?,
+            "ARC" => arc(e, tol)?,
+            "LWPOLYLINE" => lwpolyline(e, tol)?,
+            "POLYLINE" => polyline(e, &entities, &mut k, tol)?,
+            other => {
+                match design.skipped.iter_mut().find(|(n, _)| n == other) {
+                    Some((_, c)) => *c += 1,
+                    None => design.skipped.push((other.to_owned(), 1)),
+                }
+                continue;
+            }
+        };
+        let pts = in_millimetres(points, mm_per_unit, closed);
+        if pts.len() < 2 {
+            continue;
+        }
+        design.paths.push(DxfPath {
+            entity,
+            layer: e.text(8),
+            handle: e.text(5),
+            line: e.line,
+            points: pts,
+            closed,
+        });
+    }
+    Ok(design)
+}
+
+/// One entity flattened, in drawing units: its type name, points and whether it is closed.
+type Flattened = (&'static str, Vec<[f64; 2]>, bool);
+
+/// The entities of the `ENTITIES` section (spans from one `0` pair to the next) and the
+/// header's `$INSUNITS` code (0 when missing).
+fn entities_and_units(pairs: &[Pair]) -> Result<(Vec<Entity<'_>>, i64), DxfError> {
     let mut entities = Vec::new();
     let mut section = String::new();
-    let mut i = 0;
     let mut units = 0i64;
-    while i < pairs.len() {
-        let p = &pairs[i];
+    for (i, p) in pairs.iter().enumerate() {
         let end = pairs[i + 1..]
             .iter()
             .position(|q| q.code == 0)
@@ -303,9 +347,13 @@ pub fn read(bytes: &[u8], tolerance_mm: f64) -> Result<Design, DxfError> {
                 })?;
             }
         }
-        i += 1;
     }
-    let mm_per_unit = match units {
+    Ok((entities, units))
+}
+
+/// Millimetres per drawing unit of an `$INSUNITS` code.
+fn mm_per_unit(units: i64) -> Result<f64, DxfError> {
+    Ok(match units {
         0 | 4 => 1.0,
         1 => 25.4,
         2 => 304.8,
@@ -313,142 +361,137 @@ pub fn read(bytes: &[u8], tolerance_mm: f64) -> Result<Design, DxfError> {
         6 => 1000.0,
         13 => 0.001,
         code => return Err(DxfError::Units { code }),
-    };
-    let tol = tolerance_mm / mm_per_unit;
-    let mut design = Design {
-        mm_per_unit,
-        ..Design::default()
-    };
-    let mut k = 0;
-    while k < entities.len() {
-        let e = &entities[k];
-        k += 1;
-        let (entity, points, closed): (&'static str, Vec<[f64; 2]>, bool) = match e.kind {
-            "LINE" => {
-                let m = e.mirror()?;
-                let a = [m * e.need(10)?, e.need(20)?];
-                let b = [m * e.need(11)?, e.need(21)?];
-                ("LINE", vec![a, b], false)
-            }
-            "CIRCLE" => {
-                let m = e.mirror()?;
-                let (c, r) = ([m * e.need(10)?, e.need(20)?], e.need(40)?);
-                if r <= 0.0 {
-                    return Err(e.error(format!("radius must be > 0, got {r}")));
-                }
-                let mut pts = arc_points(c, r, 0.0, 2.0 * PI, tol);
-                pts.pop();
-                ("CIRCLE", pts, true)
-            }
-            "ARC" => {
-                let m = e.mirror()?;
-                let (c, r) = ([m * e.need(10)?, e.need(20)?], e.need(40)?);
-                if r <= 0.0 {
-                    return Err(e.error(format!("radius must be > 0, got {r}")));
-                }
-                let (a0, a1) = (e.need(50)?.to_radians(), e.need(51)?.to_radians());
-                let mut sweep = (a1 - a0).rem_euclid(2.0 * PI);
-                if sweep == 0.0 {
-                    sweep = 2.0 * PI;
-                }
-                // Mirrored: angles are measured in the mirrored plane, so the arc runs
-                // clockwise in XY from the mirrored start.
-                let pts = if m < 0.0 {
-                    arc_points(c, r, PI - a0, -sweep, tol)
-                } else {
-                    arc_points(c, r, a0, sweep, tol)
-                };
-                ("ARC", pts, false)
-            }
-            "LWPOLYLINE" => {
-                let m = e.mirror()?;
-                let flags = e.get(70)?.unwrap_or(0.0) as i64;
-                let mut verts: Vec<([f64; 2], f64)> = Vec::new();
-                let mut x: Option<f64> = None;
-                for p in e.groups {
-                    match p.code {
-                        10 => x = Some(m * e.num(p)?),
-                        20 => {
-                            let xv = x.take().ok_or_else(|| {
-                                e.error(format!("line {}: y (20) without x (10)", p.line))
-                            })?;
-                            verts.push(([xv, e.num(p)?], 0.0));
-                        }
-                        42 => {
-                            if let Some(v) = verts.last_mut() {
-                                v.1 = m * e.num(p)?;
-                            }
-                        }
-                        _ => {}
-                    }
-                }
-                let closed = flags & 1 == 1;
-                ("LWPOLYLINE", bulged(&verts, closed, tol), closed)
-            }
-            "POLYLINE" => {
-                let m = e.mirror()?;
-                let flags = e.get(70)?.unwrap_or(0.0) as i64;
-                if flags & (16 | 64) != 0 {
-                    return Err(e.error(
-                        "polygon meshes and polyface meshes are not 2D designs".to_owned(),
-                    ));
-                }
-                let mut verts = Vec::new();
-                loop {
-                    let Some(v) = entities.get(k) else {
-                        return Err(DxfError::Truncated {
-                            line: e.line,
-                            context: "a POLYLINE without SEQEND",
-                        });
-                    };
-                    k += 1;
-                    match v.kind {
-                        "VERTEX" => verts.push((
-                            [m * v.need(10)?, v.need(20)?],
-                            m * v.get(42)?.unwrap_or(0.0),
-                        )),
-                        "SEQEND" => break,
-                        other => {
-                            return Err(e.error(format!(
-                                "{other} inside the polyline (expected VERTEX or SEQEND)"
-                            )));
-                        }
-                    }
-                }
-                let closed = flags & 1 == 1;
-                ("POLYLINE", bulged(&verts, closed, tol), closed)
-            }
-            other => {
-                match design.skipped.iter_mut().find(|(n, _)| n == other) {
-                    Some((_, c)) => *c += 1,
-                    None => design.skipped.push((other.to_owned(), 1)),
-                }
-                continue;
-            }
-        };
-        let mut pts: Vec<[f64; 2]> = Vec::with_capacity(points.len());
-        for p in points {
-            let q = [p[0] * mm_per_unit, p[1] * mm_per_unit];
-            if pts.last() != Some(&q) {
-                pts.push(q);
-            }
-        }
-        if closed && pts.len() > 1 && pts.first() == pts.last() {
-            pts.pop();
-        }
-        if pts.len() < 2 {
-            continue;
-        }
-        design.paths.push(DxfPath {
-            entity,
-            layer: e.text(8),
-            handle: e.text(5),
-            line: e.line,
-            points: pts,
-            closed,
-        });
+    })
+}
+
+/// A `LINE`: its two ends.
+fn line(e: &Entity) -> Result<Flattened, DxfError> {
+    let m = e.mirror()?;
+    let a = [m * e.need(10)?, e.need(20)?];
+    let b = [m * e.need(11)?, e.need(21)?];
+    Ok(("LINE", vec![a, b], false))
+}
+
+/// The centre and radius of a `CIRCLE` or `ARC` (mirrored back into XY); the radius must be
+/// positive.
+fn centre_and_radius(e: &Entity, m: f64) -> Result<([f64; 2], f64), DxfError> {
+    let (c, r) = ([m * e.need(10)?, e.need(20)?], e.need(40)?);
+    if r <= 0.0 {
+        return Err(e.error(format!("radius must be > 0, got {r}")));
     }
-    Ok(design)
+    Ok((c, r))
+}
+
+/// A `CIRCLE`: a closed path that does not repeat its first point.
+fn circle(e: &Entity, tol: f64) -> Result<Flattened, DxfError> {
+    let m = e.mirror()?;
+    let (c, r) = centre_and_radius(e, m)?;
+    let mut pts = arc_points(c, r, 0.0, 2.0 * PI, tol);
+    pts.pop();
+    Ok(("CIRCLE", pts, true))
+}
+
+/// An `ARC`, counter-clockwise from its start angle to its end angle (a full turn when they
+/// are equal).
+fn arc(e: &Entity, tol: f64) -> Result<Flattened, DxfError> {
+    let m = e.mirror()?;
+    let (c, r) = centre_and_radius(e, m)?;
+    let (a0, a1) = (e.need(50)?.to_radians(), e.need(51)?.to_radians());
+    let mut sweep = (a1 - a0).rem_euclid(2.0 * PI);
+    if sweep == 0.0 {
+        sweep = 2.0 * PI;
+    }
+    // Mirrored: angles are measured in the mirrored plane, so the arc runs
+    // clockwise in XY from the mirrored start.
+    let pts = if m < 0.0 {
+        arc_points(c, r, PI - a0, -sweep, tol)
+    } else {
+        arc_points(c, r, a0, sweep, tol)
+    };
+    Ok(("ARC", pts, false))
+}
+
+/// An `LWPOLYLINE`: its vertices are `10`/`20` pairs in its own groups, each with an optional
+/// bulge (`42`).
+fn lwpolyline(e: &Entity, tol: f64) -> Result<Flattened, DxfError> {
+    let m = e.mirror()?;
+    let flags = e.get(70)?.unwrap_or(0.0) as i64;
+    let mut verts: Vec<([f64; 2], f64)> = Vec::new();
+    let mut x: Option<f64> = None;
+    for p in e.groups {
+        match p.code {
+            10 => x = Some(m * e.num(p)?),
+            20 => {
+                let xv = x
+                    .take()
+                    .ok_or_else(|| e.error(format!("line {}: y (20) without x (10)", p.line)))?;
+                verts.push(([xv, e.num(p)?], 0.0));
+            }
+            42 => {
+                if let Some(v) = verts.last_mut() {
+                    v.1 = m * e.num(p)?;
+                }
+            }
+            _ => {}
+        }
+    }
+    let closed = flags & 1 == 1;
+    Ok(("LWPOLYLINE", bulged(&verts, closed, tol), closed))
+}
+
+/// A `POLYLINE`: its vertices are the `VERTEX` entities that follow it (from `entities[*k]`)
+/// up to its `SEQEND`; `*k` is moved past the `SEQEND`.
+fn polyline(
+    e: &Entity,
+    entities: &[Entity],
+    k: &mut usize,
+    tol: f64,
+) -> Result<Flattened, DxfError> {
+    let m = e.mirror()?;
+    let flags = e.get(70)?.unwrap_or(0.0) as i64;
+    if flags & (16 | 64) != 0 {
+        return Err(e.error("polygon meshes and polyface meshes are not 2D designs".to_owned()));
+    }
+    let mut verts = Vec::new();
+    loop {
+        let Some(v) = entities.get(*k) else {
+            return Err(DxfError::Truncated {
+                line: e.line,
+                context: "a POLYLINE without SEQEND",
+            });
+        };
+        *k += 1;
+        match v.kind {
+            "VERTEX" => verts.push((
+                [m * v.need(10)?, v.need(20)?],
+                m * v.get(42)?.unwrap_or(0.0),
+            )),
+            "SEQEND" => break,
+            other => {
+                return Err(e.error(format!(
+                    "{other} inside the polyline (expected VERTEX or SEQEND)"
+                )));
+            }
+        }
+    }
+    let closed = flags & 1 == 1;
+    Ok(("POLYLINE", bulged(&verts, closed, tol), closed))
+}
+
+/// `points` scaled to millimetres, without consecutive duplicates and, when `closed`, without
+/// a repeated first point.
+fn in_millimetres(points: Vec<[f64; 2]>, mm_per_unit: f64, closed: bool) -> Vec<[f64; 2]> {
+    let mut pts: Vec<[f64; 2]> = Vec::with_capacity(points.len());
+    for p in points {
+        let q = [p[0] * mm_per_unit, p[1] * mm_per_unit];
+        if pts.last() != Some(&q) {
+            pts.push(q);
+        }
+    }
+    if closed && pts.len() > 1 && pts.first() == pts.last() {
+        pts.pop();
+    }
+    pts
 }
 
 /// Points of an arc of centre `c`, radius `r` from angle `a0` sweeping `sweep` (radians,

@@ -107,6 +107,20 @@ struct NetNode {
     pads: BTreeSet<(String, String)>,
 }
 
+/// `(part, gate, pin)` of the pins that a scope's nets reference.
+type Wired = HashSet<(String, String, String)>;
+
+/// A net of the scope being flattened, as its pin references see it.
+struct ScopeNet<'n> {
+    /// Its node in the union-find.
+    id: usize,
+    /// Its name in the scope.
+    name: &'n str,
+    class: Option<String>,
+    /// The module nesting level of the scope.
+    depth: usize,
+}
+
 /// A part as seen from inside its scope.
 struct LocalPart<'l> {
     full: String,
@@ -304,12 +318,20 @@ impl<'d, 'l> Flattener<'d, 'l> {
 
     /// Flattens one scope: its parts, nets, and (recursively) its module instances.
     fn scope(&mut self, scope: &'d Node, path: &[InstStep]) -> Result<(), EagleError> {
-        let doc = self.doc;
-        let depth = path.len();
-        let prefix = net_prefix(path);
         let local = self.resolve_parts(scope, path)?;
+        let insts = self.module_instances(scope, path)?;
+        let wired = self.scope_nets(scope, path, &local, &insts)?;
+        self.implicit_power(&local, &wired);
+        Ok(())
+    }
 
-        // Module instances of this scope, expanded depth-first.
+    /// Expands the module instances of a scope, depth-first; returns their names.
+    fn module_instances(
+        &mut self,
+        scope: &'d Node,
+        path: &[InstStep],
+    ) -> Result<HashSet<String>, EagleError> {
+        let doc = self.doc;
         let mut insts = HashSet::new();
         for mi in scope
             .list("sheets", "sheet")
@@ -342,9 +364,23 @@ impl<'d, 'l> Flattener<'d, 'l> {
             self.scope(def, &inner)?;
             self.stack.pop();
         }
+        Ok(insts)
+    }
 
-        // Nets. Same name on several sheets = same net.
-        let mut wired: HashSet<(String, String, String)> = HashSet::new();
+    /// Records the nets of a scope (same name on several sheets = same net) with the pads of
+    /// their pin references, joined to the module instances' port nets; returns the pins
+    /// wired to a net.
+    fn scope_nets(
+        &mut self,
+        scope: &'d Node,
+        path: &[InstStep],
+        local: &HashMap<String, LocalPart<'l>>,
+        insts: &HashSet<String>,
+    ) -> Result<Wired, EagleError> {
+        let doc = self.doc;
+        let depth = path.len();
+        let prefix = net_prefix(path);
+        let mut wired = Wired::new();
         for net in scope
             .list("sheets", "sheet")
             .flat_map(|s| s.list("nets", "net"))
@@ -352,37 +388,16 @@ impl<'d, 'l> Flattener<'d, 'l> {
             let name = doc.req(net, "name")?;
             let class = self.class_name(net);
             let id = self.node(format!("{prefix}{name}"), depth, class.clone());
+            let at = ScopeNet {
+                id,
+                name,
+                class,
+                depth,
+            };
             for seg in net.children_named("segment") {
                 for r in &seg.children {
                     match r.name.as_str() {
-                        "pinref" => {
-                            let pname = doc.req(r, "part")?;
-                            let gate = doc.req(r, "gate")?;
-                            let pin = doc.req(r, "pin")?;
-                            let (key, part) = local
-                                .get_key_value(pname)
-                                .or_else(|| {
-                                    local.iter().find(|(k, _)| k.eq_ignore_ascii_case(pname))
-                                })
-                                .ok_or_else(|| EagleError::UnknownReference {
-                                    element: "pinref",
-                                    kind: "part",
-                                    name: pname.to_owned(),
-                                    line: doc.line(r.pos),
-                                })?;
-                            wired.insert((key.clone(), gate.to_owned(), pin.to_owned()));
-                            if part.has_package {
-                                if let Some(pads) = part.pin_pads.get(&format!("{gate}.{pin}")) {
-                                    for pad in pads {
-                                        self.nets[id].pads.insert((part.full.clone(), pad.clone()));
-                                    }
-                                }
-                            } else if depth > 0 && Self::pin_direction(part, gate, pin) == "sup" {
-                                // A supply symbol inside a module: supply nets are global.
-                                let global = self.node(name.to_owned(), 0, class.clone());
-                                self.union(global, id);
-                            }
-                        }
+                        "pinref" => self.pinref(r, &at, local, &mut wired)?,
                         "portref" => {
                             let inst = doc.req(r, "moduleinst")?;
                             let port = doc.req(r, "port")?;
@@ -403,9 +418,51 @@ impl<'d, 'l> Flattener<'d, 'l> {
                 }
             }
         }
+        Ok(wired)
+    }
 
-        // Implicit power: `pwr` pins not wired to any net join the (global) net named after
-        // the pin, whether or not their gate is placed on a sheet.
+    /// A `<pinref>` of net `at`: the pads of the pin join the net; a supply symbol's pin inside
+    /// a module joins the net to the global net of the same name.
+    fn pinref(
+        &mut self,
+        r: &Node,
+        at: &ScopeNet<'_>,
+        local: &HashMap<String, LocalPart<'l>>,
+        wired: &mut Wired,
+    ) -> Result<(), EagleError> {
+        let doc = self.doc;
+        let pname = doc.req(r, "part")?;
+        let gate = doc.req(r, "gate")?;
+        let pin = doc.req(r, "pin")?;
+        let (key, part) = local
+            .get_key_value(pname)
+            .or_else(|| local.iter().find(|(k, _)| k.eq_ignore_ascii_case(pname)))
+            .ok_or_else(|| EagleError::UnknownReference {
+                element: "pinref",
+                kind: "part",
+                name: pname.to_owned(),
+                line: doc.line(r.pos),
+            })?;
+        wired.insert((key.clone(), gate.to_owned(), pin.to_owned()));
+        if part.has_package {
+            if let Some(pads) = part.pin_pads.get(&format!("{gate}.{pin}")) {
+                for pad in pads {
+                    self.nets[at.id]
+                        .pads
+                        .insert((part.full.clone(), pad.clone()));
+                }
+            }
+        } else if at.depth > 0 && Self::pin_direction(part, gate, pin) == "sup" {
+            // A supply symbol inside a module: supply nets are global.
+            let global = self.node(at.name.to_owned(), 0, at.class.clone());
+            self.union(global, at.id);
+        }
+        Ok(())
+    }
+
+    /// Implicit power: `pwr` pins not wired to any net join the (global) net named after
+    /// the pin, whether or not their gate is placed on a sheet.
+    fn implicit_power(&mut self, local: &HashMap<String, LocalPart<'l>>, wired: &Wired) {
         let mut names: Vec<&String> = local.keys().collect();
         names.sort();
         for pname in names {
@@ -432,7 +489,6 @@ impl<'d, 'l> Flattener<'d, 'l> {
                 }
             }
         }
-        Ok(())
     }
 
     /// Merges joined scope nets; the outermost (then alphabetically first) name wins.

@@ -257,35 +257,11 @@ pub(crate) fn tokenize(text: &[u8], number: usize, ending: LineEnding) -> Line {
                 }
                 i = end;
             }
-            b'*' => {
-                let digits_end = skip_digits(t, i + 1);
-                let value = std::str::from_utf8(&t[i + 1..digits_end])
-                    .ok()
-                    .and_then(|s| s.parse::<u8>().ok());
-                match value {
-                    Some(v) if line.checksum.is_none() && at_token_end(t, digits_end) => {
-                        line.checksum = Some(v);
-                        i = digits_end;
-                    }
-                    _ => i = push_unparsed(&mut line.unparsed, t, i),
-                }
-            }
+            b'*' => i = read_checksum(&mut line, t, i),
             b'A'..=b'Z' | b'a'..=b'z' => {
                 let letter = b.to_ascii_uppercase();
                 if letter == b'N' {
-                    let digits_end = skip_digits(t, i + 1);
-                    let value = std::str::from_utf8(&t[i + 1..digits_end])
-                        .ok()
-                        .and_then(|s| s.parse::<u64>().ok());
-                    match value {
-                        Some(v)
-                            if line.line_number_word.is_none() && at_token_end(t, digits_end) =>
-                        {
-                            line.line_number_word = Some(v);
-                            i = digits_end;
-                        }
-                        _ => i = push_unparsed(&mut line.unparsed, t, i),
-                    }
+                    i = read_line_number(&mut line, t, i);
                     continue;
                 }
                 match read_number(t, i + 1) {
@@ -310,6 +286,38 @@ pub(crate) fn tokenize(text: &[u8], number: usize, ending: LineEnding) -> Line {
         }
     }
     line
+}
+
+/// Reads the checksum `*digits` at `i` (the first one of the line, 0..=255, ending at a
+/// separator), or keeps the token as unparsed; returns where the next token starts.
+fn read_checksum(line: &mut Line, t: &[u8], i: usize) -> usize {
+    let digits_end = skip_digits(t, i + 1);
+    let value = std::str::from_utf8(&t[i + 1..digits_end])
+        .ok()
+        .and_then(|s| s.parse::<u8>().ok());
+    match value {
+        Some(v) if line.checksum.is_none() && at_token_end(t, digits_end) => {
+            line.checksum = Some(v);
+            digits_end
+        }
+        _ => push_unparsed(&mut line.unparsed, t, i),
+    }
+}
+
+/// Reads the line number `Ndigits` at `i` (the first one of the line, ending at a separator),
+/// or keeps the token as unparsed; returns where the next token starts.
+fn read_line_number(line: &mut Line, t: &[u8], i: usize) -> usize {
+    let digits_end = skip_digits(t, i + 1);
+    let value = std::str::from_utf8(&t[i + 1..digits_end])
+        .ok()
+        .and_then(|s| s.parse::<u64>().ok());
+    match value {
+        Some(v) if line.line_number_word.is_none() && at_token_end(t, digits_end) => {
+            line.line_number_word = Some(v);
+            digits_end
+        }
+        _ => push_unparsed(&mut line.unparsed, t, i),
+    }
 }
 
 /// True when a token ending at `i` is followed by a separator (or the end of the line), so that

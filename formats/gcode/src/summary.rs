@@ -5,8 +5,8 @@
 
 use serde::Serialize;
 
-use crate::Gcode;
-use crate::machine::{Command, Firmware, Machine, Position, Reading};
+use crate::machine::{Command, Firmware, Machine, Move, Position, Reading};
+use crate::{Gcode, Line};
 
 /// Statistics of a G-code file, from [`summarize`].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -209,131 +209,192 @@ pub fn summarize(g: &Gcode) -> Summary {
     let mut machine = Machine::new(Firmware::Marlin, 25.0)
         .with_reading(Reading::Survey)
         .with_position([Some(0.0); 3]);
-    let mut marker_counts = [0usize; MARKERS.len()];
-    let mut flavour = None::<(Flavour, String)>;
-    let mut flavor_line = false;
-    let (mut moves, mut extruding, mut arcs) = (0, 0, 0);
-    let (mut abs_moves, mut rel_moves) = (0usize, 0usize);
-    let mut declared_e = None::<bool>;
-    let (mut saw_g20, mut saw_g21) = (false, false);
-    let mut tools = Vec::new();
-    let mut tool_changes = 0;
-    let mut z_levels: Vec<i64> = Vec::new();
-    let mut min = [f64::INFINITY; 3];
-    let mut max = [f64::NEG_INFINITY; 3];
-    let mut lines_with_unparsed = 0;
-
+    let mut tally = Tally::new();
     for (index, line) in g.lines.iter().enumerate() {
         if !line.unparsed.is_empty() {
-            lines_with_unparsed += 1;
+            tally.lines_with_unparsed += 1;
         }
         if let Some(text) = line.comment_text() {
-            if let Some(m) = layer_marker(text) {
-                marker_counts[m] += 1;
-            }
-            if index < HEADER_LINES && flavour.is_none() {
-                flavour = generator(text);
-                flavor_line |= text.starts_with("FLAVOR:");
-            }
+            tally.comment(index, text);
         }
-        let step = machine.step_with(line, |before, command| match command {
-            Command::Inches => saw_g20 = true,
-            Command::Millimetres => saw_g21 = true,
-            Command::AbsoluteE => declared_e = Some(false),
-            Command::RelativeE => declared_e = Some(true),
-            Command::Tool(t) => {
-                if before.selected_tool() != Some(t) {
-                    tool_changes += 1;
-                }
-                // Survey command numbers are at most 10⁶.
-                tools.extend(u32::try_from(t).ok());
-            }
-            _ => {}
-        });
+        let step = machine.step_with(line, |before, command| tally.command(before, command));
         let Some(m) = step else { continue };
-        moves += 1;
-        if m.arc {
-            arcs += 1;
-        }
-        if line.get(b'E').is_none() {
-            continue;
-        }
-        let moved =
-            m.from != m.to || (m.arc && [b'I', b'J', b'R'].iter().any(|&l| line.get(l).is_some()));
-        if m.e > 0.0 && moved {
-            extruding += 1;
-            if machine.e_is_relative() {
-                rel_moves += 1;
-            } else {
-                abs_moves += 1;
-            }
-            // Survey positions start known, so they are never `None`.
-            let known = |p: Position| p.map(|c| c.unwrap_or(0.0));
-            let (start, end) = (known(m.from), known(m.to));
-            for p in [start, end] {
-                for axis in 0..3 {
-                    min[axis] = min[axis].min(p[axis]);
-                    max[axis] = max[axis].max(p[axis]);
-                }
-            }
-            // 1 µm buckets; saturating cast keeps absurd Z values from misbehaving.
-            z_levels.push((end[2] * 1000.0).round() as i64);
+        tally.motion(line, &m, machine.e_is_relative());
+    }
+    tally.summary(g.lines.len())
+}
+
+/// What [`summarize`] has counted so far.
+struct Tally {
+    marker_counts: [usize; MARKERS.len()],
+    flavour: Option<(Flavour, String)>,
+    /// A `;FLAVOR:` header comment was seen (Cura's).
+    flavor_line: bool,
+    moves: usize,
+    extruding: usize,
+    arcs: usize,
+    /// Extruding moves in absolute and in relative E mode.
+    abs_moves: usize,
+    rel_moves: usize,
+    /// The last E mode command: `Some(true)` for relative.
+    declared_e: Option<bool>,
+    saw_g20: bool,
+    saw_g21: bool,
+    tools: Vec<u32>,
+    tool_changes: usize,
+    /// Z of the extruding moves' ends, in 1 µm buckets.
+    z_levels: Vec<i64>,
+    min: [f64; 3],
+    max: [f64; 3],
+    lines_with_unparsed: usize,
+}
+
+impl Tally {
+    fn new() -> Tally {
+        Tally {
+            marker_counts: [0; MARKERS.len()],
+            flavour: None,
+            flavor_line: false,
+            moves: 0,
+            extruding: 0,
+            arcs: 0,
+            abs_moves: 0,
+            rel_moves: 0,
+            declared_e: None,
+            saw_g20: false,
+            saw_g21: false,
+            tools: Vec::new(),
+            tool_changes: 0,
+            z_levels: Vec::new(),
+            min: [f64::INFINITY; 3],
+            max: [f64::NEG_INFINITY; 3],
+            lines_with_unparsed: 0,
         }
     }
 
-    z_levels.sort_unstable();
-    z_levels.dedup();
-    let (best, &count) = marker_counts
-        .iter()
-        .enumerate()
-        .max_by_key(|&(i, c)| (*c, std::cmp::Reverse(i)))
-        .unwrap_or((0, &0));
-    let (layers, layer_source, layer_marker) = if count > 0 {
-        (
-            count,
-            LayerSource::Comments,
-            Some(MARKERS[best].to_string()),
-        )
-    } else if !z_levels.is_empty() {
-        (z_levels.len(), LayerSource::ZHeights, None)
-    } else {
-        (0, LayerSource::None, None)
-    };
-    let (flavour, generator) = match flavour {
-        Some((f, name)) => (f, Some(name)),
-        None if flavor_line => (Flavour::Cura, None),
-        None => (Flavour::Unknown, None),
-    };
-    tools.sort_unstable();
-    tools.dedup();
-    Summary {
-        lines: g.lines.len(),
-        moves,
-        extruding_moves: extruding,
-        arc_moves: arcs,
-        layers,
-        layer_source,
-        layer_marker,
-        extrusion_z_levels: z_levels.len(),
-        tools,
-        tool_changes,
-        bounds: (extruding > 0).then_some(Bounds { min, max }),
-        flavour,
-        generator,
-        extrusion: match (abs_moves > 0, rel_moves > 0, declared_e) {
-            (true, true, _) => ExtrusionMode::Mixed,
-            (true, false, _) => ExtrusionMode::Absolute,
-            (false, true, _) => ExtrusionMode::Relative,
-            (false, false, Some(false)) => ExtrusionMode::Absolute,
-            (false, false, Some(true)) => ExtrusionMode::Relative,
-            (false, false, None) => ExtrusionMode::Unknown,
-        },
-        units: match (saw_g20, saw_g21) {
-            (true, true) => Units::Mixed,
-            (true, false) => Units::Inches,
-            _ => Units::Millimetres,
-        },
-        lines_with_unparsed,
+    /// Counts a layer-change comment; reads the generator from the header's comments.
+    fn comment(&mut self, index: usize, text: &str) {
+        if let Some(m) = layer_marker(text) {
+            self.marker_counts[m] += 1;
+        }
+        if index < HEADER_LINES && self.flavour.is_none() {
+            self.flavour = generator(text);
+            self.flavor_line |= text.starts_with("FLAVOR:");
+        }
+    }
+
+    /// Notes unit and E mode commands and tool selections.
+    fn command(&mut self, before: &Machine, command: Command) {
+        match command {
+            Command::Inches => self.saw_g20 = true,
+            Command::Millimetres => self.saw_g21 = true,
+            Command::AbsoluteE => self.declared_e = Some(false),
+            Command::RelativeE => self.declared_e = Some(true),
+            Command::Tool(t) => {
+                if before.selected_tool() != Some(t) {
+                    self.tool_changes += 1;
+                }
+                // Survey command numbers are at most 10⁶.
+                self.tools.extend(u32::try_from(t).ok());
+            }
+            _ => {}
+        }
+    }
+
+    /// Counts a move of `line`; an extruding one also counts towards the E mode, the bounds
+    /// and the Z heights.
+    fn motion(&mut self, line: &Line, m: &Move, e_is_relative: bool) {
+        self.moves += 1;
+        if m.arc {
+            self.arcs += 1;
+        }
+        if line.get(b'E').is_none() {
+            return;
+        }
+        let moved =
+            m.from != m.to || (m.arc && [b'I', b'J', b'R'].iter().any(|&l| line.get(l).is_some()));
+        if !(m.e > 0.0 && moved) {
+            return;
+        }
+        self.extruding += 1;
+        if e_is_relative {
+            self.rel_moves += 1;
+        } else {
+            self.abs_moves += 1;
+        }
+        // Survey positions start known, so they are never `None`.
+        let known = |p: Position| p.map(|c| c.unwrap_or(0.0));
+        let (start, end) = (known(m.from), known(m.to));
+        for p in [start, end] {
+            for (axis, &c) in p.iter().enumerate() {
+                self.min[axis] = self.min[axis].min(c);
+                self.max[axis] = self.max[axis].max(c);
+            }
+        }
+        // 1 µm buckets; saturating cast keeps absurd Z values from misbehaving.
+        self.z_levels.push((end[2] * 1000.0).round() as i64);
+    }
+
+    /// The summary of a file of `lines` lines.
+    fn summary(mut self, lines: usize) -> Summary {
+        self.z_levels.sort_unstable();
+        self.z_levels.dedup();
+        let (best, &count) = self
+            .marker_counts
+            .iter()
+            .enumerate()
+            .max_by_key(|&(i, c)| (*c, std::cmp::Reverse(i)))
+            .unwrap_or((0, &0));
+        let (layers, layer_source, layer_marker) = if count > 0 {
+            (
+                count,
+                LayerSource::Comments,
+                Some(MARKERS[best].to_string()),
+            )
+        } else if !self.z_levels.is_empty() {
+            (self.z_levels.len(), LayerSource::ZHeights, None)
+        } else {
+            (0, LayerSource::None, None)
+        };
+        let (flavour, generator) = match self.flavour {
+            Some((f, name)) => (f, Some(name)),
+            None if self.flavor_line => (Flavour::Cura, None),
+            None => (Flavour::Unknown, None),
+        };
+        self.tools.sort_unstable();
+        self.tools.dedup();
+        Summary {
+            lines,
+            moves: self.moves,
+            extruding_moves: self.extruding,
+            arc_moves: self.arcs,
+            layers,
+            layer_source,
+            layer_marker,
+            extrusion_z_levels: self.z_levels.len(),
+            tools: self.tools,
+            tool_changes: self.tool_changes,
+            bounds: (self.extruding > 0).then_some(Bounds {
+                min: self.min,
+                max: self.max,
+            }),
+            flavour,
+            generator,
+            extrusion: match (self.abs_moves > 0, self.rel_moves > 0, self.declared_e) {
+                (true, true, _) => ExtrusionMode::Mixed,
+                (true, false, _) => ExtrusionMode::Absolute,
+                (false, true, _) => ExtrusionMode::Relative,
+                (false, false, Some(false)) => ExtrusionMode::Absolute,
+                (false, false, Some(true)) => ExtrusionMode::Relative,
+                (false, false, None) => ExtrusionMode::Unknown,
+            },
+            units: match (self.saw_g20, self.saw_g21) {
+                (true, true) => Units::Mixed,
+                (true, false) => Units::Inches,
+                _ => Units::Millimetres,
+            },
+            lines_with_unparsed: self.lines_with_unparsed,
+        }
     }
 }
 

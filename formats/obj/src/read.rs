@@ -98,6 +98,7 @@ impl Warnings {
 }
 
 /// The validated file, rewritten for tobj.
+#[derive(Default)]
 struct Canonical {
     /// All `v` lines first, so that forward references resolve for tobj too.
     vertices: String,
@@ -159,23 +160,7 @@ fn strip_bom(bytes: &[u8]) -> &[u8] {
 }
 
 fn validate(bytes: &[u8], warnings: &mut Warnings) -> Result<Canonical, ObjError> {
-    let mut out = Canonical {
-        vertices: String::new(),
-        body: String::new(),
-        has_mtllib: false,
-        names: Vec::new(),
-    };
-    let mut name = String::new();
-    let mut faces_in_model = 0usize;
-    let mut vertex_count: usize = 0;
-    // (line, 1-based index) of faces that refer to vertices defined later in the file.
-    let mut forward: Vec<(usize, i64)> = Vec::new();
-    let mut face = Vec::new();
-    let mut skipped_elements = 0usize;
-    let mut first_skipped_element = 0;
-    let mut free_form = None;
-    let mut unknown: Vec<String> = Vec::new();
-
+    let mut v = Validator::default();
     for (line_no, line) in logical_lines(bytes) {
         let trimmed = line.trim_start();
         let Some(keyword) = trimmed.split_whitespace().next() else {
@@ -185,136 +170,197 @@ fn validate(bytes: &[u8], warnings: &mut Warnings) -> Result<Canonical, ObjError
             continue;
         }
         let rest = strip_comment(&trimmed[keyword.len()..]).trim();
+        v.statement(line_no, keyword, rest, warnings)?;
+    }
+    v.finish(warnings)
+}
+
+/// The validating pre-pass's state: the canonical text written so far and what it has seen.
+#[derive(Default)]
+struct Validator {
+    out: Canonical,
+    /// Name of the current `o`/`g` model.
+    name: String,
+    faces_in_model: usize,
+    vertex_count: usize,
+    /// (line, 1-based index) of faces that refer to vertices defined later in the file.
+    forward: Vec<(usize, i64)>,
+    /// The absolute vertex indices of the face being read.
+    face: Vec<i64>,
+    skipped_elements: usize,
+    first_skipped_element: usize,
+    /// Line of the first free-form statement.
+    free_form: Option<usize>,
+    /// Unknown keywords warned about (at most ten).
+    unknown: Vec<String>,
+}
+
+impl Validator {
+    /// Checks and rewrites one statement (`keyword` with the text `rest` after it).
+    fn statement(
+        &mut self,
+        line_no: usize,
+        keyword: &str,
+        rest: &str,
+        warnings: &mut Warnings,
+    ) -> Result<(), ObjError> {
         match keyword {
-            "v" => {
-                let mut coords = rest.split_whitespace();
-                out.vertices.push('v');
-                for found in 0..3 {
-                    let Some(token) = coords.next() else {
-                        return Err(ObjError::TooFewCoordinates {
-                            line: line_no,
-                            found,
-                        });
-                    };
-                    if !token.parse::<f64>().is_ok_and(f64::is_finite) {
-                        return Err(ObjError::InvalidNumber {
-                            line: line_no,
-                            token: token.to_owned(),
-                        });
-                    }
-                    // Passed on as written: tobj parses the same text with the same `f64`
-                    // parser, so the value is exact.
-                    out.vertices.push(' ');
-                    out.vertices.push_str(token);
-                }
-                out.vertices.push('\n');
-                vertex_count += 1;
-            }
-            "f" | "fo" => {
-                face.clear();
-                for token in rest.split_whitespace() {
-                    let position = token.split('/').next().unwrap_or_default();
-                    let index = match position.parse::<i64>() {
-                        Ok(index) if index != 0 => index,
-                        _ => {
-                            return Err(ObjError::InvalidIndex {
-                                line: line_no,
-                                token: token.to_owned(),
-                            });
-                        }
-                    };
-                    let absolute = if index < 0 {
-                        let resolved = i64::try_from(vertex_count)
-                            .ok()
-                            .and_then(|count| count.checked_add(index))
-                            .filter(|&r| r >= 0);
-                        let Some(resolved) = resolved else {
-                            return Err(ObjError::IndexOutOfRange {
-                                line: line_no,
-                                index,
-                                available: vertex_count,
-                            });
-                        };
-                        resolved + 1
-                    } else {
-                        if usize::try_from(index).map_or(true, |i| i > vertex_count) {
-                            forward.push((line_no, index));
-                        }
-                        index
-                    };
-                    face.push(absolute);
-                }
-                if face.len() < 3 {
-                    warnings.push(format!(
-                        "line {line_no}: face with {} vertices ignored",
-                        face.len()
-                    ));
-                    continue;
-                }
-                out.body.push('f');
-                for index in &face {
-                    let _ = write!(out.body, " {index}");
-                }
-                out.body.push('\n');
-                faces_in_model += 1;
-            }
+            "v" => self.vertex(line_no, rest)?,
+            "f" | "fo" => self.face(line_no, rest, warnings)?,
             "o" | "g" => {
-                if faces_in_model > 0 {
-                    out.names.push(std::mem::take(&mut name));
-                    faces_in_model = 0;
+                if self.faces_in_model > 0 {
+                    self.out.names.push(std::mem::take(&mut self.name));
+                    self.faces_in_model = 0;
                 }
-                name = rest.to_owned();
-                let _ = writeln!(out.body, "{keyword} {rest}");
+                self.name = rest.to_owned();
+                let _ = writeln!(self.out.body, "{keyword} {rest}");
             }
             "mtllib" => {
-                out.has_mtllib = true;
-                let _ = writeln!(out.body, "mtllib {rest}");
+                self.out.has_mtllib = true;
+                let _ = writeln!(self.out.body, "mtllib {rest}");
             }
             "l" | "p" => {
-                if skipped_elements == 0 {
-                    first_skipped_element = line_no;
+                if self.skipped_elements == 0 {
+                    self.first_skipped_element = line_no;
                 }
-                skipped_elements += 1;
+                self.skipped_elements += 1;
             }
             k if SILENT.contains(&k) || is_mtl_keyword(k) => {}
             k if FREE_FORM.contains(&k) => {
-                free_form.get_or_insert(line_no);
+                self.free_form.get_or_insert(line_no);
             }
             k => {
-                if unknown.len() < 10 && !unknown.iter().any(|u| u == k) {
-                    unknown.push(k.to_owned());
+                if self.unknown.len() < 10 && !self.unknown.iter().any(|u| u == k) {
+                    self.unknown.push(k.to_owned());
                     warnings.push(format!("line {line_no}: unknown statement `{k}` ignored"));
                 }
             }
         }
+        Ok(())
     }
 
-    out.names.push(name);
-    if let Some(&(line, index)) = forward
-        .iter()
-        .find(|&&(_, index)| usize::try_from(index).map_or(true, |i| i > vertex_count))
-    {
-        return Err(ObjError::IndexOutOfRange {
-            line,
-            index,
-            available: vertex_count,
-        });
+    /// A `v` statement: three finite coordinates, passed on as written.
+    fn vertex(&mut self, line_no: usize, rest: &str) -> Result<(), ObjError> {
+        let mut coords = rest.split_whitespace();
+        self.out.vertices.push('v');
+        for found in 0..3 {
+            let Some(token) = coords.next() else {
+                return Err(ObjError::TooFewCoordinates {
+                    line: line_no,
+                    found,
+                });
+            };
+            if !token.parse::<f64>().is_ok_and(f64::is_finite) {
+                return Err(ObjError::InvalidNumber {
+                    line: line_no,
+                    token: token.to_owned(),
+                });
+            }
+            // Passed on as written: tobj parses the same text with the same `f64`
+            // parser, so the value is exact.
+            self.out.vertices.push(' ');
+            self.out.vertices.push_str(token);
+        }
+        self.out.vertices.push('\n');
+        self.vertex_count += 1;
+        Ok(())
     }
-    if u32::try_from(vertex_count.saturating_sub(1)).is_err() {
-        return Err(ObjError::TooManyVertices);
+
+    /// An `f` statement: its vertex indices made absolute (forward references are checked at
+    /// the end); a face of fewer than three vertices is dropped with a warning.
+    fn face(
+        &mut self,
+        line_no: usize,
+        rest: &str,
+        warnings: &mut Warnings,
+    ) -> Result<(), ObjError> {
+        self.face.clear();
+        for token in rest.split_whitespace() {
+            let absolute = self.face_index(line_no, token)?;
+            self.face.push(absolute);
+        }
+        if self.face.len() < 3 {
+            warnings.push(format!(
+                "line {line_no}: face with {} vertices ignored",
+                self.face.len()
+            ));
+            return Ok(());
+        }
+        self.out.body.push('f');
+        for index in &self.face {
+            let _ = write!(self.out.body, " {index}");
+        }
+        self.out.body.push('\n');
+        self.faces_in_model += 1;
+        Ok(())
     }
-    if skipped_elements > 0 {
-        warnings.push(format!(
-            "{skipped_elements} line/point elements (`l`, `p`) ignored, the first on line \
-             {first_skipped_element}"
-        ));
+
+    /// The absolute 1-based vertex index of one face vertex `token` (`v`, `v/vt`, `v//vn` or
+    /// `v/vt/vn`; negative indices count back from the last vertex read).
+    fn face_index(&mut self, line_no: usize, token: &str) -> Result<i64, ObjError> {
+        let position = token.split('/').next().unwrap_or_default();
+        let index = match position.parse::<i64>() {
+            Ok(index) if index != 0 => index,
+            _ => {
+                return Err(ObjError::InvalidIndex {
+                    line: line_no,
+                    token: token.to_owned(),
+                });
+            }
+        };
+        if index < 0 {
+            let resolved = i64::try_from(self.vertex_count)
+                .ok()
+                .and_then(|count| count.checked_add(index))
+                .filter(|&r| r >= 0);
+            let Some(resolved) = resolved else {
+                return Err(ObjError::IndexOutOfRange {
+                    line: line_no,
+                    index,
+                    available: self.vertex_count,
+                });
+            };
+            Ok(resolved + 1)
+        } else {
+            if usize::try_from(index).map_or(true, |i| i > self.vertex_count) {
+                self.forward.push((line_no, index));
+            }
+            Ok(index)
+        }
     }
-    if let Some(line) = free_form {
-        warnings.push(format!(
-            "line {line}: free-form curves and surfaces are not supported and were ignored"
-        ));
+
+    /// Checks the forward references and the vertex count once all vertices are known, and
+    /// adds the summary warnings.
+    fn finish(mut self, warnings: &mut Warnings) -> Result<Canonical, ObjError> {
+        let vertex_count = self.vertex_count;
+        self.out.names.push(self.name);
+        if let Some(&(line, index)) = self
+            .forward
+            .iter()
+            .find(|&&(_, index)| usize::try_from(index).map_or(true, |i| i > vertex_count))
+        {
+            return Err(ObjError::IndexOutOfRange {
+                line,
+                index,
+                available: vertex_count,
+            });
+        }
+        if u32::try_from(vertex_count.saturating_sub(1)).is_err() {
+            return Err(ObjError::TooManyVertices);
+        }
+        if self.skipped_elements > 0 {
+            warnings.push(format!(
+                "{} line/point elements (`l`, `p`) ignored, the first on line {}",
+                self.skipped_elements, self.first_skipped_element
+            ));
+        }
+        if let Some(line) = self.free_form {
+            warnings.push(format!(
+                "line {line}: free-form curves and surfaces are not supported and were ignored"
+            ));
+        }
+        Ok(self.out)
     }
-    Ok(out)
 }
 
 /// Rewrites an MTL file so that tobj cannot panic on it: tobj unwraps the parse of a colour

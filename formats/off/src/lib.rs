@@ -246,8 +246,52 @@ pub fn read(bytes: &[u8]) -> Result<Off, OffError> {
     let mut lines = Lines::new(bytes);
     let (header_line, header) = lines.next().ok_or(OffError::Empty)?;
     check_header(header_line, &header)?;
+    let (vertex_count, face_count) = counts(&mut lines, header_line, &header)?;
 
-    // Counts: either after the keyword on the header line, or on the next line.
+    // Counts are untrusted: each vertex line takes at least 6 bytes ("0 0 0\n"), each face 8.
+    let mut vertices = Vec::with_capacity(vertex_count.min(bytes.len() / 6));
+    while vertices.len() < vertex_count {
+        let Some((line, text)) = lines.next() else {
+            return Err(OffError::Truncated {
+                section: Section::Vertices,
+                expected: vertex_count,
+                found: vertices.len(),
+            });
+        };
+        vertices.push(vertex(line, &text)?);
+    }
+
+    let mut triangles = Vec::with_capacity(face_count.min(bytes.len() / 8));
+    let mut face = Vec::new();
+    for faces_read in 0..face_count {
+        let Some((line, text)) = lines.next() else {
+            return Err(OffError::Truncated {
+                section: Section::Faces,
+                expected: face_count,
+                found: faces_read,
+            });
+        };
+        face_indices(line, &text, vertices.len(), &mut face)?;
+        // Faces with fewer than three vertices have no area: skipped.
+        if let Some((&first, rest)) = face.split_first() {
+            for pair in rest.windows(2) {
+                triangles.push([first, pair[0], pair[1]]);
+            }
+        }
+    }
+
+    Ok(Off {
+        vertices,
+        triangles,
+    })
+}
+
+/// The vertex and face counts: after the keyword on the header line, or on the next line.
+fn counts(
+    lines: &mut Lines<'_>,
+    header_line: usize,
+    header: &str,
+) -> Result<(usize, usize), OffError> {
     let mut header_tokens = header.split_whitespace().skip(1).peekable();
     let (counts_line, counts_text): (usize, Cow<'_, str>) = if header_tokens.peek().is_some() {
         (
@@ -267,89 +311,70 @@ pub fn read(bytes: &[u8]) -> Result<Off, OffError> {
             count: vertex_count,
         });
     }
+    Ok((vertex_count, face_count))
+}
 
-    // Counts are untrusted: each vertex line takes at least 6 bytes ("0 0 0\n"), each face 8.
-    let mut vertices = Vec::with_capacity(vertex_count.min(bytes.len() / 6));
-    while vertices.len() < vertex_count {
-        let Some((line, text)) = lines.next() else {
-            return Err(OffError::Truncated {
-                section: Section::Vertices,
-                expected: vertex_count,
-                found: vertices.len(),
-            });
-        };
-        let mut coords = [0.0; 3];
-        let mut found = 0;
-        for token in text.split_whitespace().take(3) {
-            coords[found] = parse_f64(line, token)?;
-            found += 1;
-        }
-        if found < 3 {
-            return Err(OffError::TooFewCoordinates { line, found });
-        }
-        vertices.push(coords);
+/// The three coordinates of a vertex line (values after them are ignored).
+fn vertex(line: usize, text: &str) -> Result<[f64; 3], OffError> {
+    let mut coords = [0.0; 3];
+    let mut found = 0;
+    for token in text.split_whitespace().take(3) {
+        coords[found] = parse_f64(line, token)?;
+        found += 1;
     }
-
-    let mut triangles = Vec::with_capacity(face_count.min(bytes.len() / 8));
-    let mut face = Vec::new();
-    for faces_read in 0..face_count {
-        let Some((line, text)) = lines.next() else {
-            return Err(OffError::Truncated {
-                section: Section::Faces,
-                expected: face_count,
-                found: faces_read,
-            });
-        };
-        let mut tokens = text.split_whitespace();
-        let n: usize = match tokens.next().map(str::parse) {
-            Some(Ok(n)) => n,
-            Some(Err(_)) | None => {
-                return Err(OffError::InvalidNumber {
-                    line,
-                    token: text
-                        .split_whitespace()
-                        .next()
-                        .unwrap_or_default()
-                        .to_owned(),
-                });
-            }
-        };
-        face.clear();
-        // `take(n)` bounds the loop by the tokens present, not by the untrusted `n`.
-        for token in tokens.take(n) {
-            let index: i64 = token.parse().map_err(|_| OffError::InvalidNumber {
-                line,
-                token: token.to_owned(),
-            })?;
-            let valid = usize::try_from(index).ok().filter(|&i| i < vertices.len());
-            let Some(index) = valid.and_then(|i| u32::try_from(i).ok()) else {
-                return Err(OffError::IndexOutOfRange {
-                    line,
-                    index,
-                    vertex_count: vertices.len(),
-                });
-            };
-            face.push(index);
-        }
-        if face.len() < n {
-            return Err(OffError::ShortFace {
-                line,
-                expected: n,
-                found: face.len(),
-            });
-        }
-        // Faces with fewer than three vertices have no area: skipped.
-        if let Some((&first, rest)) = face.split_first() {
-            for pair in rest.windows(2) {
-                triangles.push([first, pair[0], pair[1]]);
-            }
-        }
+    if found < 3 {
+        return Err(OffError::TooFewCoordinates { line, found });
     }
+    Ok(coords)
+}
 
-    Ok(Off {
-        vertices,
-        triangles,
-    })
+/// Reads a face line (`n i1 .. in`, values after them ignored) into `face`: `n` indices into
+/// the `vertex_count` vertices.
+fn face_indices(
+    line: usize,
+    text: &str,
+    vertex_count: usize,
+    face: &mut Vec<u32>,
+) -> Result<(), OffError> {
+    let mut tokens = text.split_whitespace();
+    let n: usize = match tokens.next().map(str::parse) {
+        Some(Ok(n)) => n,
+        Some(Err(_)) | None => {
+            return Err(OffError::InvalidNumber {
+                line,
+                token: text
+                    .split_whitespace()
+                    .next()
+                    .unwrap_or_default()
+                    .to_owned(),
+            });
+        }
+    };
+    face.clear();
+    // `take(n)` bounds the loop by the tokens present, not by the untrusted `n`.
+    for token in tokens.take(n) {
+        let index: i64 = token.parse().map_err(|_| OffError::InvalidNumber {
+            line,
+            token: token.to_owned(),
+        })?;
+        let valid = usize::try_from(index).ok().filter(|&i| i < vertex_count);
+        let Some(index) = valid.and_then(|i| u32::try_from(i).ok()) else {
+            return Err(OffError::IndexOutOfRange {
+                line,
+                index,
+                vertex_count,
+            });
+        };
+        face.push(index);
+    }
+    if face.len() < n {
+        return Err(OffError::ShortFace {
+            line,
+            expected: n,
+            found: face.len(),
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]

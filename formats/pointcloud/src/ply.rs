@@ -579,183 +579,306 @@ fn read_body(
     body_len: usize,
     mut body: impl Body,
 ) -> Result<PointCloud, PlyError> {
-    let vertex = header
-        .elements
-        .iter()
-        .find(|e| e.name == "vertex")
-        .ok_or(PlyError::NoVertexElement)?;
-    let roles: Vec<Role> = vertex
-        .properties
-        .iter()
-        .map(|p| match p.kind {
-            Kind::Scalar(_) => vertex_role(&p.name),
-            Kind::List { .. } => Role::Other,
-        })
-        .collect();
-    for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
-        if !roles.contains(&Role::Coord(axis)) {
-            return Err(PlyError::MissingProperty {
-                element: vertex.name.clone(),
-                property: name,
-            });
-        }
-    }
-    let has_all = |f: fn(usize) -> Role| (0..3).all(|i| roles.contains(&f(i)));
-    let has_normals = has_all(Role::Normal);
-    let has_colors = has_all(Role::Color);
-    let vertex_count = vertex.count;
-    if u32::try_from(vertex_count.saturating_sub(1)).is_err() {
-        return Err(PlyError::TooManyVertices {
-            count: vertex_count,
-        });
-    }
-    let face_element = header.elements.iter().position(|e| e.name == "face");
-    let face_list = match face_element.map(|i| &header.elements[i]) {
-        Some(face) => Some(
-            face.properties
-                .iter()
-                .position(|p| {
-                    matches!(p.kind, Kind::List { .. })
-                        && (p.name == "vertex_indices" || p.name == "vertex_index")
-                })
-                .ok_or_else(|| PlyError::MissingProperty {
-                    element: face.name.clone(),
-                    property: "vertex_indices",
-                })?,
-        ),
-        None => None,
-    };
-
-    let mut cloud = PointCloud::default();
-    let mut normals = Vec::new();
-    let mut colors = Vec::new();
-    let mut face = Vec::new();
+    let layout = Layout::of(header)?;
+    let mut records = Records::new(layout);
     let mut vertex_done = false;
-
     for (element_index, element) in header.elements.iter().enumerate() {
         if element.properties.is_empty() {
             continue; // records of zero bytes: nothing to read, however large the count
         }
         let is_vertex = !vertex_done && element.name == "vertex";
-        let is_face = face_element == Some(element_index);
+        let is_face = records.layout.face_element == Some(element_index);
         if is_vertex {
             vertex_done = true;
             // The count is untrusted: reserve no more records than the body can hold.
-            let cap = vertex_count.min(body_len / element.min_record_bytes(header.format));
-            cloud.points.reserve(cap);
-            if has_normals {
-                normals.reserve(cap);
-            }
-            if has_colors {
-                colors.reserve(cap);
-            }
+            let cap = records
+                .layout
+                .vertex_count
+                .min(body_len / element.min_record_bytes(header.format));
+            records.reserve(cap);
         }
         for record in 0..element.count {
-            body.begin_record();
-            let mut point = [0.0; 3];
-            let mut normal = [0.0; 3];
-            let mut color = [0u8; 3];
-            for (index, property) in element.properties.iter().enumerate() {
-                let context = |fail: Fail, location: Location| match fail {
-                    Fail::Eof => PlyError::Truncated {
-                        element: element.name.clone(),
-                        record,
-                        count: element.count,
-                        property: property.name.clone(),
-                    },
-                    Fail::EndOfLine => PlyError::ShortRecord {
-                        location,
-                        element: element.name.clone(),
-                        record,
-                        property: property.name.clone(),
-                    },
-                    Fail::Invalid(token) => PlyError::InvalidValue {
-                        location,
-                        element: element.name.clone(),
-                        property: property.name.clone(),
-                        token,
-                    },
-                };
-                match property.kind {
-                    Kind::Scalar(ty) => {
-                        let value = body.value(ty).map_err(|f| context(f, body.location()))?;
-                        if !is_vertex {
-                            continue;
-                        }
-                        match roles[index] {
-                            Role::Coord(axis) => {
-                                if !value.is_finite() {
-                                    return Err(PlyError::InvalidValue {
-                                        location: body.location(),
-                                        element: element.name.clone(),
-                                        property: property.name.clone(),
-                                        token: value.to_string(),
-                                    });
-                                }
-                                point[axis] = value;
-                            }
-                            Role::Normal(axis) => normal[axis] = value,
-                            Role::Color(channel) => color[channel] = color_channel(value, ty),
-                            Role::Other => {}
-                        }
-                    }
-                    Kind::List { len, item } => {
-                        let n = body.value(len).map_err(|f| context(f, body.location()))?;
-                        let location = body.location();
-                        if !(n >= 0.0 && n.fract() == 0.0 && n <= usize::MAX as f64) {
-                            return Err(PlyError::InvalidListLength {
-                                location,
-                                property: property.name.clone(),
-                                value: n,
-                            });
-                        }
-                        // Exact: `n` is a non-negative integer no larger than usize::MAX.
-                        let n = n as usize;
-                        if is_face && Some(index) == face_list {
-                            face.clear();
-                            // Bounded by the data: every iteration consumes input or fails.
-                            for _ in 0..n {
-                                let value =
-                                    body.value(item).map_err(|f| context(f, body.location()))?;
-                                let location = body.location();
-                                let valid = value >= 0.0
-                                    && value.fract() == 0.0
-                                    && value < vertex_count as f64;
-                                if !valid {
-                                    return Err(PlyError::IndexOutOfRange {
-                                        location,
-                                        face: record,
-                                        index: value,
-                                        vertex_count,
-                                    });
-                                }
-                                // Exact: checked integral and below vertex_count <= 2^32.
-                                face.push(value as u32);
-                            }
-                            if let Some((&first, rest)) = face.split_first() {
-                                for pair in rest.windows(2) {
-                                    cloud.triangles.push([first, pair[0], pair[1]]);
-                                }
-                            }
-                        } else {
-                            body.skip(item, n)
-                                .map_err(|f| context(f, body.location()))?;
-                        }
-                    }
-                }
+            records.read(&mut body, element, record, is_vertex, is_face)?;
+        }
+    }
+    Ok(records.finish())
+}
+
+/// What the body reader takes from the header: what each vertex property means and where the
+/// faces' vertex indices are.
+struct Layout {
+    /// The role of each property of the `vertex` element, by index.
+    roles: Vec<Role>,
+    has_normals: bool,
+    has_colors: bool,
+    vertex_count: usize,
+    /// Index of the `face` element, if any.
+    face_element: Option<usize>,
+    /// Index of the face element's `vertex_indices` list property.
+    face_list: Option<usize>,
+}
+
+impl Layout {
+    /// Checks that the header declares a `vertex` element with `x`, `y` and `z`, no more
+    /// vertices than `u32` indices reach, and a vertex index list on its `face` element.
+    fn of(header: &Header) -> Result<Layout, PlyError> {
+        let vertex = header
+            .elements
+            .iter()
+            .find(|e| e.name == "vertex")
+            .ok_or(PlyError::NoVertexElement)?;
+        let roles: Vec<Role> = vertex
+            .properties
+            .iter()
+            .map(|p| match p.kind {
+                Kind::Scalar(_) => vertex_role(&p.name),
+                Kind::List { .. } => Role::Other,
+            })
+            .collect();
+        for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
+            if !roles.contains(&Role::Coord(axis)) {
+                return Err(PlyError::MissingProperty {
+                    element: vertex.name.clone(),
+                    property: name,
+                });
             }
-            if is_vertex {
-                cloud.points.push(point);
-                if has_normals {
-                    normals.push(normal);
+        }
+        let has_all = |f: fn(usize) -> Role| (0..3).all(|i| roles.contains(&f(i)));
+        let has_normals = has_all(Role::Normal);
+        let has_colors = has_all(Role::Color);
+        let vertex_count = vertex.count;
+        if u32::try_from(vertex_count.saturating_sub(1)).is_err() {
+            return Err(PlyError::TooManyVertices {
+                count: vertex_count,
+            });
+        }
+        let face_element = header.elements.iter().position(|e| e.name == "face");
+        let face_list = match face_element.map(|i| &header.elements[i]) {
+            Some(face) => Some(
+                face.properties
+                    .iter()
+                    .position(|p| {
+                        matches!(p.kind, Kind::List { .. })
+                            && (p.name == "vertex_indices" || p.name == "vertex_index")
+                    })
+                    .ok_or_else(|| PlyError::MissingProperty {
+                        element: face.name.clone(),
+                        property: "vertex_indices",
+                    })?,
+            ),
+            None => None,
+        };
+        Ok(Layout {
+            roles,
+            has_normals,
+            has_colors,
+            vertex_count,
+            face_element,
+            face_list,
+        })
+    }
+}
+
+/// The property being read, to name it in errors.
+#[derive(Clone, Copy)]
+struct At<'a> {
+    element: &'a Element,
+    record: usize,
+    property: &'a Property,
+}
+
+impl At<'_> {
+    /// The error for a failed read of this property at `location`.
+    fn error(self, fail: Fail, location: Location) -> PlyError {
+        match fail {
+            Fail::Eof => PlyError::Truncated {
+                element: self.element.name.clone(),
+                record: self.record,
+                count: self.element.count,
+                property: self.property.name.clone(),
+            },
+            Fail::EndOfLine => PlyError::ShortRecord {
+                location,
+                element: self.element.name.clone(),
+                record: self.record,
+                property: self.property.name.clone(),
+            },
+            Fail::Invalid(token) => PlyError::InvalidValue {
+                location,
+                element: self.element.name.clone(),
+                property: self.property.name.clone(),
+                token,
+            },
+        }
+    }
+}
+
+/// One vertex record's values.
+#[derive(Default)]
+struct Vertex {
+    point: [f64; 3],
+    normal: [f64; 3],
+    color: [u8; 3],
+}
+
+/// The cloud read so far.
+struct Records {
+    layout: Layout,
+    cloud: PointCloud,
+    normals: Vec<[f64; 3]>,
+    colors: Vec<[u8; 3]>,
+    /// The vertex indices of the face being read.
+    face: Vec<u32>,
+}
+
+impl Records {
+    fn new(layout: Layout) -> Records {
+        Records {
+            layout,
+            cloud: PointCloud::default(),
+            normals: Vec::new(),
+            colors: Vec::new(),
+            face: Vec::new(),
+        }
+    }
+
+    /// Reserves room for `cap` vertices.
+    fn reserve(&mut self, cap: usize) {
+        self.cloud.points.reserve(cap);
+        if self.layout.has_normals {
+            self.normals.reserve(cap);
+        }
+        if self.layout.has_colors {
+            self.colors.reserve(cap);
+        }
+    }
+
+    /// Reads record `record` of `element`, keeping it when it is a vertex or a face and
+    /// skipping it otherwise.
+    fn read(
+        &mut self,
+        body: &mut impl Body,
+        element: &Element,
+        record: usize,
+        is_vertex: bool,
+        is_face: bool,
+    ) -> Result<(), PlyError> {
+        body.begin_record();
+        let mut vertex = Vertex::default();
+        for (index, property) in element.properties.iter().enumerate() {
+            let at = At {
+                element,
+                record,
+                property,
+            };
+            match property.kind {
+                Kind::Scalar(ty) => {
+                    let value = body.value(ty).map_err(|f| at.error(f, body.location()))?;
+                    if is_vertex {
+                        self.set(&mut vertex, index, value, ty, body.location(), at)?;
+                    }
                 }
-                if has_colors {
-                    colors.push(color);
+                Kind::List { len, item } => {
+                    let n = body.value(len).map_err(|f| at.error(f, body.location()))?;
+                    let location = body.location();
+                    if !(n >= 0.0 && n.fract() == 0.0 && n <= usize::MAX as f64) {
+                        return Err(PlyError::InvalidListLength {
+                            location,
+                            property: property.name.clone(),
+                            value: n,
+                        });
+                    }
+                    // Exact: `n` is a non-negative integer no larger than usize::MAX.
+                    let n = n as usize;
+                    if is_face && Some(index) == self.layout.face_list {
+                        self.read_face(body, item, n, at)?;
+                    } else {
+                        body.skip(item, n)
+                            .map_err(|f| at.error(f, body.location()))?;
+                    }
                 }
             }
         }
+        if is_vertex {
+            self.cloud.points.push(vertex.point);
+            if self.layout.has_normals {
+                self.normals.push(vertex.normal);
+            }
+            if self.layout.has_colors {
+                self.colors.push(vertex.color);
+            }
+        }
+        Ok(())
     }
-    cloud.normals = has_normals.then_some(normals);
-    cloud.colors = has_colors.then_some(colors);
-    Ok(cloud)
+
+    /// Puts the value of vertex property `index` (of type `ty`, read at `location`) in its
+    /// place in `vertex`; a coordinate must be finite.
+    fn set(
+        &self,
+        vertex: &mut Vertex,
+        index: usize,
+        value: f64,
+        ty: Scalar,
+        location: Location,
+        at: At,
+    ) -> Result<(), PlyError> {
+        match self.layout.roles[index] {
+            Role::Coord(axis) => {
+                if !value.is_finite() {
+                    return Err(PlyError::InvalidValue {
+                        location,
+                        element: at.element.name.clone(),
+                        property: at.property.name.clone(),
+                        token: value.to_string(),
+                    });
+                }
+                vertex.point[axis] = value;
+            }
+            Role::Normal(axis) => vertex.normal[axis] = value,
+            Role::Color(channel) => vertex.color[channel] = color_channel(value, ty),
+            Role::Other => {}
+        }
+        Ok(())
+    }
+
+    /// Reads a face's `n` vertex indices of type `item` and fans it into triangles.
+    fn read_face(
+        &mut self,
+        body: &mut impl Body,
+        item: Scalar,
+        n: usize,
+        at: At,
+    ) -> Result<(), PlyError> {
+        let vertex_count = self.layout.vertex_count;
+        self.face.clear();
+        // Bounded by the data: every iteration consumes input or fails.
+        for _ in 0..n {
+            let value = body.value(item).map_err(|f| at.error(f, body.location()))?;
+            let location = body.location();
+            let valid = value >= 0.0 && value.fract() == 0.0 && value < vertex_count as f64;
+            if !valid {
+                return Err(PlyError::IndexOutOfRange {
+                    location,
+                    face: at.record,
+                    index: value,
+                    vertex_count,
+                });
+            }
+            // Exact: checked integral and below vertex_count <= 2^32.
+            self.face.push(value as u32);
+        }
+        if let Some((&first, rest)) = self.face.split_first() {
+            for pair in rest.windows(2) {
+                self.cloud.triangles.push([first, pair[0], pair[1]]);
+            }
+        }
+        Ok(())
+    }
+
+    /// The cloud, with normals and colours when the vertices declare all three components.
+    fn finish(mut self) -> PointCloud {
+        self.cloud.normals = self.layout.has_normals.then_some(self.normals);
+        self.cloud.colors = self.layout.has_colors.then_some(self.colors);
+        self.cloud
+    }
 }

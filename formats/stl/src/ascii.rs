@@ -162,11 +162,6 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Stl, StlError> {
     let mut triangle = [[0.0_f32; 3]; 3];
     let mut state = State::Outside { seen_solid: false };
     let (mut solid_line, mut facet_line) = (0, 0);
-    let unexpected = |cur: &Cursor, expected: &'static str, text: &[u8]| StlError::Unexpected {
-        line: cur.line,
-        expected,
-        found: excerpt(text.trim_ascii()),
-    };
 
     while cur.start_line() {
         let Some(keyword) = cur.word() else {
@@ -181,23 +176,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Stl, StlError> {
                 let Some(vertex) = triangle.get_mut(n) else {
                     return Err(unexpected(&cur, "`endloop`", cur.line_text()));
                 };
-                for (i, coord) in vertex.iter_mut().enumerate() {
-                    let line = cur.line;
-                    let word = cur
-                        .word()
-                        .ok_or(StlError::MissingCoordinates { line, found: i })?;
-                    *coord = parse_coord(word).ok_or_else(|| StlError::BadCoordinate {
-                        line,
-                        token: excerpt(word),
-                    })?;
-                }
-                if let Some(extra) = cur.word() {
-                    return Err(unexpected(
-                        &cur,
-                        "the end of the line after 3 coordinates",
-                        extra,
-                    ));
-                }
+                *vertex = coordinates(&mut cur)?;
                 State::Loop(n + 1)
             }
             State::Loop(_) => {
@@ -235,16 +214,7 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Stl, StlError> {
             State::Outside { seen_solid } => {
                 if is(keyword, "solid") {
                     if !seen_solid {
-                        let mut text = String::new();
-                        while let Some(word) = cur.word() {
-                            let word = String::from_utf8_lossy(word);
-                            let word = word.chars().filter(|c| !c.is_control());
-                            if !text.is_empty() && word.clone().next().is_some() {
-                                text.push(' ');
-                            }
-                            text.extend(word);
-                        }
-                        name = (!text.is_empty()).then_some(text);
+                        name = solid_name(&mut cur);
                     }
                     solid_line = cur.line;
                     State::Solid
@@ -280,6 +250,55 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Stl, StlError> {
             end_line,
         }),
     }
+}
+
+/// The error for a line that is not what the grammar `expected` at this point; `text` is what
+/// was found.
+fn unexpected(cur: &Cursor, expected: &'static str, text: &[u8]) -> StlError {
+    StlError::Unexpected {
+        line: cur.line,
+        expected,
+        found: excerpt(text.trim_ascii()),
+    }
+}
+
+/// The three coordinates of a `vertex` line, which must end after them.
+#[inline]
+fn coordinates(cur: &mut Cursor) -> Result<[f32; 3], StlError> {
+    let mut vertex = [0.0_f32; 3];
+    for (i, coord) in vertex.iter_mut().enumerate() {
+        let line = cur.line;
+        let word = cur
+            .word()
+            .ok_or(StlError::MissingCoordinates { line, found: i })?;
+        *coord = parse_coord(word).ok_or_else(|| StlError::BadCoordinate {
+            line,
+            token: excerpt(word),
+        })?;
+    }
+    if let Some(extra) = cur.word() {
+        return Err(unexpected(
+            cur,
+            "the end of the line after 3 coordinates",
+            extra,
+        ));
+    }
+    Ok(vertex)
+}
+
+/// The name after `solid`: the rest of the line's words without control characters, joined by
+/// single spaces; `None` when empty.
+fn solid_name(cur: &mut Cursor) -> Option<String> {
+    let mut text = String::new();
+    while let Some(word) = cur.word() {
+        let word = String::from_utf8_lossy(word);
+        let word = word.chars().filter(|c| !c.is_control());
+        if !text.is_empty() && word.clone().next().is_some() {
+            text.push(' ');
+        }
+        text.extend(word);
+    }
+    (!text.is_empty()).then_some(text)
 }
 
 /// True for the keywords that may only appear inside a `solid` block.

@@ -648,139 +648,186 @@ fn solvable(arc: &kurbo::SvgArc) -> bool {
 fn path_data(d: &str) -> Result<Vec<Sub>, svgtypes::Error> {
     let mut subs = Vec::new();
     let mut current: Option<Sub> = None;
-    let mut cur = Point::ZERO;
-    let mut start = Point::ZERO;
-    // Control points for S and T reflection: set only by the previous C/S or Q/T.
-    let mut last_cubic: Option<Point> = None;
-    let mut last_quad: Option<Point> = None;
+    let mut pen = Pen {
+        cur: Point::ZERO,
+        start: Point::ZERO,
+        last_cubic: None,
+        last_quad: None,
+    };
     for seg in PathParser::from(d) {
         let seg = seg?;
-        let abs = seg.is_abs();
-        let at = |x: f64, y: f64| {
-            if abs {
-                Point::new(x, y)
-            } else {
-                cur + Vec2::new(x, y)
-            }
-        };
-        let (mut next_cubic, mut next_quad) = (None, None);
         match seg {
             PathSegment::MoveTo { x, y, .. } => {
-                let p = at(x, y);
+                let p = pen.at(seg.is_abs(), x, y);
                 subs.extend(current.take());
                 current = Some(Sub {
                     start: p,
                     segs: Vec::new(),
                     closed: false,
                 });
-                (cur, start) = (p, p);
+                pen.move_to(p);
             }
             PathSegment::ClosePath { .. } => {
                 if let Some(mut sub) = current.take() {
                     sub.closed = true;
                     subs.push(sub);
                 }
-                cur = start;
+                pen.move_to(pen.start);
             }
             _ => {
+                let start = pen.cur;
                 let sub = current.get_or_insert_with(|| Sub {
-                    start: cur,
+                    start,
                     segs: Vec::new(),
                     closed: false,
                 });
-                let (segment, end) = match seg {
-                    PathSegment::LineTo { x, y, .. } => {
-                        let p = at(x, y);
-                        (Seg::Line(p), p)
-                    }
-                    PathSegment::HorizontalLineTo { x, .. } => {
-                        let p = Point::new(if abs { x } else { cur.x + x }, cur.y);
-                        (Seg::Line(p), p)
-                    }
-                    PathSegment::VerticalLineTo { y, .. } => {
-                        let p = Point::new(cur.x, if abs { y } else { cur.y + y });
-                        (Seg::Line(p), p)
-                    }
-                    PathSegment::CurveTo {
-                        x1,
-                        y1,
-                        x2,
-                        y2,
-                        x,
-                        y,
-                        ..
-                    } => {
-                        let (c2, p) = (at(x2, y2), at(x, y));
-                        next_cubic = Some(c2);
-                        (Seg::Cubic(at(x1, y1), c2, p), p)
-                    }
-                    PathSegment::SmoothCurveTo { x2, y2, x, y, .. } => {
-                        let c1 = last_cubic.map_or(cur, |c| cur + (cur - c));
-                        let (c2, p) = (at(x2, y2), at(x, y));
-                        next_cubic = Some(c2);
-                        (Seg::Cubic(c1, c2, p), p)
-                    }
-                    PathSegment::Quadratic { x1, y1, x, y, .. } => {
-                        let (c, p) = (at(x1, y1), at(x, y));
-                        next_quad = Some(c);
-                        (Seg::Quad(c, p), p)
-                    }
-                    PathSegment::SmoothQuadratic { x, y, .. } => {
-                        let c = last_quad.map_or(cur, |c| cur + (cur - c));
-                        let p = at(x, y);
-                        next_quad = Some(c);
-                        (Seg::Quad(c, p), p)
-                    }
-                    PathSegment::EllipticalArc {
-                        rx,
-                        ry,
-                        x_axis_rotation,
-                        large_arc,
-                        sweep,
-                        x,
-                        y,
-                        ..
-                    } => {
-                        let p = at(x, y);
-                        // kurbo treats radii below 1e-5 as zero; the centre construction is
-                        // scale-invariant, so solve it at unit scale around `cur` and scale back.
-                        let k = rx.abs().max(ry.abs());
-                        let arc = kurbo::SvgArc {
-                            from: Point::ZERO,
-                            to: Point::ZERO + (p - cur) / k,
-                            radii: Vec2::new(rx / k, ry / k),
-                            x_rotation: x_axis_rotation.to_radians(),
-                            large_arc,
-                            sweep,
-                        };
-                        // Equal end points draw nothing; zero radii draw a line (SVG F.6.2).
-                        let solved = if p == cur || !(k > 0.0 && k.is_finite()) || !solvable(&arc) {
-                            None
-                        } else {
-                            kurbo::Arc::from_svg_arc(&arc)
-                        };
-                        let segment = match solved {
-                            Some(a) if a.radii.x.is_finite() && a.radii.y.is_finite() => Seg::Arc {
-                                center: cur + a.center.to_vec2() * k,
-                                radii: a.radii * k,
-                                x_rotation: a.x_rotation,
-                                start_angle: a.start_angle,
-                                sweep_angle: a.sweep_angle,
-                                end: p,
-                            },
-                            _ => Seg::Line(p),
-                        };
-                        (segment, p)
-                    }
-                    PathSegment::MoveTo { .. } | PathSegment::ClosePath { .. } => continue,
-                };
-                sub.segs.push(segment);
-                cur = end;
+                if let Some(segment) = pen.draw(seg) {
+                    sub.segs.push(segment);
+                }
             }
         }
-        last_cubic = next_cubic;
-        last_quad = next_quad;
     }
     subs.extend(current);
     Ok(subs)
+}
+
+/// Where path data has drawn to.
+struct Pen {
+    /// The current point.
+    cur: Point,
+    /// Start of the current subpath, where `Z` returns.
+    start: Point,
+    /// Control points for S and T reflection: set only by the previous C/S or Q/T.
+    last_cubic: Option<Point>,
+    last_quad: Option<Point>,
+}
+
+impl Pen {
+    /// The point of coordinates (`x`, `y`): absolute, or relative to the current point.
+    fn at(&self, abs: bool, x: f64, y: f64) -> Point {
+        if abs {
+            Point::new(x, y)
+        } else {
+            self.cur + Vec2::new(x, y)
+        }
+    }
+
+    /// Moves to `p` (by `M`, or back to the start by `Z`), which starts a subpath there.
+    fn move_to(&mut self, p: Point) {
+        (self.cur, self.start) = (p, p);
+        self.last_cubic = None;
+        self.last_quad = None;
+    }
+
+    /// The line, curve or arc that `seg` draws from the current point, which moves to its end;
+    /// `None` for `M` and `Z`.
+    fn draw(&mut self, seg: PathSegment) -> Option<Seg> {
+        let abs = seg.is_abs();
+        let cur = self.cur;
+        let at = |x: f64, y: f64| self.at(abs, x, y);
+        let (mut next_cubic, mut next_quad) = (None, None);
+        let (segment, end) = match seg {
+            PathSegment::LineTo { x, y, .. } => {
+                let p = at(x, y);
+                (Seg::Line(p), p)
+            }
+            PathSegment::HorizontalLineTo { x, .. } => {
+                let p = Point::new(if abs { x } else { cur.x + x }, cur.y);
+                (Seg::Line(p), p)
+            }
+            PathSegment::VerticalLineTo { y, .. } => {
+                let p = Point::new(cur.x, if abs { y } else { cur.y + y });
+                (Seg::Line(p), p)
+            }
+            PathSegment::CurveTo {
+                x1,
+                y1,
+                x2,
+                y2,
+                x,
+                y,
+                ..
+            } => {
+                let (c2, p) = (at(x2, y2), at(x, y));
+                next_cubic = Some(c2);
+                (Seg::Cubic(at(x1, y1), c2, p), p)
+            }
+            PathSegment::SmoothCurveTo { x2, y2, x, y, .. } => {
+                let c1 = self.last_cubic.map_or(cur, |c| cur + (cur - c));
+                let (c2, p) = (at(x2, y2), at(x, y));
+                next_cubic = Some(c2);
+                (Seg::Cubic(c1, c2, p), p)
+            }
+            PathSegment::Quadratic { x1, y1, x, y, .. } => {
+                let (c, p) = (at(x1, y1), at(x, y));
+                next_quad = Some(c);
+                (Seg::Quad(c, p), p)
+            }
+            PathSegment::SmoothQuadratic { x, y, .. } => {
+                let c = self.last_quad.map_or(cur, |c| cur + (cur - c));
+                let p = at(x, y);
+                next_quad = Some(c);
+                (Seg::Quad(c, p), p)
+            }
+            PathSegment::EllipticalArc {
+                rx,
+                ry,
+                x_axis_rotation,
+                large_arc,
+                sweep,
+                x,
+                y,
+                ..
+            } => {
+                let p = at(x, y);
+                let arc = kurbo::SvgArc {
+                    from: cur,
+                    to: p,
+                    radii: Vec2::new(rx, ry),
+                    x_rotation: x_axis_rotation.to_radians(),
+                    large_arc,
+                    sweep,
+                };
+                (arc_segment(&arc), p)
+            }
+            PathSegment::MoveTo { .. } | PathSegment::ClosePath { .. } => return None,
+        };
+        self.cur = end;
+        self.last_cubic = next_cubic;
+        self.last_quad = next_quad;
+        Some(segment)
+    }
+}
+
+/// The segment an SVG elliptical arc command draws: an arc, or a line when its radii are zero
+/// or it has no solution. Equal end points draw nothing; zero radii draw a line (SVG F.6.2).
+fn arc_segment(svg: &kurbo::SvgArc) -> Seg {
+    let (cur, p) = (svg.from, svg.to);
+    // kurbo treats radii below 1e-5 as zero; the centre construction is
+    // scale-invariant, so solve it at unit scale around `cur` and scale back.
+    let k = svg.radii.x.abs().max(svg.radii.y.abs());
+    let arc = kurbo::SvgArc {
+        from: Point::ZERO,
+        to: Point::ZERO + (p - cur) / k,
+        radii: Vec2::new(svg.radii.x / k, svg.radii.y / k),
+        x_rotation: svg.x_rotation,
+        large_arc: svg.large_arc,
+        sweep: svg.sweep,
+    };
+    let solved = if p == cur || !(k > 0.0 && k.is_finite()) || !solvable(&arc) {
+        None
+    } else {
+        kurbo::Arc::from_svg_arc(&arc)
+    };
+    match solved {
+        Some(a) if a.radii.x.is_finite() && a.radii.y.is_finite() => Seg::Arc {
+            center: cur + a.center.to_vec2() * k,
+            radii: a.radii * k,
+            x_rotation: a.x_rotation,
+            start_angle: a.start_angle,
+            sweep_angle: a.sweep_angle,
+            end: p,
+        },
+        _ => Seg::Line(p),
+    }
 }

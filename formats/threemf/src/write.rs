@@ -10,7 +10,7 @@ use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, DateTime, ZipWriter};
 
 use crate::error::ThreeMfError;
-use crate::model::{Model, ObjectContent};
+use crate::model::{Mesh, Model, Object, ObjectContent};
 use crate::opc;
 use crate::xml::{NS_CORE, NS_CT, NS_MATERIAL, NS_RELS};
 use crate::{Limits, read};
@@ -189,6 +189,32 @@ fn object_order(model: &Model) -> Result<Vec<usize>, ThreeMfError> {
 
 /// Serialises the model part.
 fn model_xml(model: &Model) -> Result<String, ThreeMfError> {
+    let nverts: usize = model
+        .objects
+        .iter()
+        .map(|o| match &o.content {
+            ObjectContent::Mesh(m) => m.vertices.len() + m.triangles.len(),
+            ObjectContent::Components(c) => c.len(),
+        })
+        .sum();
+    let mut s = String::with_capacity(1024 + nverts.min(1 << 24) * 64);
+    s.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    model_start_tag(model, &mut s);
+    metadata_xml(model, &mut s)?;
+    s.push_str(" <resources>\n");
+    materials_xml(model, &mut s);
+    for i in object_order(model)? {
+        object_xml(&model.objects[i], &mut s)?;
+    }
+    s.push_str(" </resources>\n");
+    build_xml(model, &mut s)?;
+    s.push_str("</model>\n");
+    Ok(s)
+}
+
+/// Writes the `<model>` start tag: unit, language, the namespaces the content uses and the
+/// required extensions.
+fn model_start_tag(model: &Model, s: &mut String) {
     let mut prefixes: Vec<(String, &str)> = Vec::new(); // (prefix, uri)
     let mut required = Vec::new();
     // Only extensions whose markup this writer emits can be required: the materials extension.
@@ -212,17 +238,6 @@ fn model_xml(model: &Model) -> Result<String, ThreeMfError> {
             meta_ns.push(prefix.to_string());
         }
     }
-
-    let nverts: usize = model
-        .objects
-        .iter()
-        .map(|o| match &o.content {
-            ObjectContent::Mesh(m) => m.vertices.len() + m.triangles.len(),
-            ObjectContent::Components(c) => c.len(),
-        })
-        .sum();
-    let mut s = String::with_capacity(1024 + nverts.min(1 << 24) * 64);
-    s.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = write!(s, "<model unit=\"{}\"", model.unit.as_str());
     if let Some(lang) = &model.language {
         let _ = write!(s, " xml:lang=\"{}\"", escape(lang.as_str()));
@@ -242,6 +257,11 @@ fn model_xml(model: &Model) -> Result<String, ThreeMfError> {
         let _ = write!(s, " requiredextensions=\"{}\"", required.join(" "));
     }
     s.push_str(">\n");
+}
+
+/// Writes the `<metadata>` elements; names must be unique and well-known or
+/// namespace-qualified.
+fn metadata_xml(model: &Model, s: &mut String) -> Result<(), ThreeMfError> {
     let mut names = HashSet::new();
     for m in &model.metadata {
         if !names.insert(m.name.as_str()) {
@@ -261,7 +281,11 @@ fn model_xml(model: &Model) -> Result<String, ThreeMfError> {
             escape(m.value.as_str())
         );
     }
-    s.push_str(" <resources>\n");
+    Ok(())
+}
+
+/// Writes the base material groups and the colour groups.
+fn materials_xml(model: &Model, s: &mut String) {
     for b in &model.base_materials {
         let _ = writeln!(s, "  <basematerials id=\"{}\">", b.id);
         for m in &b.materials {
@@ -281,80 +305,89 @@ fn model_xml(model: &Model) -> Result<String, ThreeMfError> {
         }
         s.push_str("  </m:colorgroup>\n");
     }
-    for i in object_order(model)? {
-        let o = &model.objects[i];
-        let _ = write!(s, "  <object id=\"{}\" type=\"{}\"", o.id, o.kind.as_str());
-        if let Some(n) = &o.name {
-            let _ = write!(s, " name=\"{}\"", escape(n.as_str()));
+}
+
+/// Writes one `<object>` with its mesh or components.
+fn object_xml(o: &Object, s: &mut String) -> Result<(), ThreeMfError> {
+    let _ = write!(s, "  <object id=\"{}\" type=\"{}\"", o.id, o.kind.as_str());
+    if let Some(n) = &o.name {
+        let _ = write!(s, " name=\"{}\"", escape(n.as_str()));
+    }
+    if let Some(p) = o.pid {
+        let _ = write!(s, " pid=\"{p}\"");
+    }
+    if let Some(p) = o.pindex {
+        let _ = write!(s, " pindex=\"{p}\"");
+    }
+    s.push_str(">\n");
+    match &o.content {
+        ObjectContent::Mesh(m) => mesh_xml(o.id, m, s)?,
+        ObjectContent::Components(cs) => {
+            s.push_str("   <components>\n");
+            for c in cs {
+                check_path(&c.path, "a component")?;
+                let _ = write!(s, "    <component objectid=\"{}\"", c.object_id);
+                if let Some(t) = &c.transform {
+                    s.push_str(" transform=\"");
+                    matrix(t, s)?;
+                    s.push('"');
+                }
+                s.push_str("/>\n");
+            }
+            s.push_str("   </components>\n");
         }
-        if let Some(p) = o.pid {
+    }
+    s.push_str("  </object>\n");
+    Ok(())
+}
+
+/// Writes the `<mesh>` of object `id`: its vertices (all coordinates finite) and triangles.
+fn mesh_xml(id: u32, m: &Mesh, s: &mut String) -> Result<(), ThreeMfError> {
+    s.push_str("   <mesh>\n    <vertices>\n");
+    for v in &m.vertices {
+        if !v.iter().all(|c| c.is_finite()) {
+            return Err(unwritable(format!(
+                "object {id}: vertex with a non-finite coordinate"
+            )));
+        }
+        s.push_str("     <vertex x=\"");
+        format_number(v[0], s);
+        s.push_str("\" y=\"");
+        format_number(v[1], s);
+        s.push_str("\" z=\"");
+        format_number(v[2], s);
+        s.push_str("\"/>\n");
+    }
+    s.push_str("    </vertices>\n    <triangles>\n");
+    for t in &m.triangles {
+        let _ = write!(
+            s,
+            "     <triangle v1=\"{}\" v2=\"{}\" v3=\"{}\"",
+            t.v[0], t.v[1], t.v[2]
+        );
+        if let Some(p) = t.pid {
             let _ = write!(s, " pid=\"{p}\"");
         }
-        if let Some(p) = o.pindex {
-            let _ = write!(s, " pindex=\"{p}\"");
-        }
-        s.push_str(">\n");
-        match &o.content {
-            ObjectContent::Mesh(m) => {
-                s.push_str("   <mesh>\n    <vertices>\n");
-                for v in &m.vertices {
-                    if !v.iter().all(|c| c.is_finite()) {
-                        return Err(unwritable(format!(
-                            "object {}: vertex with a non-finite coordinate",
-                            o.id
-                        )));
-                    }
-                    s.push_str("     <vertex x=\"");
-                    format_number(v[0], &mut s);
-                    s.push_str("\" y=\"");
-                    format_number(v[1], &mut s);
-                    s.push_str("\" z=\"");
-                    format_number(v[2], &mut s);
-                    s.push_str("\"/>\n");
-                }
-                s.push_str("    </vertices>\n    <triangles>\n");
-                for t in &m.triangles {
-                    let _ = write!(
-                        s,
-                        "     <triangle v1=\"{}\" v2=\"{}\" v3=\"{}\"",
-                        t.v[0], t.v[1], t.v[2]
-                    );
-                    if let Some(p) = t.pid {
-                        let _ = write!(s, " pid=\"{p}\"");
-                    }
-                    for (k, p) in t.p.iter().enumerate() {
-                        if let Some(p) = p {
-                            let _ = write!(s, " p{}=\"{p}\"", k + 1);
-                        }
-                    }
-                    s.push_str("/>\n");
-                }
-                s.push_str("    </triangles>\n   </mesh>\n");
-            }
-            ObjectContent::Components(cs) => {
-                s.push_str("   <components>\n");
-                for c in cs {
-                    check_path(&c.path, "a component")?;
-                    let _ = write!(s, "    <component objectid=\"{}\"", c.object_id);
-                    if let Some(t) = &c.transform {
-                        s.push_str(" transform=\"");
-                        matrix(t, &mut s)?;
-                        s.push('"');
-                    }
-                    s.push_str("/>\n");
-                }
-                s.push_str("   </components>\n");
+        for (k, p) in t.p.iter().enumerate() {
+            if let Some(p) = p {
+                let _ = write!(s, " p{}=\"{p}\"", k + 1);
             }
         }
-        s.push_str("  </object>\n");
+        s.push_str("/>\n");
     }
-    s.push_str(" </resources>\n <build>\n");
+    s.push_str("    </triangles>\n   </mesh>\n");
+    Ok(())
+}
+
+/// Writes the `<build>` element with its items.
+fn build_xml(model: &Model, s: &mut String) -> Result<(), ThreeMfError> {
+    s.push_str(" <build>\n");
     for item in &model.build {
         check_path(&item.path, "a build item")?;
         let _ = write!(s, "  <item objectid=\"{}\"", item.object_id);
         if let Some(t) = &item.transform {
             s.push_str(" transform=\"");
-            matrix(t, &mut s)?;
+            matrix(t, s)?;
             s.push('"');
         }
         if let Some(pn) = &item.part_number {
@@ -362,8 +395,8 @@ fn model_xml(model: &Model) -> Result<String, ThreeMfError> {
         }
         s.push_str("/>\n");
     }
-    s.push_str(" </build>\n</model>\n");
-    Ok(s)
+    s.push_str(" </build>\n");
+    Ok(())
 }
 
 #[cfg(test)]

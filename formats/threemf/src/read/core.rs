@@ -6,75 +6,11 @@ use super::*;
 
 impl<'x> Parser<'x, '_, '_, '_> {
     pub(super) fn model(&mut self) -> Result<(), ThreeMfError> {
-        let (e, empty) = loop {
-            match self.x.next()? {
-                Ev::Start(e) => break (e, false),
-                Ev::Empty(e) => break (e, true),
-                Ev::Eof => return Err(self.x.xml_err("no root element")),
-                _ => {}
-            }
-        };
-        if self.x.element_ns(&e) != Ns::Core || e.local_name().as_ref() != "model" {
-            return Err(self
-                .x
-                .xml_err("root element must be <model> in the 3MF core namespace"));
-        }
-        if self.x.ns_uri(e.name(), true) == xml::NS_LEGACY {
-            self.warn("legacy 3MF 0.93 namespace, read as core 1.x");
-        }
-        // mc:Ignorable first, so attributes in ignorable namespaces pass the namespace check.
-        for a in e.attributes().flatten() {
-            let k = a.key.as_ref();
-            if let Some(prefix) = k.strip_suffix(":Ignorable") {
-                if self.x.resolve_prefix(prefix).as_deref() == Some(xml::NS_MC) {
-                    let v = a
-                        .normalized_value(quick_xml::XmlVersion::Implicit1_0)
-                        .unwrap_or_default()
-                        .into_owned();
-                    for p in v.split(xml::is_xml_ws).filter(|p| !p.is_empty()) {
-                        if let Some(uri) = self.x.resolve_prefix(p) {
-                            self.x.ignorable.push(uri);
-                        }
-                    }
-                }
-            }
-        }
-        let mut required = None;
-        for (ns, local, v) in self.attrs(&e)? {
-            match (ns, local.as_str()) {
-                (Ns::None, "unit") => {
-                    self.info.model.unit = Unit::from_attr(&v)
-                        .ok_or_else(|| self.invalid("model", "unit", &v, "unknown unit"))?;
-                }
-                (Ns::None, "requiredextensions") => required = Some(v.into_owned()),
-                (Ns::Xml, "lang") => self.info.model.language = Some(v.into_owned()),
-                _ => {}
-            }
-        }
+        let (e, empty) = self.root_element()?;
+        self.ignorable_namespaces(&e);
+        let required = self.model_attributes(&e)?;
         if let Some(req) = required {
-            for prefix in req.split(xml::is_xml_ws).filter(|p| !p.is_empty()) {
-                let Some(uri) = self.x.resolve_prefix(prefix) else {
-                    return Err(ThreeMfError::UndeclaredExtensionPrefix {
-                        at: self.x.loc(),
-                        prefix: prefix.to_string(),
-                    });
-                };
-                if !xml::SUPPORTED_REQUIRED.contains(&uri.as_str()) {
-                    return Err(ThreeMfError::UnsupportedExtension {
-                        at: self.x.loc(),
-                        namespace: uri,
-                    });
-                }
-                if !matches!(
-                    uri.as_str(),
-                    xml::NS_CORE | xml::NS_MATERIAL | xml::NS_PRODUCTION | xml::NS_SLICE
-                ) {
-                    self.warn(format_args!(
-                        "required extension {uri} is recognised but its data is not interpreted"
-                    ));
-                }
-                self.info.model.required_extensions.push(uri);
-            }
+            self.required_extensions(&req)?;
         }
         let (mut have_resources, mut have_build) = (false, false);
         if !empty {
@@ -125,6 +61,95 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 parent: "model",
                 element: "build",
             });
+        }
+        Ok(())
+    }
+
+    /// The root element, which must be `<model>` in the core namespace, and whether it is
+    /// empty.
+    fn root_element(&mut self) -> Result<(BytesStart<'x>, bool), ThreeMfError> {
+        let (e, empty) = loop {
+            match self.x.next()? {
+                Ev::Start(e) => break (e, false),
+                Ev::Empty(e) => break (e, true),
+                Ev::Eof => return Err(self.x.xml_err("no root element")),
+                _ => {}
+            }
+        };
+        if self.x.element_ns(&e) != Ns::Core || e.local_name().as_ref() != "model" {
+            return Err(self
+                .x
+                .xml_err("root element must be <model> in the 3MF core namespace"));
+        }
+        if self.x.ns_uri(e.name(), true) == xml::NS_LEGACY {
+            self.warn("legacy 3MF 0.93 namespace, read as core 1.x");
+        }
+        Ok((e, empty))
+    }
+
+    /// Records the namespaces that the root's `mc:Ignorable` names. Read before the other
+    /// attributes, so attributes in ignorable namespaces pass the namespace check.
+    fn ignorable_namespaces(&mut self, e: &BytesStart<'x>) {
+        for a in e.attributes().flatten() {
+            let k = a.key.as_ref();
+            if let Some(prefix) = k.strip_suffix(":Ignorable") {
+                if self.x.resolve_prefix(prefix).as_deref() == Some(xml::NS_MC) {
+                    let v = a
+                        .normalized_value(quick_xml::XmlVersion::Implicit1_0)
+                        .unwrap_or_default()
+                        .into_owned();
+                    for p in v.split(xml::is_xml_ws).filter(|p| !p.is_empty()) {
+                        if let Some(uri) = self.x.resolve_prefix(p) {
+                            self.x.ignorable.push(uri);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Reads the root's `unit` and `xml:lang`; returns its `requiredextensions`, if any.
+    fn model_attributes(&mut self, e: &BytesStart<'x>) -> Result<Option<String>, ThreeMfError> {
+        let mut required = None;
+        for (ns, local, v) in self.attrs(e)? {
+            match (ns, local.as_str()) {
+                (Ns::None, "unit") => {
+                    self.info.model.unit = Unit::from_attr(&v)
+                        .ok_or_else(|| self.invalid("model", "unit", &v, "unknown unit"))?;
+                }
+                (Ns::None, "requiredextensions") => required = Some(v.into_owned()),
+                (Ns::Xml, "lang") => self.info.model.language = Some(v.into_owned()),
+                _ => {}
+            }
+        }
+        Ok(required)
+    }
+
+    /// Checks each prefix of `requiredextensions` (declared, an extension this reader
+    /// supports) and records its namespace.
+    fn required_extensions(&mut self, req: &str) -> Result<(), ThreeMfError> {
+        for prefix in req.split(xml::is_xml_ws).filter(|p| !p.is_empty()) {
+            let Some(uri) = self.x.resolve_prefix(prefix) else {
+                return Err(ThreeMfError::UndeclaredExtensionPrefix {
+                    at: self.x.loc(),
+                    prefix: prefix.to_string(),
+                });
+            };
+            if !xml::SUPPORTED_REQUIRED.contains(&uri.as_str()) {
+                return Err(ThreeMfError::UnsupportedExtension {
+                    at: self.x.loc(),
+                    namespace: uri,
+                });
+            }
+            if !matches!(
+                uri.as_str(),
+                xml::NS_CORE | xml::NS_MATERIAL | xml::NS_PRODUCTION | xml::NS_SLICE
+            ) {
+                self.warn(format_args!(
+                    "required extension {uri} is recognised but its data is not interpreted"
+                ));
+            }
+            self.info.model.required_extensions.push(uri);
         }
         Ok(())
     }
@@ -254,73 +279,13 @@ impl<'x> Parser<'x, '_, '_, '_> {
             self.slicestack_uses.push((at.clone(), sid));
         }
         if let Some(thumb) = Self::get(&attrs, Ns::None, "thumbnail") {
-            let target = opc::resolve_target(self.part(), thumb);
-            match target {
-                Some(t) if self.ar.exists(&t) => {
-                    if !self.thumbnail_targets.contains(&opc::key(&t)) {
-                        self.warn(format_args!(
-                            "object {id} thumbnail {thumb} is not the target of a thumbnail relationship"
-                        ));
-                    }
-                }
-                _ => self.warn(format_args!(
-                    "object {id} thumbnail {thumb} does not exist in the package"
-                )),
-            }
+            self.object_thumbnail(id, thumb);
         }
-        let mut content: Option<ObjectContent> = None;
-        if !empty {
-            let mut groups = MetaScope::default();
-            self.children(|p, e, empty| {
-                let ns = p.x.element_ns(&e);
-                match (ns, e.local_name().as_ref()) {
-                    (Ns::Core, "mesh") => {
-                        if content.is_some() {
-                            return Err(p.rule(
-                                "object",
-                                "an object has one mesh or one components element",
-                            ));
-                        }
-                        p.attrs(&e)?;
-                        let mesh = if empty {
-                            Mesh::default()
-                        } else {
-                            p.mesh(id, kind, pid)?
-                        };
-                        content = Some(ObjectContent::Mesh(mesh));
-                        Ok(())
-                    }
-                    (Ns::Core, "components") => {
-                        if content.is_some() {
-                            return Err(p.rule(
-                                "object",
-                                "an object has one mesh or one components element",
-                            ));
-                        }
-                        p.attrs(&e)?;
-                        let comps = if empty { Vec::new() } else { p.components()? };
-                        content = Some(ObjectContent::Components(comps));
-                        Ok(())
-                    }
-                    (Ns::Core, "metadatagroup") => {
-                        if empty {
-                            return Ok(());
-                        }
-                        groups = MetaScope::default();
-                        p.children(|p, e, empty| {
-                            if p.x.element_ns(&e) == Ns::Core
-                                && e.local_name().as_ref() == "metadata"
-                            {
-                                p.metadata(&e, empty, &mut groups)
-                            } else {
-                                p.unknown(&e, empty)
-                            }
-                        })
-                    }
-                    _ => p.unknown(&e, empty),
-                }
-            })?;
-        }
+        let content = if empty {
+            None
+        } else {
+            self.object_content(id, kind, pid)?
+        };
         let content = content.unwrap_or(ObjectContent::Mesh(Mesh::default()));
         if let ObjectContent::Components(c) = &content
             && c.is_empty()
@@ -340,6 +305,82 @@ impl<'x> Parser<'x, '_, '_, '_> {
             content,
         });
         Ok(())
+    }
+
+    /// Warns when object `id`'s `thumbnail` is missing or not the target of a thumbnail
+    /// relationship.
+    fn object_thumbnail(&mut self, id: u32, thumb: &str) {
+        let target = opc::resolve_target(self.part(), thumb);
+        match target {
+            Some(t) if self.ar.exists(&t) => {
+                if !self.thumbnail_targets.contains(&opc::key(&t)) {
+                    self.warn(format_args!(
+                        "object {id} thumbnail {thumb} is not the target of a thumbnail relationship"
+                    ));
+                }
+            }
+            _ => self.warn(format_args!(
+                "object {id} thumbnail {thumb} does not exist in the package"
+            )),
+        }
+    }
+
+    /// Reads the children of object `id`: its one mesh or components element (`None` when it
+    /// has neither) and its metadata groups.
+    fn object_content(
+        &mut self,
+        id: u32,
+        kind: ObjectType,
+        pid: Option<u32>,
+    ) -> Result<Option<ObjectContent>, ThreeMfError> {
+        let mut content: Option<ObjectContent> = None;
+        let mut groups = MetaScope::default();
+        self.children(|p, e, empty| {
+            let ns = p.x.element_ns(&e);
+            match (ns, e.local_name().as_ref()) {
+                (Ns::Core, "mesh") => {
+                    if content.is_some() {
+                        return Err(
+                            p.rule("object", "an object has one mesh or one components element")
+                        );
+                    }
+                    p.attrs(&e)?;
+                    let mesh = if empty {
+                        Mesh::default()
+                    } else {
+                        p.mesh(id, kind, pid)?
+                    };
+                    content = Some(ObjectContent::Mesh(mesh));
+                    Ok(())
+                }
+                (Ns::Core, "components") => {
+                    if content.is_some() {
+                        return Err(
+                            p.rule("object", "an object has one mesh or one components element")
+                        );
+                    }
+                    p.attrs(&e)?;
+                    let comps = if empty { Vec::new() } else { p.components()? };
+                    content = Some(ObjectContent::Components(comps));
+                    Ok(())
+                }
+                (Ns::Core, "metadatagroup") => {
+                    if empty {
+                        return Ok(());
+                    }
+                    groups = MetaScope::default();
+                    p.children(|p, e, empty| {
+                        if p.x.element_ns(&e) == Ns::Core && e.local_name().as_ref() == "metadata" {
+                            p.metadata(&e, empty, &mut groups)
+                        } else {
+                            p.unknown(&e, empty)
+                        }
+                    })
+                }
+                _ => p.unknown(&e, empty),
+            }
+        })?;
+        Ok(content)
     }
 
     pub(super) fn mesh(

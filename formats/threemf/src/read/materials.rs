@@ -229,9 +229,28 @@ impl<'x> Parser<'x, '_, '_, '_> {
         if pids.is_empty() {
             return Err(self.invalid("multiproperties", "pids", pv, "empty list"));
         }
+        let counts = self.multi_layer_counts(id, &pids)?;
+        if let Some(bm) = Self::get(&attrs, Ns::None, "blendmethods") {
+            self.blend_methods(bm, pids.len())?;
+        }
+        self.add_res(id, Res::Multi(0))?;
+        let n = if empty {
+            0
+        } else {
+            self.multi_children(id, &pids, &counts)?
+        };
+        self.info.res.insert(id, Res::Multi(n));
+        Ok(())
+    }
+
+    /// The number of entries of each property group that multiproperties `id` layers (`pids`),
+    /// checking that they are groups defined earlier, with at most one material group, first,
+    /// and at most one colour group. A texture is tolerated with a warning (count
+    /// `usize::MAX`).
+    fn multi_layer_counts(&mut self, id: u32, pids: &[u32]) -> Result<Vec<usize>, ThreeMfError> {
         let mut counts = Vec::with_capacity(pids.len());
         let (mut colors, mut materials) = (0, 0);
-        for &pid in &pids {
+        for &pid in pids {
             let r = self.info.res.get(&pid).copied();
             let unresolved = |expected| ThreeMfError::UnresolvedReference {
                 at: self.x.loc(),
@@ -292,61 +311,72 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 "pids may reference at most one colorgroup",
             ));
         }
-        if let Some(bm) = Self::get(&attrs, Ns::None, "blendmethods") {
-            let methods: Vec<&str> = bm.split(xml::is_xml_ws).filter(|t| !t.is_empty()).collect();
-            if methods.len() >= pids.len() {
-                return Err(self.invalid(
-                    "multiproperties",
-                    "blendmethods",
-                    bm,
-                    "at most one blend method per pid after the first",
-                ));
-            }
-            if let Some(bad) = methods.iter().find(|m| !matches!(**m, "mix" | "multiply")) {
-                return Err(self.invalid(
-                    "multiproperties",
-                    "blendmethods",
-                    bad,
-                    "blend method must be mix or multiply",
-                ));
-            }
+        Ok(counts)
+    }
+
+    /// Checks `blendmethods`: at most one method per layer after the first, each `mix` or
+    /// `multiply`.
+    fn blend_methods(&self, bm: &str, layers: usize) -> Result<(), ThreeMfError> {
+        let methods: Vec<&str> = bm.split(xml::is_xml_ws).filter(|t| !t.is_empty()).collect();
+        if methods.len() >= layers {
+            return Err(self.invalid(
+                "multiproperties",
+                "blendmethods",
+                bm,
+                "at most one blend method per pid after the first",
+            ));
         }
-        self.add_res(id, Res::Multi(0))?;
+        if let Some(bad) = methods.iter().find(|m| !matches!(**m, "mix" | "multiply")) {
+            return Err(self.invalid(
+                "multiproperties",
+                "blendmethods",
+                bad,
+                "blend method must be mix or multiply",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Reads the `<multi>` children of multiproperties `id`, warning once about a `pindices`
+    /// entry out of its layer's range; returns how many there are.
+    fn multi_children(
+        &mut self,
+        id: u32,
+        pids: &[u32],
+        counts: &[usize],
+    ) -> Result<usize, ThreeMfError> {
         let mut n = 0usize;
         let mut warned = false;
-        if !empty {
-            self.children(|p, e, empty| {
-                if !p.material_child(&e, "multi") {
-                    return p.unknown(&e, empty);
-                }
-                let attrs = p.attrs(&e)?;
-                let v = Self::get(&attrs, Ns::None, "pindices")
-                    .ok_or_else(|| p.missing("multi", "pindices"))?;
-                let mut idx = p.u32_list("multi", "pindices", v)?;
-                // Missing indices default to 0, extra ones are ignored (materials 5.1).
-                idx.truncate(counts.len());
-                // Out-of-range layer indices are only warned about: the 3MF Consortium's own
-                // MUSTPASS_Chapter3.4.2 / 3.4.3a files use them.
-                if !warned
-                    && let Some((k, &i)) = idx
-                        .iter()
-                        .enumerate()
-                        .find(|&(k, &i)| i as usize >= counts[k])
-                {
-                    warned = true;
-                    p.warn(format_args!(
-                        "multiproperties {id}: pindices {i} is out of range of pid {} (count {})",
-                        pids[k], counts[k]
-                    ));
-                }
-                n += 1;
-                if !empty {
-                    p.x.skip()?;
-                }
-                Ok(())
-            })?;
-        }
-        self.info.res.insert(id, Res::Multi(n));
-        Ok(())
+        self.children(|p, e, empty| {
+            if !p.material_child(&e, "multi") {
+                return p.unknown(&e, empty);
+            }
+            let attrs = p.attrs(&e)?;
+            let v = Self::get(&attrs, Ns::None, "pindices")
+                .ok_or_else(|| p.missing("multi", "pindices"))?;
+            let mut idx = p.u32_list("multi", "pindices", v)?;
+            // Missing indices default to 0, extra ones are ignored (materials 5.1).
+            idx.truncate(counts.len());
+            // Out-of-range layer indices are only warned about: the 3MF Consortium's own
+            // MUSTPASS_Chapter3.4.2 / 3.4.3a files use them.
+            if !warned
+                && let Some((k, &i)) = idx
+                    .iter()
+                    .enumerate()
+                    .find(|&(k, &i)| i as usize >= counts[k])
+            {
+                warned = true;
+                p.warn(format_args!(
+                    "multiproperties {id}: pindices {i} is out of range of pid {} (count {})",
+                    pids[k], counts[k]
+                ));
+            }
+            n += 1;
+            if !empty {
+                p.x.skip()?;
+            }
+            Ok(())
+        })?;
+        Ok(n)
     }
 }

@@ -46,6 +46,30 @@ pub fn read(bytes: &[u8], limits: &Limits) -> Result<Package, ThreeMfError> {
         triangles: 0,
         resources: 0,
     };
+    let root_path = root_model_path(&mut ar, &mut ctx)?;
+    let (parts, seen) = read_model_parts(&mut ar, &root_path, &mut ctx)?;
+
+    validate_cross_part(&parts, &seen, &root_path)?;
+    check_component_graph(&parts, limits)?;
+
+    let models = parts.into_iter().map(|(k, v)| (k, v.model)).collect();
+    Ok(Package {
+        root_path,
+        models,
+        warnings: {
+            let mut w = ctx.warnings;
+            if ctx.suppressed > 0 {
+                w.push(format!("({} more warnings not shown)", ctx.suppressed));
+            }
+            w
+        },
+        limits: limits.clone(),
+    })
+}
+
+/// The path of the root model part: the one target of the package's 3D model relationship,
+/// which must be a part inside the package.
+fn root_model_path(ar: &mut Archive<'_>, ctx: &mut Ctx<'_>) -> Result<String, ThreeMfError> {
     if !ar.exists("/_rels/.rels") {
         return Err(ThreeMfError::MissingPart {
             part: "/_rels/.rels".into(),
@@ -53,7 +77,7 @@ pub fn read(bytes: &[u8], limits: &Limits) -> Result<Package, ThreeMfError> {
         });
     }
     let rels = ar.relationships("/")?;
-    check_relationships(&ar, "/", &rels, &mut ctx)?;
+    check_relationships(ar, "/", &rels, ctx)?;
     let starts: Vec<&Relationship> = rels.iter().filter(|r| r.kind == opc::REL_MODEL).collect();
     if starts.len() != 1 {
         return Err(ThreeMfError::StartPart {
@@ -81,46 +105,27 @@ pub fn read(bytes: &[u8], limits: &Limits) -> Result<Package, ThreeMfError> {
             reason: "the 3D model must be a part inside the package",
         });
     };
+    Ok(root_path)
+}
 
+/// The model parts read, by path, and every part path seen, by lookup key.
+type ModelParts = (BTreeMap<String, PartInfo>, HashMap<String, String>);
+
+/// Reads every model part reachable from the root, breadth-first. Returns the parts by path
+/// and every part path seen, by lookup key.
+fn read_model_parts(
+    ar: &mut Archive<'_>,
+    root_path: &str,
+    ctx: &mut Ctx<'_>,
+) -> Result<ModelParts, ThreeMfError> {
+    let limits = ctx.limits;
     let mut parts: BTreeMap<String, PartInfo> = BTreeMap::new();
     let mut queue: VecDeque<(String, bool)> = VecDeque::new();
-    queue.push_back((root_path.clone(), true));
+    queue.push_back((root_path.to_owned(), true));
     let mut seen: HashMap<String, String> = HashMap::new();
-    seen.insert(opc::key(&root_path), root_path.clone());
+    seen.insert(opc::key(root_path), root_path.to_owned());
     while let Some((path, is_root)) = queue.pop_front() {
-        match ar.content_type(&path) {
-            Some(opc::CT_MODEL) => {}
-            found => {
-                if !ar.exists(&path) {
-                    return Err(ThreeMfError::MissingPart {
-                        part: path,
-                        needed_for: "referenced as a 3D model part".into(),
-                    });
-                }
-                return Err(ThreeMfError::ContentType {
-                    part: path,
-                    found: found.map(str::to_string),
-                    expected: opc::CT_MODEL,
-                });
-            }
-        }
-        let Some(bytes) = ar.read(&path)? else {
-            return Err(ThreeMfError::MissingPart {
-                part: path,
-                needed_for: "referenced as a 3D model part".into(),
-            });
-        };
-        let rels = ar.relationships(&path)?;
-        check_relationships(&ar, &path, &rels, &mut ctx)?;
-        let info = parse_part(&path, &bytes, is_root, &ar, &rels, &mut ctx)?;
-        let mut refs: Vec<String> = info.referenced_parts.clone();
-        if is_root {
-            refs.extend(
-                rels.iter()
-                    .filter(|r| r.kind == opc::REL_MODEL)
-                    .filter_map(|r| r.part.clone()),
-            );
-        }
+        let (info, refs) = read_model_part(ar, &path, is_root, ctx)?;
         for r in refs {
             let k = opc::key(&r);
             if !seen.contains_key(&k) {
@@ -138,23 +143,52 @@ pub fn read(bytes: &[u8], limits: &Limits) -> Result<Package, ThreeMfError> {
         }
         parts.insert(path, info);
     }
+    Ok((parts, seen))
+}
 
-    validate_cross_part(&parts, &seen, &root_path)?;
-    check_component_graph(&parts, limits)?;
-
-    let models = parts.into_iter().map(|(k, v)| (k, v.model)).collect();
-    Ok(Package {
-        root_path,
-        models,
-        warnings: {
-            let mut w = ctx.warnings;
-            if ctx.suppressed > 0 {
-                w.push(format!("({} more warnings not shown)", ctx.suppressed));
+/// Reads the model part at `path` (which must have the model content type) and checks its
+/// relationships. Returns it with the model parts it references (and, for the root, those
+/// its 3D model relationships target).
+fn read_model_part(
+    ar: &mut Archive<'_>,
+    path: &str,
+    is_root: bool,
+    ctx: &mut Ctx<'_>,
+) -> Result<(PartInfo, Vec<String>), ThreeMfError> {
+    match ar.content_type(path) {
+        Some(opc::CT_MODEL) => {}
+        found => {
+            if !ar.exists(path) {
+                return Err(ThreeMfError::MissingPart {
+                    part: path.to_owned(),
+                    needed_for: "referenced as a 3D model part".into(),
+                });
             }
-            w
-        },
-        limits: limits.clone(),
-    })
+            return Err(ThreeMfError::ContentType {
+                part: path.to_owned(),
+                found: found.map(str::to_string),
+                expected: opc::CT_MODEL,
+            });
+        }
+    }
+    let Some(bytes) = ar.read(path)? else {
+        return Err(ThreeMfError::MissingPart {
+            part: path.to_owned(),
+            needed_for: "referenced as a 3D model part".into(),
+        });
+    };
+    let rels = ar.relationships(path)?;
+    check_relationships(ar, path, &rels, ctx)?;
+    let info = parse_part(path, &bytes, is_root, ar, &rels, ctx)?;
+    let mut refs: Vec<String> = info.referenced_parts.clone();
+    if is_root {
+        refs.extend(
+            rels.iter()
+                .filter(|r| r.kind == opc::REL_MODEL)
+                .filter_map(|r| r.part.clone()),
+        );
+    }
+    Ok((info, refs))
 }
 
 /// Most warnings kept per package; the rest are counted.
