@@ -4,6 +4,7 @@
 //! `skipped: corpus not found` and pass when it is absent.
 
 mod architecture;
+mod board_copper;
 mod calibrate;
 mod clfff;
 mod cli;

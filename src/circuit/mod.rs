@@ -19,7 +19,7 @@ pub mod settings;
 pub mod stage;
 mod three_de;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 pub use placed::{ARC_SEGMENTS, PlacedPad, PlacedPart, place};
@@ -143,9 +143,25 @@ pub struct Part {
     /// Schematic pins (`gate.pin`, e.g. `G$1.A`) and the pads each one connects to. Empty for
     /// parts read from a board.
     pub pins: BTreeMap<String, Vec<String>>,
+    /// The pins of `pins` whose pads are joined inside the part (EAGLE's `route="any"`, e.g. a
+    /// regulator's several GND pads): a net reaches such a pin through any one of its pads.
+    pub route_any: BTreeSet<String>,
 }
 
 impl Part {
+    /// The `route="any"` pin that `pad` belongs to together with other pads, if any: the pads of
+    /// that pin are one connection point.
+    pub fn joined_pin(&self, pad: &str) -> Option<&str> {
+        self.route_any
+            .iter()
+            .find(|pin| {
+                self.pins
+                    .get(pin.as_str())
+                    .is_some_and(|pads| pads.len() > 1 && pads.iter().any(|p| p == pad))
+            })
+            .map(String::as_str)
+    }
+
     /// The pad named `name`: exactly, then by schematic pin (`G$1.A`, or `A` when only one gate
     /// has such a pin, as Electronic Slic3r's `.3de` files name them; the pin's first pad), then
     /// ASCII case-insensitively as EAGLE compares names.
@@ -263,6 +279,7 @@ impl Circuit {
                     package: pkg.name.clone(),
                     pads: pkg.pads.iter().map(Pad::from_eagle).collect(),
                     pins: p.pin_pads.clone(),
+                    route_any: p.route_any.clone(),
                 })
             })
             .collect();
@@ -284,6 +301,7 @@ impl Circuit {
                 package: e.package.name.clone(),
                 pads: e.package.pads.iter().map(Pad::from_eagle).collect(),
                 pins: BTreeMap::new(),
+                route_any: BTreeSet::new(),
             })
             .collect();
         Circuit {

@@ -2,10 +2,13 @@
 //! An input of the route stage (pad outlines to connect to, footprints to keep clear).
 //!
 //! A package point `(x, y)` lands at
-//! `position + Rx(tilt[0]) · Ry(tilt[1]) · Rz(rotation) · (±x, y, 0)`,
-//! where `position` is the part's pose resolved to model coordinates and `x` is negated for
-//! mirrored (EAGLE bottom-side) parts *before* rotating, as EAGLE's `MR` rotations do. Pads keep
-//! their own rotation within the package, applied first.
+//! `position + Rx(tilt[0]) · Ry(tilt[1]) · M · Rz(rotation) · (x, y, 0)`,
+//! where `position` is the part's pose resolved to model coordinates and `M` negates x for
+//! mirrored (EAGLE bottom-side) parts *after* rotating, as EAGLE's `MR` rotations do: KiCad's
+//! EAGLE importer turns an `MR<a>` element to `a + 180°` and then flips it top to bottom, which
+//! is the same map. (Mirroring first would equal `MR<−a>`: the same for `MR0` and `MR180`, a
+//! quarter turn wrong for `MR90` and `MR270`.) Pads keep their own rotation within the
+//! package, applied first.
 
 use std::collections::BTreeMap;
 
@@ -160,7 +163,6 @@ struct Pose {
     /// Columns: images of the package x and y axes.
     ex: Vector3,
     ey: Vector3,
-    mirror: bool,
 }
 
 impl Pose {
@@ -168,21 +170,20 @@ impl Pose {
         let (c, s) = cos_sin(p.rotation);
         let (cx, sx) = cos_sin(p.tilt[0]);
         let (cy, sy) = cos_sin(p.tilt[1]);
-        // Rx · Ry applied to Rz's columns (c, s, 0) and (-s, c, 0).
+        // Rx · Ry applied to the columns of M · Rz: (±c, s, 0) and (∓s, c, 0).
         let tilt = |v: Vector3| {
             let v = Vector3::new(cy * v.x + sy * v.z, v.y, -sy * v.x + cy * v.z);
             Vector3::new(v.x, cx * v.y - sx * v.z, sx * v.y + cx * v.z)
         };
+        let m = if p.mirror { -1.0 } else { 1.0 };
         Pose {
             origin: Point3::new(p.x, p.y, p.z),
-            ex: tilt(Vector3::new(c, s, 0.0)),
-            ey: tilt(Vector3::new(-s, c, 0.0)),
-            mirror: p.mirror,
+            ex: tilt(Vector3::new(m * c, s, 0.0)),
+            ey: tilt(Vector3::new(-m * s, c, 0.0)),
         }
     }
 
     fn map(&self, x: f64, y: f64) -> Point3 {
-        let x = if self.mirror { -x } else { x };
         self.origin + self.ex * x + self.ey * y
     }
 
@@ -340,7 +341,7 @@ mod tests {
     }
 
     #[test]
-    fn mirrored_part_negates_x_before_rotating() {
+    fn mirrored_part_negates_x_after_rotating() {
         let b = match conduit_eagle::read_board(BOARD.as_bytes()) {
             Ok(b) => b,
             Err(e) => panic!("{e}"),
@@ -353,8 +354,11 @@ mod tests {
         assert_eq!(centre(&parts, "R2", "2"), Some((29.0, 20.0, 1.0)));
         // R1 at (10, 20), R90: pad 1 (-1, 0) -> (10, 19).
         assert_eq!(centre(&parts, "R1", "1"), Some((10.0, 19.0, 1.0)));
-        // MR90: (-1, 0) -> mirrored (1, 0) -> turned (0, 1).
+        // MR90: (-1, 0) -> turned (0, -1) -> mirrored (0, -1); MR270: -> (0, 1).
         p.parts[1].rotation = 90.0;
+        let parts = placed(&c, &p, &[]);
+        assert_eq!(centre(&parts, "R2", "1"), Some((30.0, 19.0, 1.0)));
+        p.parts[1].rotation = 270.0;
         let parts = placed(&c, &p, &[]);
         assert_eq!(centre(&parts, "R2", "1"), Some((30.0, 21.0, 1.0)));
         assert!(

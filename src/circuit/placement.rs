@@ -89,7 +89,7 @@ pub struct PartPlacement {
     /// `Rx(tilt[0]) · Ry(tilt[1]) · Rz(rotation)`, as Electronic Slic3r turns its part meshes.
     #[serde(default)]
     pub tilt: [f64; 2],
-    /// EAGLE's mirror (a bottom-side part): package x is negated before rotating.
+    /// EAGLE's mirror (a bottom-side part): x is negated after `rotation`, as in `MR90`.
     #[serde(default)]
     pub mirror: bool,
     /// How the part is inserted.

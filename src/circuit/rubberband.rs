@@ -103,7 +103,8 @@ pub fn rubberbands(
             None => {
                 let pins: Vec<(PinRef, Point3)> = net.pins.iter().filter_map(&mut locate).collect();
                 let points: Vec<Point3> = pins.iter().map(|(_, p)| *p).collect();
-                for (i, j) in prim(&points) {
+                let groups = joined_groups(circuit, &pins);
+                for (i, j) in prim(&points, &groups) {
                     let end = |k: usize| (Some(pins[k].0.clone()), pins[k].1);
                     out.bands.push(band(end(i), end(j)));
                 }
@@ -115,33 +116,54 @@ pub fn rubberbands(
     Ok(out)
 }
 
-/// Minimum spanning tree edges `(tree vertex, new vertex)` in the order they are added.
-fn prim(points: &[Point3]) -> Vec<(usize, usize)> {
+/// Per located pin, the index of the first pin of its group: pads of one `route="any"` pin of a
+/// part form a group (joined inside the part); every other pin is a group of its own.
+fn joined_groups(circuit: &Circuit, pins: &[(PinRef, Point3)]) -> Vec<usize> {
+    fn key<'a>(circuit: &'a Circuit, pin: &'a PinRef) -> Option<(&'a str, &'a str)> {
+        circuit
+            .part(&pin.part)
+            .and_then(|part| part.joined_pin(&pin.pad))
+            .map(|joined| (pin.part.as_str(), joined))
+    }
+    let key = |pin| key(circuit, pin);
+    (0..pins.len())
+        .map(|i| match key(&pins[i].0) {
+            Some(k) => (0..i).find(|&j| key(&pins[j].0) == Some(k)).unwrap_or(i),
+            None => i,
+        })
+        .collect()
+}
+
+/// Minimum spanning tree edges `(tree vertex, new vertex)` in the order they are added, where
+/// the vertices sharing a `groups` value are already joined: when one of them is reached, all
+/// of them are in the tree (no edge between them).
+fn prim(points: &[Point3], groups: &[usize]) -> Vec<(usize, usize)> {
     let n = points.len();
     let mut edges = Vec::with_capacity(n.saturating_sub(1));
     if n < 2 {
         return edges;
     }
     let mut in_tree = vec![false; n];
-    in_tree[0] = true;
     // Per vertex outside the tree: squared distance to the tree and the tree vertex at it.
-    let mut best: Vec<(f64, usize)> = points
-        .iter()
-        .map(|p| ((p - points[0]).norm_squared(), 0))
-        .collect();
-    for _ in 1..n {
-        let next = (0..n)
-            .filter(|&j| !in_tree[j])
-            .min_by(|&a, &b| best[a].0.total_cmp(&best[b].0).then(a.cmp(&b)));
-        let Some(j) = next else { break };
-        in_tree[j] = true;
-        edges.push((best[j].1, j));
-        for k in 0..n {
-            let d = (points[k] - points[j]).norm_squared();
-            if !in_tree[k] && d < best[k].0 {
-                best[k] = (d, j);
+    let mut best: Vec<(f64, usize)> = vec![(f64::INFINITY, 0); n];
+    let join = |j: usize, in_tree: &mut Vec<bool>, best: &mut Vec<(f64, usize)>| {
+        for m in (0..n).filter(|&m| groups[m] == groups[j]) {
+            in_tree[m] = true;
+            for k in 0..n {
+                let d = (points[k] - points[m]).norm_squared();
+                if !in_tree[k] && d < best[k].0 {
+                    best[k] = (d, m);
+                }
             }
         }
+    };
+    join(0, &mut in_tree, &mut best);
+    while let Some(j) = (0..n)
+        .filter(|&j| !in_tree[j])
+        .min_by(|&a, &b| best[a].0.total_cmp(&best[b].0).then(a.cmp(&b)))
+    {
+        edges.push((best[j].1, j));
+        join(j, &mut in_tree, &mut best);
     }
     edges
 }
@@ -207,6 +229,7 @@ mod tests {
             package: "P".into(),
             pads,
             pins: BTreeMap::new(),
+            route_any: Default::default(),
         };
         let c = Circuit {
             parts: vec![
@@ -240,11 +263,25 @@ mod tests {
             ]
         );
         assert_eq!(r.bands[2].to, Point3::new(3.0, 0.0, 1.0));
+        // A's pads 1 and 2 on one route="any" pin: no wire between them; B's pads join A at
+        // whichever of its pads is nearer (ties to the earlier tree pin).
+        let mut joined = c.clone();
+        joined.parts[0].pins = BTreeMap::from([("G$1.GND".into(), vec!["1".into(), "2".into()])]);
+        joined.parts[0].route_any = ["G$1.GND".to_owned()].into();
+        assert_eq!(
+            edges(&bands(&joined, &p)),
+            [e("N", "A.1", "B.1"), e("N", "A.2", "B.2")]
+        );
         // Equal distances (a unit square): lowest pin index first, from the earliest tree pin.
         let square =
             [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(x, y)| Point3::new(x, y, 0.0));
-        assert_eq!(prim(&square), [(0, 1), (0, 2), (1, 3)]);
-        assert!(prim(&square[..1]).is_empty());
+        let alone = [0, 1, 2, 3];
+        assert_eq!(prim(&square, &alone), [(0, 1), (0, 2), (1, 3)]);
+        assert!(prim(&square[..1], &alone[..1]).is_empty());
+        // Joined vertices 0 and 3 (one route="any" pin): no edge between them, and the
+        // others reach the group by its nearest member.
+        assert_eq!(prim(&square, &[0, 1, 2, 0]), [(0, 1), (0, 2)]);
+        assert!(prim(&square[..2], &[0, 0]).is_empty());
     }
 
     #[test]

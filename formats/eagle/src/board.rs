@@ -1,6 +1,6 @@
 //! Boards (`.brd`): placed elements, signals, outline.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 use crate::doc::{Doc, Node};
 use crate::error::EagleError;
@@ -49,6 +49,25 @@ pub struct OutlineSegment {
     pub curve: f64,
 }
 
+/// A straight copper track of a signal (a `<wire>` inside `<signal>`): where the board's own
+/// routing runs, so a reader can check where it puts the pads against it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SignalWire {
+    /// Start x in mm.
+    pub x1: f64,
+    /// Start y in mm.
+    pub y1: f64,
+    /// End x in mm.
+    pub x2: f64,
+    /// End y in mm.
+    pub y2: f64,
+    /// Track width in mm.
+    pub width: f64,
+    /// EAGLE layer number (1 top copper, 16 bottom copper, 2-15 inner layers; others are
+    /// drawings such as airwires on 19).
+    pub layer: u32,
+}
+
 /// A board: elements, signals resolved to pads, and outline.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Board {
@@ -62,6 +81,10 @@ pub struct Board {
     /// Wires of `<plain>` on layer 20 (Dimension). Outline drawn inside packages is not
     /// included.
     pub outline: Vec<OutlineSegment>,
+    /// The copper tracks of each signal, by signal name (signals without tracks are absent).
+    pub signal_wires: BTreeMap<String, Vec<SignalWire>>,
+    /// Signals with a copper pour (`<polygon>`): their pads may be joined by the pour alone.
+    pub poured_signals: BTreeSet<String>,
 }
 
 impl Board {
@@ -119,6 +142,8 @@ pub(crate) fn read(doc: &Doc<'_>, version: String, brd: &Node) -> Result<Board, 
     }
 
     let mut nets = Vec::new();
+    let mut tracks = BTreeMap::new();
+    let mut poured = BTreeSet::new();
     for s in brd.list("signals", "signal") {
         let mut pads = BTreeSet::new();
         for c in s.children_named("contactref") {
@@ -146,11 +171,18 @@ pub(crate) fn read(doc: &Doc<'_>, version: String, brd: &Node) -> Result<Board, 
                 .find(|(n, _)| n == c)
                 .map_or_else(|| c.to_owned(), |(_, name)| name.clone())
         });
-        nets.push(Net {
-            name: doc.req(s, "name")?.to_owned(),
-            class,
-            pads,
-        });
+        let name = doc.req(s, "name")?.to_owned();
+        let wires = signal_wires(doc, s)?;
+        if s.children_named("polygon").next().is_some() {
+            poured.insert(name.clone());
+        }
+        if !wires.is_empty() {
+            tracks
+                .entry(name.clone())
+                .or_insert_with(Vec::new)
+                .extend(wires);
+        }
+        nets.push(Net { name, class, pads });
     }
 
     let mut outline = Vec::new();
@@ -175,5 +207,29 @@ pub(crate) fn read(doc: &Doc<'_>, version: String, brd: &Node) -> Result<Board, 
         elements,
         nets,
         outline,
+        signal_wires: tracks,
+        poured_signals: poured,
     })
+}
+
+/// The copper `<wire>`s of one `<signal>` (layers 1-16).
+fn signal_wires(doc: &Doc<'_>, signal: &Node) -> Result<Vec<SignalWire>, EagleError> {
+    let mut out = Vec::new();
+    for w in signal.children_named("wire") {
+        let Some(layer) = doc.opt_u32(w, "layer")? else {
+            continue;
+        };
+        if !(1..=16).contains(&layer) {
+            continue;
+        }
+        out.push(SignalWire {
+            x1: doc.f64(w, "x1")?,
+            y1: doc.f64(w, "y1")?,
+            x2: doc.f64(w, "x2")?,
+            y2: doc.f64(w, "y2")?,
+            width: doc.opt_f64(w, "width")?.unwrap_or(0.0),
+            layer,
+        });
+    }
+    Ok(out)
 }

@@ -59,7 +59,7 @@ mod netlist;
 mod rotation;
 mod schematic;
 
-pub use board::{Board, Element, OutlineSegment};
+pub use board::{Board, Element, OutlineSegment, SignalWire};
 pub use error::EagleError;
 pub use library::{LAYER_BOTTOM, LAYER_DIMENSION, LAYER_PADS, LAYER_TOP, Package, Pad, PadShape};
 pub use netlist::{Net, Netlist, NetlistComparison};

@@ -1,6 +1,6 @@
 //! Embedded libraries: packages with their pads, device sets with their pin-to-pad connects.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use crate::doc::{Doc, Node};
 use crate::error::EagleError;
@@ -98,6 +98,8 @@ pub(crate) struct Device {
     pub(crate) package: Option<String>,
     /// `gate.pin` -> pads, in connect order.
     pub(crate) connects: BTreeMap<String, Vec<String>>,
+    /// `gate.pin`s connected with `route="any"`: their pads are joined inside the part.
+    pub(crate) route_any: BTreeSet<String>,
     pub(crate) pos: usize,
 }
 
@@ -203,21 +205,26 @@ fn read_library(doc: &Doc<'_>, lib: &Node) -> Result<Library, EagleError> {
                 .filter(|p| !p.is_empty())
                 .map(str::to_owned);
             let mut connects: BTreeMap<String, Vec<String>> = BTreeMap::new();
+            let mut route_any = BTreeSet::new();
             for c in d.list("connects", "connect") {
                 let gate = doc.req(c, "gate")?;
                 let pin = doc.req(c, "pin")?;
-                // One pin may sit on several pads: `pad="1 3"` (EAGLE 7+ "multiple pads").
+                // One pin may sit on several pads: `pad="1 3"` (EAGLE 7+ "multiple pads"),
+                // all to be wired (`route="all"`, the default) or joined inside the part so
+                // that one wired pad connects the pin (`route="any"`).
                 let pads = doc.req(c, "pad")?.split_whitespace().map(str::to_owned);
-                connects
-                    .entry(format!("{gate}.{pin}"))
-                    .or_default()
-                    .extend(pads);
+                let key = format!("{gate}.{pin}");
+                if c.attr("route") == Some("any") {
+                    route_any.insert(key.clone());
+                }
+                connects.entry(key).or_default().extend(pads);
             }
             devices.insert(
                 d_name,
                 Device {
                     package,
                     connects,
+                    route_any,
                     pos: d.pos,
                 },
             );

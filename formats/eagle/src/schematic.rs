@@ -27,6 +27,9 @@ pub struct Part {
     /// `gate.pin` (e.g. `G$1.P1`, `A.1`) -> pad names. A pin connected to several pads
     /// (`<connect pad="1 3">`) lists all of them.
     pub pin_pads: BTreeMap<String, Vec<String>>,
+    /// The pins of `pin_pads` connected with `route="any"`: their pads are joined inside the
+    /// part, so wiring one of them connects the pin.
+    pub route_any: BTreeSet<String>,
 }
 
 /// A schematic, flattened: all sheets and module instances merged into one part list and one
@@ -287,6 +290,7 @@ impl<'d, 'l> Flattener<'d, 'l> {
                     value: p.attr("value").map(str::to_owned),
                     package,
                     pin_pads: pin_pads.clone(),
+                    route_any: dev.route_any.clone(),
                 });
             } else {
                 self.dropped.push(full.clone());

@@ -27,7 +27,7 @@ const LIB: &str = r#"<libraries><library name="L">
 <devicesets>
  <deviceset name="R"><gates><gate name="G$1" symbol="S2" x="0" y="0"/></gates>
   <devices><device name="" package="P3"><connects>
-   <connect gate="G$1" pin="A" pad="1 3"/><connect gate="G$1" pin="B" pad="2"/>
+   <connect gate="G$1" pin="A" pad="1 3" route="any"/><connect gate="G$1" pin="B" pad="2"/>
   </connects></device></devices></deviceset>
  <deviceset name="IC"><gates><gate name="A" symbol="S2" x="0" y="0"/>
    <gate name="P" symbol="PWR" x="0" y="0" addlevel="request"/></gates>
@@ -87,6 +87,7 @@ fn one_pin_on_two_pads_puts_both_pads_on_the_net() {
     assert_eq!(r1.value.as_deref(), Some("10k"));
     assert_eq!(r1.pin_pads["G$1.A"], ["1", "3"]);
     assert_eq!(r1.pin_pads["G$1.B"], ["2"]);
+    assert_eq!(r1.route_any, ["G$1.A".to_owned()].into());
     let pkg = r1.package.as_ref().expect("package");
     assert_eq!(pkg.name, "P3");
     assert_eq!(pkg.library, "L");
