@@ -127,6 +127,7 @@ impl<S: GcodeSink> Writer<'_, S> {
         })
     }
 
+    /// One layer: PrusaSlicer's markers, `G1 Z` at the travel speed, then its items.
     fn switched_layer(
         &mut self,
         layer: &Layer,
