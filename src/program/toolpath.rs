@@ -412,6 +412,55 @@ mod tests {
     }
 
     #[test]
+    fn segments_follow_their_points_when_reversed_rotated_and_flattened() {
+        let quarter = |a: [f64; 2], b: [f64; 2], c: [f64; 2], sweep: f64| Segment::Arc {
+            a,
+            b,
+            c,
+            r: 1.0,
+            sweep,
+        };
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        // A closed "D": a straight edge up the y axis and a half circle back, as two arcs.
+        let mut d = Toolpath {
+            points: vec![
+                Point3::new(0.0, -1.0, 0.2),
+                Point3::new(1.0, 0.0, 0.2),
+                Point3::new(0.0, 1.0, 0.2),
+            ],
+            closed: true,
+            segments: Some(vec![
+                quarter([0.0, -1.0], [1.0, 0.0], [0.0, 0.0], half_pi),
+                quarter([1.0, 0.0], [0.0, 1.0], [0.0, 0.0], half_pi),
+                Segment::Line {
+                    a: [0.0, 1.0],
+                    b: [0.0, -1.0],
+                },
+            ]),
+            tool_axis: None,
+            ..square(true)
+        };
+        let length = std::f64::consts::PI + 2.0;
+        assert!((d.length() - length).abs() < 1e-12);
+        let runs = |p: &Toolpath| {
+            let n = p.points.len();
+            p.segments.iter().flatten().enumerate().all(|(i, s)| {
+                let (a, b) = (p.points[i], p.points[(i + 1) % n]);
+                s.start() == [a.x, a.y] && s.end() == [b.x, b.y]
+            })
+        };
+        d.reverse();
+        assert!(runs(&d));
+        assert!((d.length() - length).abs() < 1e-12);
+        d.rotate_start(1);
+        assert!(runs(&d));
+        let chords = d.chords(1e-3).expect("a path with segments");
+        assert_eq!(chords.first(), chords.last(), "a loop returns to its start");
+        assert!(chords.len() > 4, "arcs are flattened into several chords");
+        assert_eq!(square(true).chords(1e-3), None);
+    }
+
+    #[test]
     fn type_names_are_prusaslicer_names_and_round_trip() {
         assert_eq!(Role::SparseInfill.type_name(), "Internal infill");
         assert_eq!(Role::Skirt.type_name(), "Skirt/Brim");
