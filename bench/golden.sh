@@ -91,6 +91,29 @@ run jet_star jet samples/jet/star8.svg --width 20 --layers 32 --layer-height 5 \
     -o out/star.gcode --report out/star.json
 run jet_dog jet samples/jet/dog.svg --width 20 --layers 8 --layer-height 5 --set jet.fill=contour \
     -o out/dog.gcode --report out/dog.json
+# Every branch of the jet's G-code: chords instead of arcs, no E words, the shutter on the fly
+# (on walls, on contour fills, with chords), serpentine fills, another flavour with snippets
+# that have blank lines and trailing blanks.
+run jet_star_chords jet samples/jet/star8.svg --width 20 --layers 4 --layer-height 5 \
+    --set jet.arcs=false -o out/star_chords.gcode --report out/star_chords.json
+run jet_star_no_e jet samples/jet/star8.svg --width 20 --layers 4 --layer-height 5 \
+    --set jet.e_words=false -o out/star_no_e.gcode --report out/star_no_e.json
+run jet_star_lead jet samples/jet/star8.svg --width 20 --layers 4 --layer-height 5 \
+    --set jet.shutter_lead_time=0.05 -o out/star_lead.gcode --report out/star_lead.json
+run jet_star_lead_chords jet samples/jet/star8.svg --width 20 --layers 4 --layer-height 5 \
+    --set jet.shutter_lead_time=0.05 --set jet.arcs=false --set jet.e_words=false \
+    -o out/star_lead_chords.gcode --report out/star_lead_chords.json
+run jet_dog_lead jet samples/jet/dog.svg --width 20 --layers 4 --layer-height 5 \
+    --set jet.fill=contour --set jet.shutter_lead_time=0.05 \
+    -o out/dog_lead.gcode --report out/dog_lead.json
+run jet_dog_serpentine jet samples/jet/dog.svg --width 20 --layers 2 --layer-height 5 \
+    --set jet.fill=serpentine --set jet.speed=3.5 --set jet.travel_speed=25 \
+    -o out/dog_serpentine.gcode --report out/dog_serpentine.json
+run jet_star_snippets jet samples/jet/star8.svg --width 20 --layers 2 --layer-height 5 \
+    --set printer.flavor=klipper --set 'jet.start_gcode="G28\n\n  M400  \n"' \
+    --set 'jet.shutter_open_gcode="SET_PIN PIN=shutter VALUE=1  \nG4 P10\n"' \
+    --set 'jet.shutter_close_gcode=""' --set 'jet.end_gcode="M84\n\nM117 done"' \
+    -o out/star_snippets.gcode --report out/star_snippets.json
 run jet_model jet model --angle 30 --width 35 --height 14 --roi 150 --json
 
 # --- robot calibration and gap compensation ----------------------------------------------------

@@ -453,6 +453,7 @@ fn trace_paths(
                 width: style.width,
                 height,
                 speed: style.speed,
+                segments: None,
                 tool_axis: None,
             });
         }
@@ -627,6 +628,7 @@ fn drop_path(centre: Point3, z: f64, width: f64, height: f64, tool: usize, speed
         width,
         height,
         speed,
+        segments: None,
         tool_axis: None,
     }
 }

@@ -64,7 +64,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::check::CheckParams;
 use crate::curved::CurvedParams;
-use crate::emit::gcode::{GcodeParams, UnknownPlaceholder};
+use crate::emit::gcode::{GcodeParams, SwitchedParams, UnknownPlaceholder};
 use crate::program::Role;
 pub use crate::program::machine::{
     DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, PnpSettings, Printer, Tool, ToolKind,
@@ -638,6 +638,37 @@ impl Config {
             tools: self.tools.clone(),
             pnp: self.pnp.clone(),
             template_keys,
+            switched: None,
+        }
+    }
+
+    /// The G-code writer's parameters for an aerosol-jet job printing lines `width` mm wide:
+    /// the printer and tools of [`Config::gcode_params`], written in the switched-tool style
+    /// with the `[jet]` snippets, travel speed, `E` words and arcs (a header note names the
+    /// tool, the width, the arcs and the shutter lead).
+    pub fn jet_gcode_params(&self, width: f64) -> GcodeParams {
+        let jet = &self.jet;
+        let note = format!(
+            "jet: tool {}, line width {} mm, arcs {}, shutter lead {} s",
+            jet.tool,
+            conduit_gcode::fmt_xyz(width),
+            if jet.arcs { "G2/G3" } else { "flattened" },
+            conduit_gcode::fmt_e(jet.shutter_lead_time)
+        );
+        GcodeParams {
+            switched: Some(SwitchedParams {
+                job: "jet".to_owned(),
+                notes: vec![note],
+                start_gcode: jet.start_gcode.clone(),
+                end_gcode: jet.end_gcode.clone(),
+                on_gcode: jet.shutter_open_gcode.clone(),
+                off_gcode: jet.shutter_close_gcode.clone(),
+                lead_in_comment: "shutter lead-in".to_owned(),
+                travel_speed: jet.travel_speed,
+                e_words: jet.e_words,
+                arc_chords: (!jet.arcs).then_some(jet.arc_tolerance),
+            }),
+            ..self.gcode_params()
         }
     }
 

@@ -367,6 +367,7 @@ pub fn program(paths: &[Vec<Point3>], settings: &ConformSettings, safe_z: f64) -
                 width: settings.inner_diameter,
                 height: settings.inner_diameter,
                 speed: settings.feed,
+                segments: None,
                 tool_axis: None,
             })
         })

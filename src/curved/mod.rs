@@ -745,6 +745,7 @@ impl<'a> RegionJob<'a> {
                 width,
                 height: h,
                 speed: speeds.for_role(role),
+                segments: None,
                 tool_axis: None,
             };
             let (paths, stats) =

@@ -1,6 +1,7 @@
 //! Closed contours get a gap where the shutter opens and closes, and the gap moves every layer.
 //!
-//! Place in the pipeline: design polylines → corners → fillet → **contour** → schedule → emit.
+//! Place in the pipeline: design polylines → corners → fillet → **contour** → schedule → program →
+//! emit.
 //!
 //! The places for the gap are on straight stretches of the filleted contour, at least
 //! `margin + gap` from the nearest corner (a fillet arc, or a joint sharper than

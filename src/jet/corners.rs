@@ -1,7 +1,8 @@
 //! Corner angles and the rule table: which corners of a design get a fillet, how large at
 //! least, and which are split.
 //!
-//! Place in the pipeline: design polylines → **corners** → fillet → contour → schedule → emit.
+//! Place in the pipeline: design polylines → **corners** → fillet → contour → schedule → program →
+//! emit.
 //! The angle θ of a corner is the angle between its two segments (180° = straight, 0° = the
 //! path turns back on itself).
 

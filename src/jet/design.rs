@@ -1,7 +1,8 @@
 //! Reading a design: SVG (through `conduit-svg`) or DXF (through `conduit-dxf`) into plain
 //! polylines in millimetres.
 //!
-//! Place in the pipeline: **design** → fill → corners → fillet → contour → schedule → emit.
+//! Place in the pipeline: **design** → fill → corners → fillet → contour → schedule → program →
+//! emit.
 //! Each path of the file becomes one [`Outline`], one structure of the job.
 
 use std::path::{Path, PathBuf};

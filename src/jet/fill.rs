@@ -1,13 +1,13 @@
 //! Walls and fills: which lines a design's outlines become.
 //!
-//! Place in the pipeline: design polylines → **fill** → corners → fillet → contour → schedule
-//! → emit. Open polylines are always walls. Closed outlines are walls (`jet.fill = "wall"`: the
-//! outline itself is the line's centre), or filled: `"contour"` prints the outline inset by
+//! Place in the pipeline: design polylines → **fill** → corners → fillet → contour → schedule →
+//! program → emit. Open polylines are always walls. Closed outlines are walls (`jet.fill = "wall"`:
+//! the outline itself is the line's centre), or filled: `"contour"` prints the outline inset by
 //! half a line width and further insets `fill_spacing × width` apart until nothing is left;
 //! `"serpentine"` prints lines `fill_spacing × width` apart at `fill_angle`, inside the outline
-//! inset by half a line width, joined end to end where the next line starts within two
-//! spacings. The offsets and clipping are the project's exact integer-grid operations
-//! ([`crate::geom`]); sharp corners stay sharp (mitred) so the corner rules see them.
+//! inset by half a line width, joined end to end where the next line starts within two spacings.
+//! The offsets and clipping are the project's exact integer-grid operations ([`crate::geom`]);
+//! sharp corners stay sharp (mitred) so the corner rules see them.
 
 use super::JetFill;
 use crate::geom::{

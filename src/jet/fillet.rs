@@ -1,7 +1,8 @@
 //! Tangent fillet arcs at the corners of a polyline, per the rule table, shrunk where the
 //! adjacent segments are too short; corners too sharp to fillet split the path.
 //!
-//! Place in the pipeline: design polylines → corners → **fillet** → contour → schedule → emit.
+//! Place in the pipeline: design polylines → corners → **fillet** → contour → schedule → program →
+//! emit.
 //!
 //! A fillet of radius `r` at a corner of angle `θ` starts and ends `t = r / tan(θ/2)` from the
 //! vertex on each segment. Two fillets share a segment: when their `t` add up to more than the

@@ -2,8 +2,9 @@
 //! corners split, shutter gaps that move every layer, direction reversed every block of
 //! layers, structures interleaved layer by layer, and the corner accumulation model.
 //!
-//! Place in the pipeline: a design (2D polylines) → **jet** → G-code. The stages, one file
-//! each:
+//! Place in the pipeline: a design (2D polylines) → **jet** → Program → G-code (written by the
+//! project's G-code writer, [`crate::emit::gcode`], in its switched-tool style). The stages, one
+//! file each:
 //!
 //! 1. [`design`]: SVG or DXF → [`design::Outline`]s (one structure each).
 //! 2. [`fill`]: outlines → lines (walls, contour-parallel loops or a serpentine).
@@ -13,8 +14,10 @@
 //!    arcs.
 //! 5. [`contour`]: closed contours get a gap whose place cycles over straight stretches.
 //! 6. [`schedule`]: layers, direction blocks, structures in turn.
-//! 7. [`shutter`]: the G-code, with the shutter snippets around every path.
-//! 8. [`model`] and [`report`]: the accumulation model and the JSON report.
+//! 7. [`program`]: the layers as a [`crate::program::Program`]: every path a toolpath of lines
+//!    and arcs between a shutter switch-on and switch-off (with the shutter lead time).
+//! 8. [`model`] and [`report`]: the accumulation model and the JSON report (with the writer's
+//!    totals, [`JetStats`]).
 //!
 //! Lengths are millimetres (the CLI converts from micrometres); the 2D work here is float
 //! geometry on arcs (as for curved paths), with the fills' offsets and clipping done by the
@@ -27,17 +30,17 @@ pub mod fill;
 pub mod fillet;
 pub mod model;
 pub mod path;
+pub mod program;
 pub mod report;
 pub mod schedule;
 pub mod settings;
-pub mod shutter;
 
 pub use design::{DesignError, Outline};
 pub use model::{ModelInput, ModelResult, accumulation};
-pub use report::JetReport;
+pub use program::program;
+pub use report::{JetReport, JetStats};
 pub use schedule::{JetLayer, JetParams, Structure};
 pub use settings::{JetFill, JetSettings};
-pub use shutter::{JetStats, write_jet};
 
 use crate::program::machine::{Tool, ToolKind};
 

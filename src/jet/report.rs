@@ -1,7 +1,8 @@
 //! The JSON report of `conduit jet --report`: every corner with its angle, the rule, the fillet
 //! and the accumulation model; the gap places; the layer plan; totals and warnings.
 //!
-//! Place in the pipeline: a side output of the jet stage, after scheduling and writing.
+//! Place in the pipeline: a side output of the jet stage, after scheduling and writing (the
+//! walk hands in the G-code writer's totals as [`JetStats`]).
 //! Lengths in the report are micrometres (`_um`) or millimetres (`_mm`) as their names say.
 
 use serde::Serialize;
@@ -10,7 +11,19 @@ use super::JetSettings;
 use super::fillet::{Corner, CornerAction};
 use super::model::{ModelInput, accumulation};
 use super::schedule::{JetLayer, JetParams, Structure};
-use super::shutter::JetStats;
+
+/// What the G-code writer wrote for the job: its totals in the report.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct JetStats {
+    /// Paths printed (shutter cycles).
+    pub paths: usize,
+    /// Jetted length, mm.
+    pub jetted_mm: f64,
+    /// Travel length, mm (XY).
+    pub travel_mm: f64,
+    /// Estimated time at the set speeds (no acceleration), s.
+    pub estimated_time_s: f64,
+}
 
 /// One corner in the report.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -1,7 +1,8 @@
 //! Layers, blocks, direction and structures: which paths each layer prints, in which order and
 //! which way round.
 //!
-//! Place in the pipeline: design → fill → corners → fillet → contour → **schedule** → emit.
+//! Place in the pipeline: design → fill → corners → fillet → contour → **schedule** → program →
+//! emit.
 //!
 //! - Every outline of the design is one structure. Layer `k` prints layer `k` of every
 //!   structure in turn, then layer `k + 1` of all, so each structure's layer has the others'

@@ -8,12 +8,16 @@
 //!
 //! - [`toolpath`]: the types: [`Role`], [`Toolpath`], [`Event`], [`Layer`], [`Program`], and
 //!   what a layer gets besides its regions ([`LayerExtras`]).
+//! - [`segment`]: planar line and arc [`Segment`]s, the moves of toolpaths with arcs, and their
+//!   geometry (length, cutting, starting direction, chords).
 //! - [`extrusion`]: the flow model (bead cross-section, E per millimetre, paste tools).
 //! - [`machine`]: the printer, its tools and the part-placement commands.
 
 pub mod extrusion;
 pub mod machine;
+pub mod segment;
 pub mod toolpath;
 
 pub use extrusion::{BeadShape, Feed, bead_area, e_per_mm, filament_area};
+pub use segment::Segment;
 pub use toolpath::{Event, Layer, LayerExtras, LayerInsert, LayerItem, Program, Role, Toolpath};

@@ -1,8 +1,10 @@
-//! The Program's vocabulary: [`Toolpath`]s with a [`Role`], [`Event`]s, and [`Layer`]s of both in
-//! print order.
+//! The Program's vocabulary: [`Toolpath`]s with a [`Role`] (straight moves, or planar line and
+//! arc [`Segment`]s), [`Event`]s (tool changes, part placements, the tool switched on and off
+//! with a lead time, ...), and [`Layer`]s of both in print order, each at its z.
 
 use std::collections::BTreeMap;
 
+use super::segment::{self, Segment};
 use crate::geom::{Point3, Vector3};
 
 /// What an extrusion is for. Decides speed, cooling and the `;TYPE:` comment of G-code output.
@@ -34,13 +36,17 @@ pub enum Role {
     ConductiveTrace,
     /// A conductive drop (a dot of paste on a pad).
     ConductiveDrop,
+    /// An aerosol-jet line along an outline (a free-standing micro-wall).
+    JetWall,
+    /// An aerosol-jet line of a fill (contour-parallel loops or a serpentine).
+    JetFill,
     /// Anything else (custom G-code, imported paths).
     Custom,
 }
 
 impl Role {
     /// Every role, in declaration order.
-    pub const ALL: [Role; 14] = [
+    pub const ALL: [Role; 16] = [
         Role::ExternalPerimeter,
         Role::Perimeter,
         Role::SolidInfill,
@@ -54,6 +60,8 @@ impl Role {
         Role::Buffer,
         Role::ConductiveTrace,
         Role::ConductiveDrop,
+        Role::JetWall,
+        Role::JetFill,
         Role::Custom,
     ];
 
@@ -63,7 +71,7 @@ impl Role {
     /// PrusaSlicer has the role, so its G-code viewer and post-processors understand the
     /// output: bottom solid infill is `Solid infill` as in PrusaSlicer, which has no separate
     /// role for it. The conduit-only roles use names in the same style: `Scaffold`, `Buffer`,
-    /// `Conductive trace`, `Conductive drop`.
+    /// `Conductive trace`, `Conductive drop`, `Jet wall`, `Jet fill`.
     pub fn type_name(self) -> &'static str {
         match self {
             Role::ExternalPerimeter => "External perimeter",
@@ -78,6 +86,8 @@ impl Role {
             Role::Buffer => "Buffer",
             Role::ConductiveTrace => "Conductive trace",
             Role::ConductiveDrop => "Conductive drop",
+            Role::JetWall => "Jet wall",
+            Role::JetFill => "Jet fill",
             Role::Custom => "Custom",
         }
     }
@@ -131,11 +141,20 @@ pub struct Toolpath {
     /// Tool direction per point (unit vectors, for 5/6-axis output); `None` for 3-axis paths.
     /// When present it has one entry per point.
     pub tool_axis: Option<Vec<Vector3>>,
+    /// The moves as planar lines and arcs (in the XY plane at the points' z), for paths with
+    /// arcs; `None`: straight moves between the points. When present, segment `i` runs from
+    /// `points[i]` to `points[i + 1]` (for a closed path the last one returns to the first
+    /// point), with its ends as the stage computed them.
+    pub segments: Option<Vec<Segment>>,
 }
 
 impl Toolpath {
-    /// Length of the extrusion, mm, including the closing segment of a closed path.
+    /// Length of the extrusion, mm, including the closing segment of a closed path (along the
+    /// arcs of a path with [`Toolpath::segments`]).
     pub fn length(&self) -> f64 {
+        if let Some(segments) = &self.segments {
+            return segment::length_of(segments);
+        }
         let open: f64 = self.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
         match (self.closed, self.points.first(), self.points.last()) {
             (true, Some(first), Some(last)) if self.points.len() > 2 => {
@@ -143,6 +162,27 @@ impl Toolpath {
             }
             _ => open,
         }
+    }
+
+    /// The path through chords of its [`Toolpath::segments`] that stray at most `tolerance` mm
+    /// from their arcs: the start, then every chord's end (a closed path ends at its start
+    /// again), each segment's at the z of its end; `None` for a path without segments.
+    pub fn chords(&self, tolerance: f64) -> Option<Vec<Point3>> {
+        let segments = self.segments.as_ref()?;
+        let mut out: Vec<Point3> = self.points.first().copied().into_iter().collect();
+        for (i, s) in segments.iter().enumerate() {
+            let z = self
+                .points
+                .get(i + 1)
+                .or(self.points.first())
+                .map_or(0.0, |p| p.z);
+            out.extend(
+                s.flatten(tolerance)
+                    .into_iter()
+                    .map(|p| Point3::new(p[0], p[1], z)),
+            );
+        }
+        Some(out)
     }
 
     /// The point where the extrusion starts.
@@ -159,16 +199,27 @@ impl Toolpath {
         }
     }
 
-    /// Reverses the direction of travel (points and tool axes together).
+    /// Reverses the direction of travel (points, tool axes and segments together).
     pub fn reverse(&mut self) {
         self.points.reverse();
         if let Some(axis) = &mut self.tool_axis {
             axis.reverse();
         }
+        if let Some(segments) = &mut self.segments {
+            segments.reverse();
+            for s in segments.iter_mut() {
+                *s = s.reversed();
+            }
+            // Segment i of a loop leaves point i: after the reversal the closing segment
+            // (last → first) comes first.
+            if self.closed {
+                segments.rotate_left(1);
+            }
+        }
     }
 
-    /// Makes a closed path start at its point `index` (points and tool axes rotate together).
-    /// Does nothing for an open path or an index out of range.
+    /// Makes a closed path start at its point `index` (points, tool axes and segments rotate
+    /// together). Does nothing for an open path or an index out of range.
     pub fn rotate_start(&mut self, index: usize) {
         if !self.closed || index >= self.points.len() {
             return;
@@ -178,6 +229,11 @@ impl Toolpath {
             && index < axis.len()
         {
             axis.rotate_left(index);
+        }
+        if let Some(segments) = &mut self.segments
+            && index < segments.len()
+        {
+            segments.rotate_left(index);
         }
     }
 }
@@ -218,6 +274,18 @@ pub enum Event {
     Dwell {
         /// Duration, seconds.
         seconds: f64,
+    },
+    /// Switch the active tool's output on or off (an aerosol jet's shutter). An `on` switch
+    /// before a path takes effect where the path starts, an `off` switch after a path where it
+    /// ends. With a `lead_time` the command is sent that long (at the path's speed) before the
+    /// nozzle gets there, while it keeps moving: the writer runs in to the start on the path's
+    /// starting tangent, and cuts the path where the command must go.
+    Switch {
+        /// On (true) or off.
+        on: bool,
+        /// Seconds between the command and the moment it takes effect; 0: at standstill at the
+        /// path's ends.
+        lead_time: f64,
     },
 }
 
@@ -327,6 +395,7 @@ mod tests {
             width: 0.45,
             height: 0.2,
             speed: 60.0,
+            segments: None,
             tool_axis: Some(
                 (0..4)
                     .map(|i| Vector3::new(f64::from(i), 0.0, 1.0))
@@ -354,6 +423,55 @@ mod tests {
         let mut open = square(false);
         open.rotate_start(2);
         assert_eq!(open, square(false));
+    }
+
+    #[test]
+    fn segments_follow_their_points_when_reversed_rotated_and_flattened() {
+        let quarter = |a: [f64; 2], b: [f64; 2], c: [f64; 2], sweep: f64| Segment::Arc {
+            a,
+            b,
+            c,
+            r: 1.0,
+            sweep,
+        };
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        // A closed "D": a straight edge up the y axis and a half circle back, as two arcs.
+        let mut d = Toolpath {
+            points: vec![
+                Point3::new(0.0, -1.0, 0.2),
+                Point3::new(1.0, 0.0, 0.2),
+                Point3::new(0.0, 1.0, 0.2),
+            ],
+            closed: true,
+            segments: Some(vec![
+                quarter([0.0, -1.0], [1.0, 0.0], [0.0, 0.0], half_pi),
+                quarter([1.0, 0.0], [0.0, 1.0], [0.0, 0.0], half_pi),
+                Segment::Line {
+                    a: [0.0, 1.0],
+                    b: [0.0, -1.0],
+                },
+            ]),
+            tool_axis: None,
+            ..square(true)
+        };
+        let length = std::f64::consts::PI + 2.0;
+        assert!((d.length() - length).abs() < 1e-12);
+        let runs = |p: &Toolpath| {
+            let n = p.points.len();
+            p.segments.iter().flatten().enumerate().all(|(i, s)| {
+                let (a, b) = (p.points[i], p.points[(i + 1) % n]);
+                s.start() == [a.x, a.y] && s.end() == [b.x, b.y]
+            })
+        };
+        d.reverse();
+        assert!(runs(&d));
+        assert!((d.length() - length).abs() < 1e-12);
+        d.rotate_start(1);
+        assert!(runs(&d));
+        let chords = d.chords(1e-3).expect("a path with segments");
+        assert_eq!(chords.first(), chords.last(), "a loop returns to its start");
+        assert!(chords.len() > 4, "arcs are flattened into several chords");
+        assert_eq!(square(true).chords(1e-3), None);
     }
 
     #[test]

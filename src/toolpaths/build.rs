@@ -102,6 +102,7 @@ impl RoleSpeeds {
             Role::SparseInfill | Role::Scaffold | Role::Buffer => self.sparse_infill,
             Role::Skirt => self.skirt,
             Role::ConductiveTrace | Role::ConductiveDrop => self.conductive,
+            Role::JetWall | Role::JetFill => self.conductive,
         }
     }
 
@@ -275,6 +276,7 @@ impl PathMaker {
             width,
             height: self.height,
             speed,
+            segments: None,
             tool_axis: None,
         }
     }
@@ -621,6 +623,7 @@ mod tests {
             width: 0.6,
             height: 0.2,
             speed: 10.0,
+            segments: None,
             tool_axis: None,
         };
         let mut extras = LayerExtras::default();

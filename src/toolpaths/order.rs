@@ -447,6 +447,7 @@ mod tests {
             width: 0.45,
             height: 0.2,
             speed: 80.0,
+            segments: None,
             tool_axis: None,
         }
     }

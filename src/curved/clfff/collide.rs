@@ -202,6 +202,7 @@ mod tests {
             width: 0.45,
             height: 0.2,
             speed: 40.0,
+            segments: None,
             tool_axis: None,
         })
     }

@@ -647,6 +647,7 @@ fn emit_curved(
             width: *width,
             height: ctx.h,
             speed: ctx.speeds.for_role(*role),
+            segments: None,
             tool_axis: None,
         };
         let (paths, stats) = motion::to_toolpaths(piece, &template, ctx.max_z_speed);
@@ -751,6 +752,7 @@ fn scaffold_section(
                     width,
                     height: l.height,
                     speed,
+                    segments: None,
                     tool_axis: None,
                 })
             }));

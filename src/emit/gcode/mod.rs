@@ -1,8 +1,15 @@
-//! G-code for FFF printers with filament and paste tools: Marlin, RepRapFirmware, Klipper.
+//! G-code for FFF printers with filament and paste tools, and for switched-tool jobs (an
+//! aerosol jet): Marlin, RepRapFirmware, Klipper. The project's one G-code writer.
 //!
 //! Place in the pipeline: Program → **emit** → file. [`write_gcode`] writes a whole file; the
 //! body is produced by a state machine that sends lines and motions to a [`GcodeSink`]
-//! ([`write_program`]), so the same code can feed a preview or a test [`Recorder`].
+//! ([`write_program`]), so the same code can feed a preview or a test [`Recorder`]. What it
+//! writes is decided by the Program and the [`GcodeParams`] alone: the FFF printer's style
+//! (below), or with [`GcodeParams::switched`] the switched-tool style of [`SwitchedParams`]
+//! (the jet walk's: `;TYPE:Jet wall`, the shutter snippets around every path at
+//! [`crate::program::Event::Switch`] events, run-ins and early switch-offs for their lead
+//! times, `G2`/`G3` arcs of paths with [`crate::program::Toolpath::segments`] or chords, `E` =
+//! length; the totals in [`GcodeStats::switched`]).
 //!
 //! # Output
 //!
@@ -35,7 +42,9 @@
 //!   minus `tools.n.offset` (PrusaSlicer's `extruder_offset` convention). Flavour differences
 //!   are listed in [`flavor`](self#flavours).
 //! - Events: `;PICK_AND_PLACE PART=.. X=.. Y=.. Z=.. ROTATION=..` (a marker for a host plugin),
-//!   a manual-insert pause in the flavour's way, comments, `G4 P<ms>` dwells.
+//!   a manual-insert pause in the flavour's way, comments, `G4 P<ms>` dwells, the active paste
+//!   tool's `paste_on_gcode`/`paste_off_gcode` for a switch on/off.
+//! - Arcs of paths with segments are written as chords within half the output resolution.
 //! - The end: retract, `;TYPE:Custom`, the rendered `printer.end_gcode`, then PrusaSlicer's
 //!   footer lines (`; filament used [mm] = ...`, `; estimated printing time (normal mode) =
 //!   ...`) that OctoPrint and other tools read.
@@ -66,7 +75,7 @@ mod writer;
 #[cfg(test)]
 mod tests;
 
-pub use params::GcodeParams;
+pub use params::{GcodeParams, SwitchedParams};
 pub use sink::{GcodeSink, Motion, MotionKind, Recorder};
 pub use template::UnknownPlaceholder;
 
@@ -155,10 +164,28 @@ pub struct GcodeStats {
     pub estimated_time_s: f64,
     /// Per tool used, ascending.
     pub tools: Vec<ToolStats>,
+    /// The totals of a switched-tool job ([`SwitchedParams`]); `None` otherwise. Not part of
+    /// reports.
+    #[serde(skip)]
+    pub switched: Option<SwitchedStats>,
+}
+
+/// What a switched-tool job ([`SwitchedParams`]) wrote.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SwitchedStats {
+    /// Paths printed (switch-on cycles).
+    pub paths: usize,
+    /// Length of the depositing moves, mm (along arcs; run-ins not counted).
+    pub printed_mm: f64,
+    /// Travel length, mm (XY).
+    pub travel_mm: f64,
+    /// Time of every move at its feed, without acceleration, s.
+    pub time_s: f64,
 }
 
 /// Writes the body of the G-code for `program` (start G-code to end G-code, no header or
-/// footer) to `sink`, and returns the totals.
+/// footer) to `sink`, and returns the totals. With [`GcodeParams::switched`] the body is a
+/// switched-tool job's (see [`SwitchedParams`]).
 pub fn write_program<S: GcodeSink>(
     program: &Program,
     cfg: &GcodeParams,
@@ -173,6 +200,9 @@ pub fn write_program<S: GcodeSink>(
     }
     let first_tool = program.first_tool().or(used.first().copied()).unwrap_or(0);
     let mut w = Writer::new(cfg, sink)?;
+    if let Some(switched) = &cfg.switched {
+        return w.switched_program(program, switched, first_tool);
+    }
     w.start(program, first_tool)?;
     for layer in &program.layers {
         w.layer(layer)?;
@@ -230,7 +260,8 @@ pub fn write_block<S: GcodeSink>(
 }
 
 /// Writes a complete G-code file for `program` to `w`: header, body ([`write_program`]) and
-/// footer. See the module docs for what it contains.
+/// footer (a switched-tool job has a header of its own and no footer). See the module docs for
+/// what it contains.
 pub fn write_gcode(
     program: &Program,
     cfg: &GcodeParams,
@@ -239,9 +270,14 @@ pub fn write_gcode(
     let mut body: Vec<u8> = Vec::new();
     let stats = write_program(program, cfg, &mut body)?;
     let mut head = String::new();
-    header(&stats, cfg, &mut head);
     let mut foot = String::new();
-    footer(&stats, &mut foot);
+    match &cfg.switched {
+        Some(switched) => writer::switched_header(program, cfg, switched, &mut head),
+        None => {
+            header(&stats, cfg, &mut head);
+            footer(&stats, &mut foot);
+        }
+    }
     w.write_all(head.as_bytes())?;
     w.write_all(&body)?;
     w.write_all(foot.as_bytes())?;

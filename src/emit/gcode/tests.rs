@@ -64,6 +64,7 @@ fn path(points: &[(f64, f64)], z: f64, closed: bool, role: Role, tool: usize) ->
         width: 0.45,
         height: 0.2,
         speed: 30.0,
+        segments: None,
         tool_axis: None,
     }
 }
@@ -612,4 +613,122 @@ fn events_become_markers_pauses_and_dwells() {
         text.contains(";MANUAL_INSERT PART=U1\nM117 Insert U1\nM0 insert U1  pin 1 top-left\nT0\n"),
         "{text}"
     );
+}
+
+/// A switched-tool job (the jet's style): one layer with a line and a quarter arc between a
+/// switch-on and a switch-off with lead time `lead_time`.
+fn switched_job(lead_time: f64, arc_chords: Option<f64>) -> (String, GcodeStats) {
+    use crate::program::Segment;
+    let segments = vec![
+        Segment::Line {
+            a: [0.0, 0.0],
+            b: [1.0, 0.0],
+        },
+        Segment::Arc {
+            a: [1.0, 0.0],
+            b: [2.0, 1.0],
+            c: [1.0, 1.0],
+            r: 1.0,
+            sweep: std::f64::consts::FRAC_PI_2,
+        },
+    ];
+    let mut jet = path(
+        &[(0.0, 0.0), (1.0, 0.0), (2.0, 1.0)],
+        0.01,
+        false,
+        Role::JetWall,
+        1,
+    );
+    jet.speed = 2.0;
+    jet.segments = Some(segments);
+    let switch = |on| LayerItem::Event(Event::Switch { on, lead_time });
+    let program = Program {
+        layers: vec![Layer {
+            index: 0,
+            z: 0.01,
+            height: 0.01,
+            items: vec![switch(true), LayerItem::Path(jet), switch(false)],
+        }],
+    };
+    let params = GcodeParams {
+        switched: Some(SwitchedParams {
+            job: "jet".to_owned(),
+            on_gcode: "M42 P5 S255".to_owned(),
+            off_gcode: "M42 P5 S0".to_owned(),
+            lead_in_comment: "lead-in".to_owned(),
+            travel_speed: 10.0,
+            e_words: true,
+            arc_chords,
+            ..SwitchedParams::default()
+        }),
+        ..GcodeParams::for_tests()
+    };
+    let mut out: Vec<u8> = Vec::new();
+    let stats = write_gcode(&program, &params, &mut out).expect("written");
+    (String::from_utf8_lossy(&out).into_owned(), stats)
+}
+
+#[test]
+fn a_switched_job_writes_arcs_between_the_switch_snippets() {
+    let (text, stats) = switched_job(0.0, None);
+    let body: Vec<&str> = text.lines().skip_while(|l| *l != "T1").collect();
+    assert_eq!(
+        body,
+        [
+            "T1",
+            ";LAYER_CHANGE",
+            ";Z:0.01",
+            ";HEIGHT:0.01",
+            "G1 Z0.01 F600",
+            ";TYPE:Jet wall",
+            ";WIDTH:0.45",
+            "G1 X0 Y0",
+            "M42 P5 S255",
+            "G1 X1 Y0 E1 F120",
+            "G3 X2 Y1 I0 J1 E1.5708",
+            "M42 P5 S0",
+            ";TYPE:Custom",
+            "M42 P5 S0",
+        ]
+    );
+    assert!(text.starts_with("; conduit "));
+    assert!(text.contains("(jet)\n; flavor = marlin\n; layer count = 1\n"));
+    let s = stats.switched.expect("switched totals");
+    assert_eq!(s.paths, 1);
+    assert!((s.printed_mm - (1.0 + std::f64::consts::FRAC_PI_2)).abs() < 1e-12);
+    assert_eq!(s.travel_mm, 0.0, "the first travel starts from nowhere");
+    assert!((stats.estimated_time_s - s.printed_mm / 2.0).abs() < 1e-12);
+}
+
+#[test]
+fn a_switch_lead_time_runs_in_and_switches_off_before_the_end() {
+    // 0.25 s at 2 mm/s: half a millimetre.
+    let (text, stats) = switched_job(0.25, Some(0.0005));
+    let body: Vec<&str> = text
+        .lines()
+        .skip_while(|l| !l.starts_with(";WIDTH"))
+        .collect();
+    assert_eq!(
+        &body[1..5],
+        ["G1 X-0.5 Y0", "M42 P5 S255", "; lead-in", "G1 X0 Y0 F120"]
+    );
+    assert_eq!(body[5], "G1 X1 Y0 E1");
+    let off = body
+        .iter()
+        .position(|l| *l == "M42 P5 S0")
+        .expect("switched off");
+    assert!(
+        body[6..off].iter().all(|l| l.starts_with("G1 X")),
+        "chords, no arcs"
+    );
+    assert!(
+        body[off + 1].starts_with("G1 X"),
+        "the path goes on after the switch-off"
+    );
+    assert!(
+        body.iter()
+            .any(|l| *l == "G1 X2 Y1" || l.starts_with("G1 X2 Y1 E"))
+    );
+    let s = stats.switched.expect("switched totals");
+    assert!((s.printed_mm - (1.0 + std::f64::consts::FRAC_PI_2)).abs() < 1e-12);
 }

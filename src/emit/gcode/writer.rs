@@ -1,4 +1,9 @@
-//! The state machine that walks a [`Program`] and writes G-code lines to a [`GcodeSink`].
+//! The state machine that walks a [`Program`] and writes G-code lines to a [`GcodeSink`]: the
+//! FFF printer's style here, the switched-tool style (an aerosol jet) in [`switched`].
+
+mod switched;
+
+pub(super) use switched::header as switched_header;
 
 use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
 
@@ -10,6 +15,10 @@ use super::{EmitError, GcodeStats, Resume, ToolStats};
 use crate::geom::Point3;
 use crate::program::machine::{Flavor, ToolKind};
 use crate::program::{Event, Feed, Layer, LayerItem, Program, Toolpath};
+
+/// Largest distance between an arc of a path's segments and the chords the FFF style writes
+/// for it, mm: half the output resolution.
+const ARC_CHORD_TOLERANCE: f64 = 0.0005;
 
 /// Layers printed faster than this (s) get the fan at `fan_max_speed` (PrusaSlicer's default
 /// `slowdown_below_layer_time`).
@@ -97,6 +106,8 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     used: Vec<usize>,
     /// Fan command written last.
     fan: Option<String>,
+    /// Position, carried `E` and totals of a switched-tool job.
+    switch: switched::SwitchState,
 }
 
 impl<'a, S: GcodeSink> Writer<'a, S> {
@@ -111,6 +122,8 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                     Vec::new(),
                     Vec::new(),
                 ),
+                // A switched-tool job switches with its own snippets.
+                ToolKind::Paste if cfg.switched.is_some() => (Feed::Paste, Vec::new(), Vec::new()),
                 ToolKind::Paste => (
                     Feed::Paste,
                     render(
@@ -160,6 +173,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             time_s: 0.0,
             used: Vec::new(),
             fan: None,
+            switch: switched::SwitchState::default(),
         })
     }
 
@@ -743,14 +757,19 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             // Marks the dispensing moves, which carry no E, for `conduit check` and preview.
             self.line(";DISPENSE:ON");
         }
-        let closing = path.closed.then(|| path.points[0]);
+        let chords = path.chords(ARC_CHORD_TOLERANCE);
+        let (points, closed) = match &chords {
+            Some(c) => (c.as_slice(), false),
+            None => (path.points.as_slice(), path.closed),
+        };
+        let closing = closed.then(|| path.points[0]);
         let start = self
             .pos
             .unwrap_or_else(|| self.machine(&path.points[0], tool));
         let mut last_xy = (fmt_xyz(start.x), fmt_xyz(start.y));
         // Relative E of points dropped for being closer than the output resolution.
         let mut pending_de = 0.0;
-        for p in path.points[1..].iter().chain(closing.iter()) {
+        for p in points.iter().skip(1).chain(closing.iter()) {
             let to = self.machine(p, tool);
             let from = self.pos.unwrap_or(to);
             let de = e_per_mm.map_or(0.0, |k| (to - from).norm() * k);
@@ -851,6 +870,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                     self.line(&format!("; {}", l.trim_end()));
                 }
             }
+            Event::Switch { on, .. } => self.switch_snippet(*on),
             Event::Dwell { seconds } => {
                 if seconds.is_finite() && *seconds > 0.0 {
                     self.line(&format!("G4 P{}", fmt_f(seconds * 1000.0)));
@@ -859,6 +879,20 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             }
         }
         Ok(())
+    }
+
+    /// The active tool's output switched on or off outside a switched-tool job: the paste
+    /// tool's `paste_on_gcode` or `paste_off_gcode` (nothing for a filament tool).
+    fn switch_snippet(&mut self, on: bool) {
+        let Some(ts) = self.tool.and_then(|t| self.tools.get(t)) else {
+            return;
+        };
+        let lines = if on {
+            ts.paste_on.clone()
+        } else {
+            ts.paste_off.clone()
+        };
+        self.lines(&lines);
     }
 
     /// Around a part placement: retract, lift `pnp.lift` above the current layer, the
@@ -899,7 +933,18 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         )?;
         self.line(";TYPE:Custom");
         self.lines(&end);
-        let tools = used_tools(program)
+        Ok(GcodeStats {
+            layers: program.layers.len(),
+            estimated_time_s: self.time_s,
+            tools: self.tool_stats(program),
+            switched: None,
+        })
+    }
+
+    /// Material used by each tool `program` uses.
+    fn tool_stats(&self, program: &Program) -> Vec<ToolStats> {
+        let cfg = self.cfg;
+        used_tools(program)
             .into_iter()
             .filter_map(|t| {
                 let (ts, tc) = (self.tools.get(t)?, cfg.tools.get(t)?);
@@ -917,12 +962,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                     extrusion_time_s: ts.extrusion_time_s,
                 })
             })
-            .collect();
-        Ok(GcodeStats {
-            layers: program.layers.len(),
-            estimated_time_s: self.time_s,
-            tools,
-        })
+            .collect()
     }
 }
 

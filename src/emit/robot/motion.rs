@@ -188,6 +188,7 @@ mod tests {
                     width: 0.25,
                     height: 0.25,
                     speed: 5.0,
+                    segments: None,
                     tool_axis: axis,
                 })],
             }],
