@@ -161,13 +161,7 @@ impl ConformParams {
             });
         }
         Ok(Self {
-            nozzle: Nozzle {
-                inner,
-                outer,
-                needle_length: s.needle_length,
-                cone_angle_deg: s.cone_angle,
-                cone_height: s.cone_height,
-            },
+            nozzle: Nozzle::new(inner, outer, s.needle_length, s.cone_angle, s.cone_height),
             tolerance: s.tolerance,
             corrections: s.corrections,
             mapping: s.mapping,
@@ -322,7 +316,7 @@ pub fn plan(
     // The whole-nozzle check of the method's path, before anything is lifted.
     let mut remaining = Vec::new();
     for p in method.iter().flatten() {
-        let pen = params.nozzle.penetration(surface, p);
+        let pen = params.nozzle.solid.penetration(surface, p);
         if pen > 0.0 {
             remaining.push(report::Contact {
                 at: [p.x, p.y, p.z],
