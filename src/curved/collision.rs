@@ -101,6 +101,7 @@ impl Material {
             tested: true,
         });
         let mut obstacle = self;
+        // One position per stretch: the spacing has nothing to space.
         walk(
             head,
             &mut obstacle,
@@ -129,19 +130,7 @@ impl Material {
                 }
             }
         }
-        for &q in &self.points {
-            let Some((r, part)) = head.radius_at(q.z - p.z) else {
-                continue;
-            };
-            if (q.x - p.x).hypot(q.y - p.y) < r {
-                return Some(Hit {
-                    nozzle: p,
-                    material: q,
-                    part,
-                });
-            }
-        }
-        None
+        self.points.iter().find_map(|&q| Hit::of_point(head, p, q))
     }
 }
 

@@ -28,6 +28,17 @@ pub struct Hit {
 }
 
 impl Hit {
+    /// The material point `q` as a hit of `tool` with its tip at `nozzle`: when it lies above
+    /// the tip, horizontally closer to the axis than the tool's radius at its height.
+    pub fn of_point(tool: &ToolSolid, nozzle: Point3, q: Point3) -> Option<Hit> {
+        let (radius, part) = tool.radius_at(q.z - nozzle.z)?;
+        ((q.x - nozzle.x).hypot(q.y - nozzle.y) < radius).then_some(Hit {
+            nozzle,
+            material: q,
+            part,
+        })
+    }
+
     /// Horizontal distance between nozzle and material, mm.
     pub fn radius(&self) -> f64 {
         (self.material.x - self.nozzle.x).hypot(self.material.y - self.nozzle.y)
@@ -180,5 +191,96 @@ pub fn walk<'a, O: Obstacle>(
             }
         }
         obstacle.lay(index, &stretch, &samples);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points laid down so far; a tip hits one that stands higher within 1 mm.
+    #[derive(Default)]
+    struct Pile {
+        laid: Vec<Point3>,
+    }
+
+    impl Obstacle for Pile {
+        type Contact = Option<Point3>;
+
+        fn contact(&self, _tool: &ToolSolid, _index: usize, sample: &Sample) -> Option<Point3> {
+            let p = sample.tip;
+            self.laid
+                .iter()
+                .copied()
+                .find(|q| q.z > p.z && (q.x - p.x).hypot(q.y - p.y) < 1.0)
+        }
+
+        fn lay(&mut self, _index: usize, _stretch: &Stretch<'_>, samples: &[Sample]) {
+            self.laid.extend(samples.iter().map(|s| s.tip));
+        }
+    }
+
+    #[test]
+    fn spacings_give_both_ends_of_a_move_and_each_vertex_of_a_path_once() {
+        let (a, b) = (Point3::new(0.0, 0.0, 0.0), Point3::new(1.0, 0.0, 1.0));
+        let steps = Spacing::Steps(0.5).samples(&[a, b], false);
+        // 3D length √2: 3 steps, 4 positions.
+        assert_eq!(steps.len(), 4);
+        assert_eq!(steps[3].fraction, 1.0);
+        let square = [
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(1.0, 1.0, 0.0),
+        ];
+        let open = Spacing::Horizontal(0.5).samples(&square, false);
+        assert_eq!(open.len(), 5);
+        assert_eq!(open[4].tip, square[2]);
+        // Closed: back to the first point along the diagonal (3 steps), not repeated.
+        let closed = Spacing::Horizontal(0.5).samples(&square, true);
+        assert_eq!(closed.len(), 7);
+        assert_eq!(Spacing::Steps(0.5).samples(&square[..1], false).len(), 1);
+    }
+
+    #[test]
+    fn the_walk_meets_what_earlier_stretches_laid_and_skips_or_stops_as_told() {
+        let tool = ToolSolid::fff_head(45.0, 5.0, 0.0, 10.0);
+        let high = [Point3::new(0.0, 0.0, 2.0), Point3::new(1.0, 0.0, 2.0)];
+        let low = [Point3::new(0.0, 0.5, 1.0), Point3::new(1.0, 0.5, 1.0)];
+        let stretch = |points| Stretch {
+            points,
+            closed: false,
+            tested: true,
+        };
+        let mut seen = Vec::new();
+        walk(
+            &tool,
+            &mut Pile::default(),
+            [stretch(&high), stretch(&low), stretch(&low)],
+            Spacing::Steps(0.5),
+            |i, _, hit| match hit {
+                Some(_) => {
+                    seen.push(i);
+                    Next::Stretch
+                }
+                None => Next::Sample,
+            },
+        );
+        // The first stretch meets nothing; each low one meets the high one, once.
+        assert_eq!(seen, [1, 2]);
+        let mut first = Vec::new();
+        walk(
+            &tool,
+            &mut Pile::default(),
+            [stretch(&high), stretch(&low), stretch(&low)],
+            Spacing::Steps(0.5),
+            |i, _, hit| {
+                if hit.is_some() {
+                    first.push(i);
+                    return Next::Stop;
+                }
+                Next::Sample
+            },
+        );
+        assert_eq!(first, [1]);
     }
 }

@@ -287,3 +287,47 @@ impl ToolSolid {
             .find(|p| matches!(p.shape, PieceShape::Cone { .. }))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fff_head_is_a_cone_until_the_carriage_is_wider() {
+        let head = ToolSolid::fff_head(45.0, 5.0, 3.0, 4.0);
+        let tan = 45f64.to_radians().tan();
+        assert_eq!(head.radius_at(0.0), None);
+        assert_eq!(head.radius_at(2.0), Some((2.0 * tan, ToolPart::Cone)));
+        // At 4.5 mm the carriage (3 mm) is narrower than the cone; past the cone only it.
+        assert_eq!(head.radius_at(4.5), Some((4.5 * tan, ToolPart::Cone)));
+        assert_eq!(head.radius_at(6.0), Some((3.0, ToolPart::Carriage)));
+        assert_eq!(head.widest(), 5.0 * tan);
+        assert_eq!(head.widest_up_to(2.0), 2.0 * tan);
+        assert_eq!(head.widest_up_to(100.0), 5.0 * tan);
+        assert_eq!(head.tip_radius(), 0.0);
+        assert_eq!(head.shoulder(), 0.0);
+        assert_eq!(head.top(), f64::INFINITY);
+        // Without a carriage nothing is above the cone.
+        let bare = ToolSolid::fff_head(60.0, 5.0, 0.0, 10.0);
+        assert_eq!(bare.radius_at(5.5), None);
+        assert_eq!(bare.pieces().len(), 1);
+    }
+
+    #[test]
+    fn the_needle_nozzle_stands_on_its_tip_disc_and_widens_above_the_needle() {
+        let n = ToolSolid::needle_nozzle(0.5, 6.0, 30.0, 10.0);
+        let tan = 30f64.to_radians().tan();
+        assert_eq!(n.tip_radius(), 0.25);
+        assert_eq!(n.shoulder(), 6.0);
+        assert_eq!(n.top(), 16.0);
+        assert_eq!(n.widest(), 0.25 + 10.0 * tan);
+        assert_eq!(n.radius_at(3.0), Some((0.25, ToolPart::Needle)));
+        assert_eq!(n.floor_at(0.2), Some(0.0));
+        assert_eq!(n.floor_at(1.25), Some(6.0 + 1.0 / tan));
+        assert_eq!(n.floor_at(n.widest() + 0.1), None);
+        // No cone: the needle is all there is above the disc.
+        let bare = ToolSolid::needle_nozzle(0.5, 6.0, 0.0, 10.0);
+        assert_eq!((bare.shoulder(), bare.widest()), (6.0, 0.25));
+        assert!(bare.cone().is_none());
+    }
+}

@@ -124,15 +124,8 @@ impl Grid {
                 let Some(q) = self.cells[cy * self.dims[0] + cx] else {
                     continue;
                 };
-                let Some((radius, part)) = head.radius_at(q.z - p.z) else {
-                    continue;
-                };
-                if (q.x - p.x).hypot(q.y - p.y) < radius {
-                    return Some(Hit {
-                        nozzle: p,
-                        material: q,
-                        part,
-                    });
+                if let Some(hit) = Hit::of_point(head, p, q) {
+                    return Some(hit);
                 }
             }
         }
