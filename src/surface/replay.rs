@@ -241,8 +241,9 @@ mod tests {
         assert_eq!(Spacing::Steps(0.5).samples(&square[..1], false).len(), 1);
     }
 
-    #[test]
-    fn the_walk_meets_what_earlier_stretches_laid_and_skips_or_stops_as_told() {
+    /// The stretches of a walk over a high stretch and two low ones beside it whose
+    /// positions met something, the walk going on with `on_hit` after each.
+    fn stretches_hit(on_hit: Next) -> Vec<usize> {
         let tool = ToolSolid::fff_head(45.0, 5.0, 0.0, 10.0);
         let high = [Point3::new(0.0, 0.0, 2.0), Point3::new(1.0, 0.0, 2.0)];
         let low = [Point3::new(0.0, 0.5, 1.0), Point3::new(1.0, 0.5, 1.0)];
@@ -260,27 +261,18 @@ mod tests {
             |i, _, hit| match hit {
                 Some(_) => {
                     seen.push(i);
-                    Next::Stretch
+                    on_hit
                 }
                 None => Next::Sample,
             },
         );
+        seen
+    }
+
+    #[test]
+    fn the_walk_meets_what_earlier_stretches_laid_and_skips_or_stops_as_told() {
         // The first stretch meets nothing; each low one meets the high one, once.
-        assert_eq!(seen, [1, 2]);
-        let mut first = Vec::new();
-        walk(
-            &tool,
-            &mut Pile::default(),
-            [stretch(&high), stretch(&low), stretch(&low)],
-            Spacing::Steps(0.5),
-            |i, _, hit| {
-                if hit.is_some() {
-                    first.push(i);
-                    return Next::Stop;
-                }
-                Next::Sample
-            },
-        );
-        assert_eq!(first, [1]);
+        assert_eq!(stretches_hit(Next::Stretch), [1, 2]);
+        assert_eq!(stretches_hit(Next::Stop), [1]);
     }
 }
