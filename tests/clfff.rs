@@ -12,7 +12,7 @@ use std::process::Command;
 use conduit::check::moves;
 use conduit::config::Flavor;
 use conduit::curved::clfff::{CORE_COMMENT, LAYER_COMMENT, SCAFFOLD_COMMENT, TOP_COMMENT};
-use conduit::curved::collision::Head;
+use conduit::surface::ToolSolid;
 use serde_json::Value;
 
 use crate::support::{sample, stderr, stdout, temp_dir};
@@ -324,18 +324,10 @@ fn clfff_dish_with_scaffold_buffer_and_three_layers() {
     assert!(scaffold > 500, "{scaffold} scaffold moves");
 
     // The head (cone 60°, 5 mm) never touches what was printed before the nozzle got there.
-    let head = Head {
-        angle_deg: 60.0,
-        height: 5.0,
-        carriage_radius: 0.0,
-        carriage_clearance: 10.0,
-    };
+    let head = ToolSolid::fff_head(60.0, 5.0, 0.0, 10.0);
     assert_eq!(replay_hits(&ex, &head, usize::MAX), 0);
     // A much wider head would: the replay does find collisions.
-    let wide = Head {
-        angle_deg: 80.0,
-        ..head
-    };
+    let wide = ToolSolid::fff_head(80.0, 5.0, 0.0, 10.0);
     assert!(replay_hits(&ex, &wide, 1) > 0);
 
     // Tools: scaffold T0, buffer T1, model T2, in that order.
@@ -392,13 +384,13 @@ const GCODE_RESOLUTION: f64 = 0.0011;
 /// the bed as the highest point; each extrusion is tested at its points before it is added.
 /// Material at most [`GCODE_RESOLUTION`] above the tip is not above it: two points of a
 /// surface a hair apart can round to different z in the file.
-fn replay_hits(ex: &[(Part, [f64; 3], [f64; 3])], head: &Head, limit: usize) -> usize {
+fn replay_hits(ex: &[(Part, [f64; 3], [f64; 3])], head: &ToolSolid, limit: usize) -> usize {
     const CELL: f64 = 0.5;
     const N: usize = 500; // 250 mm bed
     let key = |v: f64| ((v / CELL).floor().max(0.0) as usize).min(N - 1);
     let mut cells: Vec<Option<[f64; 3]>> = vec![None; N * N];
     let mut top = f64::MIN;
-    let reach = (head.max_radius() / CELL).ceil() as usize + 1;
+    let reach = (head.widest() / CELL).ceil() as usize + 1;
     let mut hits = 0;
     for (_, from, to) in ex {
         let len = (to[0] - from[0]).hypot(to[1] - from[1]);
@@ -729,12 +721,7 @@ fn clfff_sandwich_of_a_thick_dish_has_skins_on_its_surfaces_and_a_planar_core_be
     );
 
     // The head (cone 60°, 5 mm) never touches what was printed before.
-    let head = Head {
-        angle_deg: 60.0,
-        height: 5.0,
-        carriage_radius: 0.0,
-        carriage_clearance: 10.0,
-    };
+    let head = ToolSolid::fff_head(60.0, 5.0, 0.0, 10.0);
     let parts: Vec<(Part, [f64; 3], [f64; 3])> = ex
         .iter()
         .map(|(_, f, t, ..)| (Part::Scaffold, *f, *t))

@@ -8,7 +8,7 @@ use std::process::Command;
 
 use conduit::config::Config;
 use conduit::curved::LAYER_COMMENT;
-use conduit::curved::collision::{Bead, Head, ReplayHit, ReplayTolerances, replay};
+use conduit::curved::collision::{Bead, ReplayHit, ReplayTolerances, replay};
 use conduit::geom::Point3;
 use conduit::pipeline::place_on_bed;
 use conduit::scene::{LoadOptions, load_scene};
@@ -197,13 +197,7 @@ fn head_hits(name: &str, gcode: &str) -> (Vec<ReplayHit>, Vec<Bead>, usize) {
     let Some(first) = first else {
         panic!("{name}: no curved layer")
     };
-    let c = Config::default().curved;
-    let head = Head {
-        angle_deg: c.head_angle,
-        height: c.head_height,
-        carriage_radius: c.carriage_radius,
-        carriage_clearance: c.carriage_clearance,
-    };
+    let head = Config::default().curved.head();
     let hits = replay(&beads, first, &head, &ReplayTolerances::default());
     (hits, beads, first)
 }

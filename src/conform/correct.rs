@@ -127,15 +127,19 @@ pub fn correct(
         .map(|m| {
             let tip = m.base + m.travel * m.along;
             if m.along <= 0.0
-                || nozzle.shortfall(surface, &tip, CLEARANCE) <= 0.0
-                || nozzle.shortfall(surface, &m.base, CLEARANCE) > 0.0
+                || nozzle.solid.shortfall(surface, &tip, CLEARANCE) <= 0.0
+                || nozzle.solid.shortfall(surface, &m.base, CLEARANCE) > 0.0
             {
                 return tip;
             }
             let (mut free, mut hit) = (0.0, m.along);
             for _ in 0..CUT_STEPS {
                 let mid = 0.5 * (free + hit);
-                if nozzle.shortfall(surface, &(m.base + m.travel * mid), CLEARANCE) > 0.0 {
+                if nozzle
+                    .solid
+                    .shortfall(surface, &(m.base + m.travel * mid), CLEARANCE)
+                    > 0.0
+                {
                     hit = mid;
                 } else {
                     free = mid;
@@ -210,7 +214,7 @@ fn point_move(
     counts: &mut CorrectionCounts,
 ) -> Move {
     let d = nozzle.inner;
-    let ro = nozzle.outer / 2.0;
+    let ro = nozzle.tip_radius();
     let v = g.travel;
     // A slope under 0.1 % is level: rounding would otherwise make flat paths "downhill".
     let downhill = g.tangent.z < -1e-3;
@@ -245,7 +249,7 @@ fn point_move(
         }
         along
     };
-    match nozzle.disk_contact(surface, &tip) {
+    match nozzle.solid.disc_contact(surface, &tip) {
         Some(p) => {
             let (qx, qy) = (ti.x - p[0], ti.y - p[1]);
             let dist = qx.hypot(qy);
@@ -318,7 +322,7 @@ pub fn clear(surface: &Surface, nozzle: &Nozzle, path: &mut [Point3], margin: f6
     for _ in 0..CLEAR_ROUNDS {
         let mut changed = false;
         for i in 0..path.len() {
-            let need = nozzle.shortfall(surface, &path[i], margin);
+            let need = nozzle.solid.shortfall(surface, &path[i], margin);
             if need > 0.0 {
                 path[i] = snap(path[i] + crate::geom::Vector3::new(0.0, 0.0, need));
                 lifted[i] = true;
@@ -329,7 +333,11 @@ pub fn clear(surface: &Surface, nozzle: &Nozzle, path: &mut [Point3], margin: f6
             let (a, b) = (path[i], path[i + 1]);
             let n = (((b - a).norm() / step).ceil() as usize).max(2);
             let need = (1..n)
-                .map(|k| nozzle.shortfall(surface, &(a + (b - a) * (k as f64 / n as f64)), margin))
+                .map(|k| {
+                    nozzle
+                        .solid
+                        .shortfall(surface, &(a + (b - a) * (k as f64 / n as f64)), margin)
+                })
                 .fold(f64::MIN, f64::max);
             if need > 0.0 {
                 let up = crate::geom::Vector3::new(0.0, 0.0, need);
@@ -539,8 +547,8 @@ mod tests {
         for (ti, tip) in t.iter().zip(&tips) {
             // The moves are horizontal: the unshifted tip is at the tip's height over Tᵢ.
             let unshifted = Point3::new(ti.x, ti.y, tip.z);
-            if n.shortfall(&s, &unshifted, CLEARANCE) <= 0.0 {
-                assert!(n.shortfall(&s, tip, CLEARANCE) <= 1e-9, "{ti} {tip}");
+            if n.solid.shortfall(&s, &unshifted, CLEARANCE) <= 0.0 {
+                assert!(n.solid.shortfall(&s, tip, CLEARANCE) <= 1e-9, "{ti} {tip}");
             }
             if tip.x - ti.x < 0.25 - 1e-9 && ti.x > 1.0 {
                 cut += 1;
@@ -550,6 +558,6 @@ mod tests {
         // Uncut, the last point's shift would reach into the wall.
         let (last, tip) = (t[t.len() - 1], tips[tips.len() - 1]);
         let reach = Point3::new(last.x + 0.25, 0.0, tip.z);
-        assert!(n.penetration(&s, &reach) > 0.0);
+        assert!(n.solid.penetration(&s, &reach) > 0.0);
     }
 }

@@ -10,7 +10,7 @@
 //! thickness − d. An error below −`flattening_error` is flattening, above `floating_error`
 //! floating.
 //!
-//! Tool-surface contact is a sample where the whole nozzle ([`Nozzle::penetration`]) meets the
+//! Tool-surface contact is a sample where the whole nozzle ([`crate::surface::ToolSolid::penetration`]) meets the
 //! surface, or where the thickness is at or below `contact_thickness`. The reference point
 //! alone would miss a nozzle face ploughing into a wall ahead of it; and where the nozzle meets
 //! the surface it scrapes the substrate and the paste under it, so a contact sample's
@@ -77,7 +77,7 @@ pub fn profile(
     nozzle: &Nozzle,
     thresholds: &Thresholds,
 ) -> Vec<Sample> {
-    let (d, d_o) = (nozzle.inner, nozzle.outer);
+    let (d, ro) = (nozzle.inner, nozzle.tip_radius());
     let mut out = Vec::new();
     let step = d / 2.0;
     for (index, path) in paths.iter().enumerate() {
@@ -93,14 +93,14 @@ pub fn profile(
             let v = horizontal
                 .try_normalize(1e-12)
                 .unwrap_or_else(Vector3::zeros);
-            let back = if seg.z < 0.0 { d_o / 2.0 } else { d / 2.0 };
+            let back = if seg.z < 0.0 { ro } else { d / 2.0 };
             let mut s = carry;
             while s < len {
                 let tip = w[0] + seg * (s / len);
                 let r = tip - v * back;
                 let thickness = surface.signed_distance(&r);
                 let contact = thickness <= thresholds.contact_thickness
-                    || nozzle.penetration(surface, &tip) > 0.0;
+                    || nozzle.solid.penetration(surface, &tip) > 0.0;
                 out.push(Sample {
                     path: index,
                     s: along + s,
@@ -191,11 +191,7 @@ mod tests {
     };
 
     fn nozzle(d: f64, d_o: f64) -> Nozzle {
-        Nozzle {
-            inner: d,
-            outer: d_o,
-            ..Nozzle::for_tests()
-        }
+        Nozzle::new(d, d_o, 6.0, 30.0, 10.0)
     }
 
     #[test]

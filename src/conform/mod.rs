@@ -12,9 +12,11 @@
 //! 5. [`spline`]: tangent, signed curvature, inflections, direction of travel.
 //! 6. [`correct`]: standoff, tip-disk contact escape, shift along the travel (the tip placed
 //!    on the deposit model, or the published method's curvature-scaled downhill formula); then
-//!    a clearance pass with the whole nozzle ([`nozzle`]) lifts what still touches.
+//!    a clearance pass with the whole nozzle ([`nozzle`]: its bore and its tool solid, checked
+//!    against the surface by [`crate::surface::contact`]) lifts what still touches.
 //! 7. [`deposit`]: expected deposit thickness and its errors, for every corrections mode.
-//! 8. [`report`]: the JSON report; [`replay`] re-checks the written G-code for contacts.
+//! 8. [`report`]: the JSON report; [`replay`] re-checks the written G-code for contacts (the
+//!    replay walk of [`crate::surface::replay`] with the surface as obstacle).
 //!
 //! Robot and five-axis work builds on the same stages: [`orient`] sets a tool axis per point
 //! (surface normal, vertical or fixed) for the robot emitters in [`crate::emit::robot`];
@@ -106,7 +108,7 @@ pub enum ConformError {
 /// Validated parameters of a run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConformParams {
-    /// Nozzle shape.
+    /// The nozzle: its bore and its solid.
     pub nozzle: Nozzle,
     /// Extra lateral clearance of contact corrections, mm.
     pub tolerance: f64,
@@ -161,13 +163,7 @@ impl ConformParams {
             });
         }
         Ok(Self {
-            nozzle: Nozzle {
-                inner,
-                outer,
-                needle_length: s.needle_length,
-                cone_angle_deg: s.cone_angle,
-                cone_height: s.cone_height,
-            },
+            nozzle: Nozzle::new(inner, outer, s.needle_length, s.cone_angle, s.cone_height),
             tolerance: s.tolerance,
             corrections: s.corrections,
             mapping: s.mapping,
@@ -322,7 +318,7 @@ pub fn plan(
     // The whole-nozzle check of the method's path, before anything is lifted.
     let mut remaining = Vec::new();
     for p in method.iter().flatten() {
-        let pen = params.nozzle.penetration(surface, p);
+        let pen = params.nozzle.solid.penetration(surface, p);
         if pen > 0.0 {
             remaining.push(report::Contact {
                 at: [p.x, p.y, p.z],

@@ -1,5 +1,6 @@
 //! Replay of written G-code against the surface: every move sampled every quarter of the inner
-//! diameter, each sample checked with the whole nozzle ([`super::nozzle`]).
+//! diameter, each sample checked with the whole nozzle ([`super::nozzle`]) — the replay walk of
+//! [`crate::surface::replay`] with the scanned surface as obstacle.
 //!
 //! Place in the pipeline: after emit, on conduit's own output (or any G-code for the same
 //! machine frame), as the tests of a slicer re-parse their G-code: what the file would make the
@@ -9,7 +10,7 @@ use super::nozzle::Nozzle;
 use crate::check::moves;
 use crate::geom::Point3;
 use crate::program::machine::Flavor;
-use crate::surface::Surface;
+use crate::surface::{Next, Spacing, Stretch, Surface, walk};
 use serde::Serialize;
 
 /// The 1-based line range of a conduit G-code file's body: from its first `;LAYER_CHANGE` to
@@ -47,12 +48,13 @@ pub struct ReplayContacts {
     pub places: Vec<[f64; 3]>,
 }
 
-/// Replays `gcode` and counts the nozzle-surface contacts of its moves (moves whose both ends
-/// are above the surface's top plus the needle are skipped). Moves at or below `print_feed`
-/// (mm/s) count as dispensing: a pneumatic dispenser's on/off is a snippet the replay does not
-/// interpret, so the feed rate tells printing from travel. Moves on lines outside `body`
-/// (1-based line numbers: from the first layer change to the end G-code) are the printer's
-/// custom G-code and counted apart.
+/// Replays `gcode` and counts the nozzle-surface contacts of its moves: the replay walk
+/// ([`walk`]) of every move with known ends, sampled every quarter of the inner diameter, with
+/// the surface as obstacle (moves whose both ends are above the surface's top plus the needle
+/// are skipped). Moves at or below `print_feed` (mm/s) count as dispensing: a pneumatic
+/// dispenser's on/off is a snippet the replay does not interpret, so the feed rate tells
+/// printing from travel. Moves on lines outside `body` (1-based line numbers: from the first
+/// layer change to the end G-code) are the printer's custom G-code and counted apart.
 pub fn replay(
     gcode: &conduit_gcode::Gcode,
     flavor: Flavor,
@@ -65,20 +67,27 @@ pub fn replay(
         worst_penetration: f64::MIN,
         ..ReplayContacts::default()
     };
-    let step = nozzle.inner / 4.0;
-    let top = surface.max().z;
-    for m in moves(gcode, flavor).moves.iter() {
-        let (Some(a), Some(b)) = (known(&m.from), known(&m.to)) else {
-            continue;
-        };
-        if a.z > top + nozzle.needle_length && b.z > top + nozzle.needle_length {
-            continue;
-        }
-        let len = (b - a).norm();
-        let n = ((len / step).ceil() as usize).max(1);
-        for k in 0..=n {
-            let p = a + (b - a) * (k as f64 / n as f64);
-            let pen = nozzle.penetration(surface, &p);
+    let all = moves(gcode, flavor);
+    let known_moves: Vec<(&crate::check::Move, [Point3; 2])> = all
+        .moves
+        .iter()
+        .filter_map(|m| Some((m, [known(&m.from)?, known(&m.to)?])))
+        .collect();
+    let stretches = known_moves.iter().map(|(_, ends)| Stretch {
+        points: ends,
+        closed: false,
+        tested: true,
+    });
+    let spacing = Spacing::Steps(nozzle.inner / 4.0);
+    let mut obstacle = surface;
+    walk(
+        &nozzle.solid,
+        &mut obstacle,
+        stretches,
+        spacing,
+        |i, s, pen| {
+            let m = known_moves[i].0;
+            let p = s.tip;
             out.samples += 1;
             out.worst_penetration = out.worst_penetration.max(pen);
             if pen > 0.0 {
@@ -93,8 +102,9 @@ pub fn replay(
                     out.places.push([p.x, p.y, p.z]);
                 }
             }
-        }
-    }
+            Next::Sample
+        },
+    );
     out
 }
 

@@ -1,61 +1,21 @@
-//! The print head as a collision volume, and the test of nozzle positions against material
-//! already printed.
+//! Material already printed as obstacles of the print head: the test of nozzle positions
+//! against it, and the replay of written beads.
 //!
 //! Place in the pipeline: [`super`] runs it on each curved region before it accepts it; a
 //! region with a hit stays planar and the hit is reported.
 //!
-//! The head is a cone with its apex at the nozzle tip, opening upward at `head_angle` from the
-//! vertical up to `head_height`, plus, when `carriage_radius > 0`, a cylinder of that radius
-//! around the nozzle axis from `carriage_clearance` above the tip upward. Material is given as
-//! planar layers (their top z and xy area) and as single points (the surface itself).
+//! The head is the `[curved]` head ([`ToolSolid::fff_head`]): a cone with its apex at the
+//! nozzle tip, opening upward at `head_angle` from the vertical up to `head_height`, plus, when
+//! `carriage_radius > 0`, a cylinder of that radius around the nozzle axis from
+//! `carriage_clearance` above the tip upward. Two obstacles of the replay walk
+//! ([`crate::surface::replay`]) hold the material: [`Material`], planar layers (their top z and
+//! xy area) and single points (the surface itself), fixed while the nozzles are tested; and
+//! the beads printed so far ([`replay`]), indexed in a grid and grown bead by bead.
 
 use crate::geom::{ExPolygon, Point3};
-
-/// The head model (`[curved]` head keys).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Head {
-    /// Cone half-angle from the vertical, degrees.
-    pub angle_deg: f64,
-    /// Cone height above the tip, mm.
-    pub height: f64,
-    /// Carriage cylinder radius, mm (0 = none).
-    pub carriage_radius: f64,
-    /// Height of the cylinder's bottom above the tip, mm.
-    pub carriage_clearance: f64,
-}
-
-/// Which part of the head is hit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum HeadPart {
-    /// The cone around the nozzle.
-    Cone,
-    /// The carriage cylinder.
-    Carriage,
-}
-
-/// A collision: material inside the head with the nozzle at `nozzle`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Hit {
-    /// The nozzle tip, mm.
-    pub nozzle: Point3,
-    /// The material point inside the head, mm.
-    pub material: Point3,
-    /// The part of the head it is in.
-    pub part: HeadPart,
-}
-
-impl Hit {
-    /// Horizontal distance between nozzle and material, mm.
-    pub fn radius(&self) -> f64 {
-        (self.material.x - self.nozzle.x).hypot(self.material.y - self.nozzle.y)
-    }
-
-    /// Height of the material above the nozzle tip, mm.
-    pub fn rise(&self) -> f64 {
-        self.material.z - self.nozzle.z
-    }
-}
+use crate::surface::{
+    Hit, Next, Obstacle, PieceShape, Sample, Spacing, Stretch, ToolPart, ToolSolid, walk,
+};
 
 /// A shape as float rings (contour first) with its bounding box [x0, y0, x1, y1].
 type Shape = (Vec<Vec<(f64, f64)>>, [f64; 4]);
@@ -105,81 +65,82 @@ impl Material {
     }
 }
 
-impl Head {
-    /// The head's radius at `rise` mm above the tip (0 where it has no extent), and the part.
-    pub fn radius_at(&self, rise: f64) -> Option<(f64, HeadPart)> {
-        self.radius_with(rise, self.angle_deg.to_radians().tan())
+impl Material {
+    /// The first hit (in the order of `nozzles`) of `head` against the material.
+    pub fn first_hit(&self, head: &ToolSolid, nozzles: &[Point3]) -> Option<Hit> {
+        let mut first = None;
+        self.walk_nozzles(head, nozzles, |hit| {
+            first = Some(hit);
+            Next::Stop
+        });
+        first
     }
 
-    /// [`Head::radius_at`] with the cone's `tan(angle)` computed by the caller.
-    fn radius_with(&self, rise: f64, tan: f64) -> Option<(f64, HeadPart)> {
-        if rise <= 0.0 {
-            return None;
-        }
-        let cone = (rise <= self.height).then_some(rise * tan);
-        let carriage = (self.carriage_radius > 0.0 && rise >= self.carriage_clearance)
-            .then_some(self.carriage_radius);
-        match (cone, carriage) {
-            (Some(c), Some(r)) if r > c => Some((r, HeadPart::Carriage)),
-            (Some(c), _) => Some((c, HeadPart::Cone)),
-            (None, Some(r)) => Some((r, HeadPart::Carriage)),
-            (None, None) => None,
-        }
+    /// Every nozzle position of `nozzles` where `head` hits the material, each with its first
+    /// hit, in order.
+    pub fn hits(&self, head: &ToolSolid, nozzles: &[Point3]) -> Vec<Hit> {
+        let mut out = Vec::new();
+        self.walk_nozzles(head, nozzles, |hit| {
+            out.push(hit);
+            Next::Stretch
+        });
+        out
     }
 
-    /// The widest the head gets, mm.
-    pub fn max_radius(&self) -> f64 {
-        (self.height * self.angle_deg.to_radians().tan()).max(self.carriage_radius)
+    /// The replay walk of `nozzles`, each position a stretch of its own, handing every hit to
+    /// `visit`.
+    fn walk_nozzles(
+        &self,
+        head: &ToolSolid,
+        nozzles: &[Point3],
+        mut visit: impl FnMut(Hit) -> Next,
+    ) {
+        let stretches = nozzles.iter().map(|p| Stretch {
+            points: std::slice::from_ref(p),
+            closed: false,
+            tested: true,
+        });
+        let mut obstacle = self;
+        // One position per stretch: the spacing has nothing to space.
+        walk(
+            head,
+            &mut obstacle,
+            stretches,
+            Spacing::Steps(1.0),
+            |_, _, hit| hit.map_or(Next::Sample, &mut visit),
+        );
     }
 
-    /// The first hit (in the order of `nozzles`) of the head against `material`.
-    pub fn first_hit(&self, nozzles: &[Point3], material: &Material) -> Option<Hit> {
-        nozzles.iter().find_map(|&p| self.hit_at(p, material))
-    }
-
-    /// Every nozzle position of `nozzles` with a hit, each with its first hit, in order.
-    pub fn hits(&self, nozzles: &[Point3], material: &Material) -> Vec<Hit> {
-        nozzles
-            .iter()
-            .filter_map(|&p| self.hit_at(p, material))
-            .collect()
-    }
-
-    /// The first hit of the head against `material` with the nozzle at `p`.
-    pub fn hit_at(&self, p: Point3, material: &Material) -> Option<Hit> {
-        let tan = self.angle_deg.to_radians().tan();
-        {
-            for slab in &material.slabs {
-                let Some((r, part)) = self.radius_with(slab.top - p.z, tan) else {
+    /// The first hit of `head` against the material with the nozzle at `p`.
+    pub fn hit_at(&self, head: &ToolSolid, p: Point3) -> Option<Hit> {
+        for slab in &self.slabs {
+            let Some((r, part)) = head.radius_at(slab.top - p.z) else {
+                continue;
+            };
+            for (rings, bb) in &slab.shapes {
+                if p.x + r < bb[0] || p.x - r > bb[2] || p.y + r < bb[1] || p.y - r > bb[3] {
                     continue;
-                };
-                for (rings, bb) in &slab.shapes {
-                    if p.x + r < bb[0] || p.x - r > bb[2] || p.y + r < bb[1] || p.y - r > bb[3] {
-                        continue;
-                    }
-                    if let Some((x, y)) = closest_within(rings, p.x, p.y, r) {
-                        return Some(Hit {
-                            nozzle: p,
-                            material: Point3::new(x, y, slab.top),
-                            part,
-                        });
-                    }
                 }
-            }
-            for &q in &material.points {
-                let Some((r, part)) = self.radius_with(q.z - p.z, tan) else {
-                    continue;
-                };
-                if (q.x - p.x).hypot(q.y - p.y) < r {
+                if let Some((x, y)) = closest_within(rings, p.x, p.y, r) {
                     return Some(Hit {
                         nozzle: p,
-                        material: q,
+                        material: Point3::new(x, y, slab.top),
                         part,
                     });
                 }
             }
         }
-        None
+        self.points.iter().find_map(|&q| Hit::of_point(head, p, q))
+    }
+}
+
+/// The material as an obstacle: the contact is its first hit with the tip there; nothing is
+/// laid down.
+impl Obstacle for &Material {
+    type Contact = Option<Hit>;
+
+    fn contact(&self, tool: &ToolSolid, _index: usize, sample: &Sample) -> Option<Hit> {
+        self.hit_at(tool, sample.tip)
     }
 }
 
@@ -256,61 +217,112 @@ const REPLAY_CELL_MM: f64 = 2.0;
 /// part of that run within one bead width behind the nozzle is the material it is laying down,
 /// not an obstacle, and is skipped — as is, while the nozzle is within one bead width of the
 /// run's end, the run's first bead width (a loop closing over its own start: the seam).
-pub fn replay(beads: &[Bead], start: usize, head: &Head, tol: &ReplayTolerances) -> Vec<ReplayHit> {
-    let mut index = BeadIndex::new(beads);
-    for i in 0..start.min(beads.len()) {
-        index.insert(beads, i);
-    }
+pub fn replay(
+    beads: &[Bead],
+    start: usize,
+    head: &ToolSolid,
+    tol: &ReplayTolerances,
+) -> Vec<ReplayHit> {
+    let mut printed = PrintedBeads::new(beads, tol.rise);
+    let ends: Vec<[Point3; 2]> = beads.iter().map(|b| [b.from, b.to]).collect();
+    let stretches = ends.iter().enumerate().map(|(i, e)| Stretch {
+        points: e,
+        closed: false,
+        tested: i >= start,
+    });
+    let spacing = Spacing::Steps(tol.sample.max(1e-3));
     let mut out = Vec::new();
-    // Per bead: the first bead of its continuous run and the run's arc length up to the bead's
-    // start; per run (by first bead): its total length.
-    let joined = |i: usize| i > 0 && (beads[i].from - beads[i - 1].to).norm() < 1e-6;
-    let mut run_of = vec![0; beads.len()];
-    let mut run_len = vec![0.0; beads.len()];
-    let mut run_total = vec![0.0; beads.len()];
-    for i in 0..beads.len() {
-        if joined(i) {
-            run_of[i] = run_of[i - 1];
-            run_len[i] = run_len[i - 1] + beads[i - 1].length();
-        } else {
-            run_of[i] = i;
+    walk(
+        head,
+        &mut printed,
+        stretches,
+        spacing,
+        |i, _, hit| match hit {
+            Some((earlier, hit)) => {
+                out.push(ReplayHit {
+                    bead: i,
+                    earlier,
+                    hit,
+                });
+                Next::Stretch
+            }
+            None => Next::Sample,
+        },
+    );
+    out
+}
+
+/// The beads printed so far as an obstacle of the replay walk: a grid index of them, and per
+/// bead its continuous run (so the nozzle's own bead is not an obstacle).
+struct PrintedBeads<'a> {
+    beads: &'a [Bead],
+    index: BeadIndex,
+    /// Material must rise more than this above the tip to count, mm.
+    rise: f64,
+    /// Per bead: the first bead of its continuous run.
+    run_of: Vec<usize>,
+    /// Per bead: the run's arc length up to the bead's start, mm.
+    run_len: Vec<f64>,
+    /// Per run (by first bead): its total length, mm.
+    run_total: Vec<f64>,
+}
+
+impl<'a> PrintedBeads<'a> {
+    /// None of `beads` printed yet, with their runs.
+    fn new(beads: &'a [Bead], rise: f64) -> Self {
+        let joined = |i: usize| i > 0 && (beads[i].from - beads[i - 1].to).norm() < 1e-6;
+        let mut run_of = vec![0; beads.len()];
+        let mut run_len = vec![0.0; beads.len()];
+        let mut run_total = vec![0.0; beads.len()];
+        for i in 0..beads.len() {
+            if joined(i) {
+                run_of[i] = run_of[i - 1];
+                run_len[i] = run_len[i - 1] + beads[i - 1].length();
+            } else {
+                run_of[i] = i;
+            }
+            run_total[run_of[i]] = run_len[i] + beads[i].length();
         }
-        run_total[run_of[i]] = run_len[i] + beads[i].length();
+        Self {
+            beads,
+            index: BeadIndex::new(beads),
+            rise,
+            run_of,
+            run_len,
+            run_total,
+        }
     }
-    for i in 0..beads.len() {
-        if i < start {
-            continue;
-        }
+}
+
+impl Obstacle for PrintedBeads<'_> {
+    /// The earlier bead hit and the hit.
+    type Contact = Option<(usize, Hit)>;
+
+    fn contact(&self, head: &ToolSolid, i: usize, sample: &Sample) -> Option<(usize, Hit)> {
+        let beads = self.beads;
         let b = &beads[i];
-        let len = b.length();
-        let steps = ((len / tol.sample.max(1e-3)).ceil() as usize).max(1);
-        'samples: for s in 0..=steps {
-            let f = s as f64 / steps as f64;
-            let p = Point3::from(b.from.coords + (b.to.coords - b.from.coords) * f);
-            let arc = run_len[i] + f * len;
-            let total = run_total[run_of[i]];
-            for j in index.candidates(beads, p, head, tol) {
-                // Within one bead width behind the nozzle on its own run: its own bead; and a
-                // loop's last bead width closing over the run's first one: its seam.
-                if run_of[j] == run_of[i]
-                    && (arc - (run_len[j] + beads[j].length()) < b.width
-                        || (run_len[j] < b.width && total - arc < b.width))
-                {
-                    continue;
-                }
-                if let Some(hit) = head.bead_hit(p, &beads[j], tol.rise) {
-                    out.push(ReplayHit {
-                        bead: i,
-                        earlier: j,
-                        hit,
-                    });
-                    break 'samples;
-                }
+        let p = sample.tip;
+        let arc = self.run_len[i] + sample.fraction * b.length();
+        let total = self.run_total[self.run_of[i]];
+        for j in self.index.candidates(beads, p, head, self.rise) {
+            // Within one bead width behind the nozzle on its own run: its own bead; and a
+            // loop's last bead width closing over the run's first one: its seam.
+            if self.run_of[j] == self.run_of[i]
+                && (arc - (self.run_len[j] + beads[j].length()) < b.width
+                    || (self.run_len[j] < b.width && total - arc < b.width))
+            {
+                continue;
+            }
+            if let Some(hit) = bead_hit(head, p, &beads[j], self.rise) {
+                return Some((j, hit));
             }
         }
-        index.insert(beads, i);
+        None
     }
-    out
+
+    fn lay(&mut self, i: usize, _stretch: &Stretch<'_>, _samples: &[Sample]) {
+        self.index.insert(self.beads, i);
+    }
 }
 
 impl Bead {
@@ -324,100 +336,103 @@ impl Bead {
     }
 }
 
-impl Head {
-    /// The hit of the head with its tip at `p` against `bead` (see [`replay`]): the bead's
-    /// highest point inside the head, if any rises more than `min_rise` above the tip.
-    pub fn bead_hit(&self, p: Point3, bead: &Bead, min_rise: f64) -> Option<Hit> {
-        if bead.top() - p.z <= min_rise {
-            return None;
-        }
-        let (w, h) = (bead.width, bead.height.min(bead.width));
-        let (r, a) = (h / 2.0, (w - h) / 2.0);
-        let theta = self.angle_deg.to_radians();
-        let (cos, tan) = (theta.cos(), theta.tan());
-        let lean = bead.lean_deg.to_radians().tan();
-        let at = |t: f64| Point3::from(bead.from.coords + (bead.to.coords - bead.from.coords) * t);
-        // Top of a button at horizontal distance u from its centre, relative to the centre.
-        let profile = |u: f64| {
-            if u <= a {
-                0.0
-            } else {
-                (r * r - (u - a) * (u - a)).max(0.0).sqrt() - r
-            }
-        };
-        // How far the head is from touching the button at t (negative: it touches). Along the
-        // line from the nozzle to the centre the head's measure |e − u| − radius(rise(u)) is
-        // convex in u towards the centre and grows away from it, so the flat top's edge, the
-        // cone's tangent point on the rounded edge (u = a + r·cos θ) and the point under the
-        // nozzle are the candidates.
-        let gap = |t: f64| {
-            let c = at(t);
-            let e = (c.x - p.x).hypot(c.y - p.y);
-            let mut g = f64::MAX;
-            if e > w / 2.0 + self.max_radius() {
-                return g;
-            }
-            for u in [a.min(e), (a + r * cos).min(e), e.min(w / 2.0)] {
-                let rise = c.z + profile(u) - u * lean - p.z;
-                if rise <= min_rise {
-                    continue;
-                }
-                let dist = e - u;
-                if dist <= 0.0 {
-                    // Material right above the tip.
-                    g = g.min(-rise);
-                } else if let Some((radius, _)) = self.radius_at(rise) {
-                    g = g.min(dist - radius);
-                }
-            }
-            g
-        };
-        // The cone's measure without its limits is convex along the bead (distance to a
-        // segment minus a linear height): its minimum, the point nearest to the nozzle and the
-        // ends cover the cone, the footprint and the carriage.
-        let cone = |t: f64| {
-            let c = at(t);
-            (c.x - p.x).hypot(c.y - p.y) - tan * (c.z - p.z)
-        };
-        let (mut lo, mut hi) = (0.0f64, 1.0f64);
-        let golden = 0.5 * (5f64.sqrt() - 1.0);
-        for _ in 0..60 {
-            if (hi - lo) * bead.length() < 1e-5 {
-                break;
-            }
-            let m1 = hi - golden * (hi - lo);
-            let m2 = lo + golden * (hi - lo);
-            if cone(m1) < cone(m2) {
-                hi = m2;
-            } else {
-                lo = m1;
-            }
-        }
-        let d = bead.to - bead.from;
-        let l2 = d.x * d.x + d.y * d.y;
-        let nearest = if l2 > 0.0 {
-            (((p.x - bead.from.x) * d.x + (p.y - bead.from.y) * d.y) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let t = [(lo + hi) / 2.0, nearest, 0.0, 1.0]
-            .into_iter()
-            .map(|t| (gap(t), t))
-            .fold((f64::MAX, 0.0), |b, c| if c.0 < b.0 { c } else { b })
-            .1;
-        (gap(t) < 0.0).then(|| {
-            let c = at(t);
-            let rise = c.z - p.z;
-            let part = self
-                .radius_at(rise)
-                .map_or(HeadPart::Cone, |(_, part)| part);
-            Hit {
-                nozzle: p,
-                material: c,
-                part,
-            }
-        })
+/// The hit of `head` with its tip at `p` against `bead` (see [`replay`]): the bead's highest
+/// point inside the head, if any rises more than `min_rise` above the tip. The tangent point
+/// is the one of the head's cone ([`ToolSolid::cone`]; a head without one is tested as a
+/// cylinder).
+pub fn bead_hit(head: &ToolSolid, p: Point3, bead: &Bead, min_rise: f64) -> Option<Hit> {
+    if bead.top() - p.z <= min_rise {
+        return None;
     }
+    let (w, h) = (bead.width, bead.height.min(bead.width));
+    let (r, a) = (h / 2.0, (w - h) / 2.0);
+    let theta = match head.cone().map(|c| c.shape) {
+        Some(PieceShape::Cone { angle_deg, .. }) => angle_deg.to_radians(),
+        _ => 0.0,
+    };
+    let (cos, tan) = (theta.cos(), theta.tan());
+    let lean = bead.lean_deg.to_radians().tan();
+    let at = |t: f64| Point3::from(bead.from.coords + (bead.to.coords - bead.from.coords) * t);
+    // Top of a button at horizontal distance u from its centre, relative to the centre.
+    let profile = |u: f64| {
+        if u <= a {
+            0.0
+        } else {
+            (r * r - (u - a) * (u - a)).max(0.0).sqrt() - r
+        }
+    };
+    // How far the head is from touching the button at t (negative: it touches). Along the
+    // line from the nozzle to the centre the head's measure |e − u| − radius(rise(u)) is
+    // convex in u towards the centre and grows away from it, so the flat top's edge, the
+    // cone's tangent point on the rounded edge (u = a + r·cos θ) and the point under the
+    // nozzle are the candidates.
+    let gap = |t: f64| {
+        let c = at(t);
+        let e = (c.x - p.x).hypot(c.y - p.y);
+        let mut g = f64::MAX;
+        if e > w / 2.0 + head.widest() {
+            return g;
+        }
+        for u in [a.min(e), (a + r * cos).min(e), e.min(w / 2.0)] {
+            let rise = c.z + profile(u) - u * lean - p.z;
+            if rise <= min_rise {
+                continue;
+            }
+            let dist = e - u;
+            if dist <= 0.0 {
+                // Material right above the tip.
+                g = g.min(-rise);
+            } else if let Some((radius, _)) = head.radius_at(rise) {
+                g = g.min(dist - radius);
+            }
+        }
+        g
+    };
+    // The cone's measure without its limits is convex along the bead (distance to a
+    // segment minus a linear height): its minimum, the point nearest to the nozzle and the
+    // ends cover the cone, the footprint and the carriage.
+    let cone = |t: f64| {
+        let c = at(t);
+        (c.x - p.x).hypot(c.y - p.y) - tan * (c.z - p.z)
+    };
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    let golden = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        if (hi - lo) * bead.length() < 1e-5 {
+            break;
+        }
+        let m1 = hi - golden * (hi - lo);
+        let m2 = lo + golden * (hi - lo);
+        if cone(m1) < cone(m2) {
+            hi = m2;
+        } else {
+            lo = m1;
+        }
+    }
+    let d = bead.to - bead.from;
+    let l2 = d.x * d.x + d.y * d.y;
+    let nearest = if l2 > 0.0 {
+        (((p.x - bead.from.x) * d.x + (p.y - bead.from.y) * d.y) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let t = [(lo + hi) / 2.0, nearest, 0.0, 1.0]
+        .into_iter()
+        .map(|t| (gap(t), t))
+        .fold((f64::MAX, 0.0), |b, c| if c.0 < b.0 { c } else { b })
+        .1;
+    (gap(t) < 0.0).then(|| {
+        let c = at(t);
+        let rise = c.z - p.z;
+        let part = head
+            .radius_at(rise)
+            .map_or(ToolPart::Cone, |(_, part)| part);
+        Hit {
+            nozzle: p,
+            material: c,
+            part,
+        }
+    })
 }
 
 /// Beads sorted into [`REPLAY_CELL_MM`] cells by the xy box of their footprint; each cell's
@@ -493,24 +508,9 @@ impl BeadIndex {
     }
 
     /// Beads that may reach into the head at `p`, in ascending index order without repeats.
-    fn candidates(
-        &self,
-        beads: &[Bead],
-        p: Point3,
-        head: &Head,
-        tol: &ReplayTolerances,
-    ) -> Vec<usize> {
+    fn candidates(&self, beads: &[Bead], p: Point3, head: &ToolSolid, min_rise: f64) -> Vec<usize> {
         let mut out = Vec::new();
-        let reach = |rise: f64| -> f64 {
-            let tan = head.angle_deg.to_radians().tan();
-            let cone = rise.min(head.height) * tan;
-            let carriage = if head.carriage_radius > 0.0 && rise >= head.carriage_clearance {
-                head.carriage_radius
-            } else {
-                0.0
-            };
-            cone.max(carriage) + self.widest / 2.0
-        };
+        let reach = |rise: f64| -> f64 { head.widest_up_to(rise) + self.widest / 2.0 };
         let far = reach(f64::MAX / 4.0).min(1e4);
         let (x0, y0) = self.cell(p.x - far, p.y - far);
         let (x1, y1) = self.cell(p.x + far, p.y + far);
@@ -518,7 +518,7 @@ impl BeadIndex {
             for cx in x0..=x1 {
                 let k = cy * self.dims[0] + cx;
                 let rise = self.tops[k] - p.z;
-                if rise <= tol.rise {
+                if rise <= min_rise {
                     continue;
                 }
                 // Distance from p to the cell's square.
@@ -532,7 +532,7 @@ impl BeadIndex {
                     continue;
                 }
                 for &(z, j) in &self.cells[k] {
-                    if z - p.z <= tol.rise {
+                    if z - p.z <= min_rise {
                         break;
                     }
                     let b = &beads[j];
@@ -615,12 +615,7 @@ mod tests {
 
     #[test]
     fn cone_hits_a_wall_within_its_radius_only() {
-        let head = Head {
-            angle_deg: 45.0,
-            height: 5.0,
-            carriage_radius: 0.0,
-            carriage_clearance: 10.0,
-        };
+        let head = ToolSolid::fff_head(45.0, 5.0, 0.0, 10.0);
         let mut m = Material::default();
         m.add_layer(
             3.0,
@@ -630,29 +625,19 @@ mod tests {
         // 2 mm above the tip the cone is 2 mm wide.
         let near = [Point3::new(8.5, 2.0, 1.0)];
         let far = [Point3::new(7.5, 2.0, 1.0)];
-        let hit = head.first_hit(&near, &m).map(|h| (h.part, h.material));
-        assert_eq!(hit, Some((HeadPart::Cone, Point3::new(10.0, 2.0, 3.0))));
-        assert!(head.first_hit(&far, &m).is_none());
+        let hit = m.first_hit(&head, &near).map(|h| (h.part, h.material));
+        assert_eq!(hit, Some((ToolPart::Cone, Point3::new(10.0, 2.0, 3.0))));
+        assert!(m.first_hit(&head, &far).is_none());
         // Material below the tip never collides.
-        assert!(head.first_hit(&[Point3::new(11.0, 2.0, 3.5)], &m).is_none());
-        let carriage = Head {
-            carriage_radius: 20.0,
-            carriage_clearance: 1.5,
-            height: 1.0,
-            ..head
-        };
-        let hit = carriage.first_hit(&far, &m).map(|h| h.part);
-        assert_eq!(hit, Some(HeadPart::Carriage));
+        assert!(m.first_hit(&head, &[Point3::new(11.0, 2.0, 3.5)]).is_none());
+        let carriage = ToolSolid::fff_head(45.0, 1.0, 20.0, 1.5);
+        let hit = m.first_hit(&carriage, &far).map(|h| h.part);
+        assert_eq!(hit, Some(ToolPart::Carriage));
     }
 
     #[test]
     fn replay_finds_a_bead_exactly_where_the_cone_meets_its_rounded_edge() {
-        let head = Head {
-            angle_deg: 60.0,
-            height: 5.0,
-            carriage_radius: 0.0,
-            carriage_clearance: 10.0,
-        };
+        let head = ToolSolid::fff_head(60.0, 5.0, 0.0, 10.0);
         let wall = Bead {
             from: Point3::new(0.0, 0.0, 1.3),
             to: Point3::new(10.0, 0.0, 1.3),
@@ -674,7 +659,7 @@ mod tests {
         let near = replay(&[wall, pass(limit - 0.01)], 1, &head, &tol);
         assert_eq!(near.len(), 1);
         assert_eq!((near[0].bead, near[0].earlier), (1, 0));
-        assert_eq!(near[0].hit.part, HeadPart::Cone);
+        assert_eq!(near[0].hit.part, ToolPart::Cone);
         assert!((near[0].hit.material.z - 1.3).abs() < 1e-9);
         assert!(replay(&[wall, pass(limit + 0.01)], 1, &head, &tol).is_empty());
         // Before `start` nothing is tested; a bead at the same height never counts.
@@ -691,10 +676,7 @@ mod tests {
             to: Point3::new(8.0, 0.05, 1.2),
             ..pass(0.0)
         };
-        let narrow = Head {
-            angle_deg: 0.0,
-            ..head
-        };
+        let narrow = ToolSolid::fff_head(0.0, 5.0, 0.0, 10.0);
         assert_eq!(replay(&[wall, under], 1, &narrow, &tol).len(), 1);
     }
 }

@@ -44,8 +44,9 @@ use crate::region::infill::{InfillPattern, Rectilinear};
 use crate::region::make_perimeters;
 use crate::slice::LayerZ;
 use crate::surface::HeightField;
+use crate::surface::{Hit, ToolPart, ToolSolid};
 use crate::toolpaths::RoleSpeeds;
-use collision::{Head, HeadPart, Material};
+use collision::Material;
 use tops::{
     AreaIndex, Projector, TopRegion, find_top_regions, removal_stepped, rim_step, top_layer_at,
 };
@@ -293,10 +294,11 @@ fn disc(x: f64, y: f64, r: f64) -> ExPolygon {
 }
 
 /// The rejection for a head hit: what part of the head, where, and the setting that allows it.
-fn collision_rejection(oi: usize, hit: &collision::Hit, what: String) -> Rejection {
+fn collision_rejection(oi: usize, hit: &Hit, what: String) -> Rejection {
     let (r, rise) = (hit.radius(), hit.rise());
     let (part, setting) = match hit.part {
-        HeadPart::Cone => (
+        // The FFF head has a cone and a carriage only.
+        ToolPart::Cone | ToolPart::Tip | ToolPart::Needle => (
             "cone",
             format!(
                 "curved.head_angle < {:.1} or curved.head_height < {:.2}",
@@ -304,7 +306,7 @@ fn collision_rejection(oi: usize, hit: &collision::Hit, what: String) -> Rejecti
                 rise
             ),
         ),
-        HeadPart::Carriage => (
+        ToolPart::Carriage => (
             "carriage",
             format!("curved.carriage_radius < {r:.2} or curved.carriage_clearance > {rise:.2}"),
         ),
@@ -330,7 +332,7 @@ fn plan_region(
     oi: usize,
     region: &TopRegion,
     hf: &HeightField,
-    head: &Head,
+    head: &ToolSolid,
     cfg: &CurvedParams,
     rejections: &mut Vec<Rejection>,
 ) -> Result<RegionPlan, Rejection> {
@@ -358,7 +360,7 @@ struct RegionJob<'a> {
     /// The object's top surface.
     hf: &'a HeightField,
     /// The head model.
-    head: &'a Head,
+    head: &'a ToolSolid,
     /// The whole config.
     cfg: &'a CurvedParams,
     /// Number of curved layers (the top solid layers).
@@ -387,7 +389,7 @@ struct Cleared {
     /// Per planar layer, the area the curved layers replace.
     remove: Vec<Vec<ExPolygon>>,
     /// Every hit trimmed, with its layer.
-    trims: Vec<(usize, collision::Hit)>,
+    trims: Vec<(usize, Hit)>,
     /// Rounds of trimming.
     rounds: usize,
 }
@@ -400,7 +402,7 @@ impl<'a> RegionJob<'a> {
         oi: usize,
         region: &'a TopRegion,
         hf: &'a HeightField,
-        head: &'a Head,
+        head: &'a ToolSolid,
         cfg: &'a CurvedParams,
     ) -> Result<Self, Rejection> {
         let obj = &objects[oi];
@@ -483,7 +485,7 @@ impl<'a> RegionJob<'a> {
     /// `areas` around the hits and projects again. A rejection when nothing of the region is
     /// left or the head still hits after [`MAX_TRIM_ROUNDS`] rounds.
     fn trim_until_clear(&self, areas: &mut [Vec<ExPolygon>]) -> Result<Cleared, Rejection> {
-        let mut trims: Vec<(usize, collision::Hit)> = Vec::new();
+        let mut trims: Vec<(usize, Hit)> = Vec::new();
         let mut rounds = 0;
         loop {
             let layers = project_layers(areas, self.region, self.obj, self.hf, self.cfg);
@@ -517,7 +519,7 @@ impl<'a> RegionJob<'a> {
 
     /// The rejection when the layers hold no path: the first trim took it all, or the region
     /// is too small for one.
-    fn nothing_left(&self, trims: &[(usize, collision::Hit)]) -> Rejection {
+    fn nothing_left(&self, trims: &[(usize, Hit)]) -> Rejection {
         let region = self.region;
         match trims.first() {
             Some((_, hit)) => collision_rejection(
@@ -578,18 +580,14 @@ impl<'a> RegionJob<'a> {
     /// Every layer's nozzles against the planar material and the layer's own points (a concave
     /// surface may rise into the head beside the nozzle): the hits, one per layer and
     /// [`HIT_GRID_MM`] square.
-    fn head_hits(
-        &self,
-        layers: &[ProjectedLayer],
-        material: &Material,
-    ) -> Vec<(usize, collision::Hit)> {
-        let mut found: Vec<(usize, collision::Hit)> = Vec::new();
+    fn head_hits(&self, layers: &[ProjectedLayer], material: &Material) -> Vec<(usize, Hit)> {
+        let mut found: Vec<(usize, Hit)> = Vec::new();
         let mut seen = std::collections::BTreeSet::new();
         for (k, pieces, ..) in layers {
             let nozzles = sample_nozzles(pieces.iter().flat_map(|p| p.points.iter().copied()));
             let mut with_own = material.clone();
             with_own.add_points(nozzles.iter().copied());
-            for hit in self.head.hits(&nozzles, &with_own) {
+            for hit in with_own.hits(self.head, &nozzles) {
                 let key = (
                     *k,
                     (hit.material.x / HIT_GRID_MM).floor() as i64,
@@ -606,7 +604,7 @@ impl<'a> RegionJob<'a> {
     /// Trims `areas` around the hits: a hit on layer k trims it and every deeper layer, each
     /// deeper one a rim step more (what it trims becomes planar material beside the deeper
     /// layers).
-    fn trim(&self, areas: &mut [Vec<ExPolygon>], found: &[(usize, collision::Hit)]) {
+    fn trim(&self, areas: &mut [Vec<ExPolygon>], found: &[(usize, Hit)]) {
         let discs_of = |k: usize| -> Vec<ExPolygon> {
             found
                 .iter()
@@ -628,9 +626,9 @@ impl<'a> RegionJob<'a> {
 
     /// Reports every trimmed piece to `rejections`: per layer, each connected group of trimmed
     /// hits with the area of the rim it leaves planar.
-    fn report_trims(&self, trims: &[(usize, collision::Hit)], rejections: &mut Vec<Rejection>) {
+    fn report_trims(&self, trims: &[(usize, Hit)], rejections: &mut Vec<Rejection>) {
         for k in 0..self.n {
-            let hits: Vec<&collision::Hit> = trims
+            let hits: Vec<&Hit> = trims
                 .iter()
                 .filter(|(hk, _)| *hk == k)
                 .map(|(_, h)| h)
@@ -777,7 +775,7 @@ fn peak(region: &TopRegion) -> [f64; 3] {
 /// reach of its perimeters and rim steps.
 fn region_window(
     region: &TopRegion,
-    head: &Head,
+    head: &ToolSolid,
     cfg: &CurvedParams,
     step: Option<f64>,
 ) -> [f64; 4] {
@@ -787,7 +785,7 @@ fn region_window(
         + n as f64 * step.unwrap_or(0.0)
         + 1.0;
     let bb = ring_bbox(&region.area);
-    let grow = head.max_radius().max(reach) + 1.0;
+    let grow = head.widest().max(reach) + 1.0;
     [bb[0] - grow, bb[1] - grow, bb[2] + grow, bb[3] + grow]
 }
 

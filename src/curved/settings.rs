@@ -9,6 +9,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::region::RegionParams;
+use crate::surface::ToolSolid;
 use crate::toolpaths::ProgramParams;
 
 /// Which curved-layer mode a slice uses.
@@ -188,13 +189,13 @@ impl CurvedSettings {
 
 impl CurvedSettings {
     /// The print head these settings describe: the cone and the carriage cylinder.
-    pub fn head(&self) -> crate::curved::collision::Head {
-        crate::curved::collision::Head {
-            angle_deg: self.head_angle,
-            height: self.head_height,
-            carriage_radius: self.carriage_radius,
-            carriage_clearance: self.carriage_clearance,
-        }
+    pub fn head(&self) -> ToolSolid {
+        ToolSolid::fff_head(
+            self.head_angle,
+            self.head_height,
+            self.carriage_radius,
+            self.carriage_clearance,
+        )
     }
 }
 

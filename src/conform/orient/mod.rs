@@ -16,7 +16,9 @@
 //! With an axis a the tip is T + d·a (d the inner diameter: the standoff along the tool). A
 //! tool along the normal meets the surface square, so the 3-axis contact escape and downhill
 //! shift, which make up for a vertical nozzle on a slope, are not applied. The whole tilted
-//! nozzle is then checked against the surface ([`collide`]); contacts are reported, not moved.
+//! nozzle is then checked against the surface along its axis
+//! ([`crate::surface::ToolSolid::penetration_along`], the needle sampled every quarter of the
+//! inner diameter); contacts are reported, not moved.
 //!
 //! The report ([`OrientationReport`]) gives, per path and overall, the largest angle between
 //! the tool axis and the surface normal (for `vertical`: the steepest slope under the tip), the
@@ -25,7 +27,6 @@
 //! (the deposit model measures from a vertical nozzle's back edge, an approximation for a
 //! tilted one), and its comparison lists the 3-axis method and controls on the same path.
 
-pub mod collide;
 pub mod normals;
 
 use super::ConformSettings;
@@ -222,7 +223,7 @@ pub fn plan(
     if o.axis == ToolAxis::Vertical {
         let Planned { paths, report } = super::plan(surface, design, place, params, |_| {})?;
         let axes: Vec<Vec<Vector3>> = paths.iter().map(|p| vec![Vector3::z(); p.len()]).collect();
-        let half = params.nozzle.outer / 2.0;
+        let half = params.nozzle.tip_radius();
         // Normals under the tips; the whole-nozzle check of a vertical nozzle is the plan's own.
         let normals: Vec<Vec<Option<Vector3>>> = paths
             .iter()
@@ -236,7 +237,7 @@ pub fn plan(
             .iter()
             .map(|p| {
                 p.iter()
-                    .map(|q| params.nozzle.penetration(surface, q))
+                    .map(|q| params.nozzle.solid.penetration(surface, q))
                     .collect()
             })
             .collect();
@@ -250,7 +251,7 @@ pub fn plan(
     }
     let d = params.nozzle.inner;
     let super::OnSurface { planar, projected } = super::on_surface(surface, design, place, params)?;
-    let half = params.nozzle.outer / 2.0;
+    let half = params.nozzle.tip_radius();
     let mut limited = 0;
     let mut paths = Vec::with_capacity(projected.paths.len());
     let mut axes = Vec::with_capacity(projected.paths.len());
@@ -277,7 +278,12 @@ pub fn plan(
         contacts.push(
             tips.iter()
                 .zip(&a)
-                .map(|(p, ax)| collide::penetration(surface, &params.nozzle, p, ax))
+                .map(|(p, ax)| {
+                    params
+                        .nozzle
+                        .solid
+                        .penetration_along(surface, p, ax, d / 4.0)
+                })
                 .collect(),
         );
         paths.push(tips);

@@ -2,9 +2,10 @@
 //! touch anything printed before the nozzle gets there?
 //!
 //! Place in the pipeline: after the sections are Programs, before they are written; its
-//! findings go to the report and to stderr. It uses the head of [`crate::curved::collision`]
-//! (the `[curved]` head keys) but not its material model, which tests every nozzle position
-//! against every point: a whole print needs a spatial index.
+//! findings go to the report and to stderr. It uses the head of the `[curved]` head keys
+//! ([`ToolSolid::fff_head`]) but not the material model of [`crate::curved::collision`], which
+//! tests every nozzle position against every point: a whole print needs a spatial index. The
+//! replay is the walk of [`crate::surface::replay`] with the grid as its obstacle.
 //!
 //! # Method
 //!
@@ -13,15 +14,15 @@
 //! its segments). Each path is tested before it is added: every nozzle position (its points and
 //! points every [`CELL_MM`] between them) against the cells within the head's widest radius;
 //! a cell's point `q` hits when it is above the tip and closer horizontally than the head's
-//! radius at that height ([`Head::radius_at`]). Positions at or above everything printed so far
+//! radius at that height ([`ToolSolid::radius_at`]). Positions at or above everything printed so far
 //! are skipped (nothing can be above the tip). Keeping one point per cell is an approximation
 //! at the scale of a cell: a lower point beside the highest is not tested.
 
 use serde::Serialize;
 
-use crate::curved::collision::{Head, HeadPart};
 use crate::geom::Point3;
 use crate::program::{Program, Role};
+use crate::surface::{Hit, Next, Obstacle, Sample, Spacing, Stretch, ToolPart, ToolSolid, walk};
 
 /// Side of the material grid's cells, mm.
 pub const CELL_MM: f64 = 0.25;
@@ -41,7 +42,7 @@ pub struct Collision {
     /// The material inside the head, mm.
     pub material: [f64; 3],
     /// The part of the head.
-    pub part: HeadPart,
+    pub part: ToolPart,
 }
 
 /// What the replay found.
@@ -53,6 +54,7 @@ pub struct Collisions {
     pub count: usize,
 }
 
+/// Printed material: per [`CELL_MM`] cell the highest point laid down in it.
 struct Grid {
     origin: [f64; 2],
     dims: [usize; 2],
@@ -101,11 +103,11 @@ impl Grid {
     }
 
     /// The first material point inside the head with its tip at `p`.
-    fn hit(&self, head: &Head, p: Point3) -> Option<(Point3, HeadPart)> {
+    fn hit(&self, head: &ToolSolid, p: Point3) -> Option<Hit> {
         if p.z >= self.top {
             return None;
         }
-        let r = head.max_radius();
+        let r = head.widest();
         let (x0, y0) = (p.x - r, p.y - r);
         let c0 = (
             ((x0 - self.origin[0]) / CELL_MM).floor().max(0.0) as usize,
@@ -122,11 +124,8 @@ impl Grid {
                 let Some(q) = self.cells[cy * self.dims[0] + cx] else {
                     continue;
                 };
-                let Some((radius, part)) = head.radius_at(q.z - p.z) else {
-                    continue;
-                };
-                if (q.x - p.x).hypot(q.y - p.y) < radius {
-                    return Some((q, part));
+                if let Some(hit) = Hit::of_point(head, p, q) {
+                    return Some(hit);
                 }
             }
         }
@@ -134,57 +133,63 @@ impl Grid {
     }
 }
 
-/// Points along `points` (closed: back to the first) at most [`CELL_MM`] apart.
-fn samples(points: &[Point3], closed: bool) -> Vec<Point3> {
-    let mut out = Vec::with_capacity(points.len() * 2);
-    let n = points.len();
-    let segs = if closed && n > 2 {
-        n
-    } else {
-        n.saturating_sub(1)
-    };
-    for i in 0..segs {
-        let (a, b) = (points[i], points[(i + 1) % n]);
-        let k = ((b - a).xy().norm() / CELL_MM).ceil().max(1.0) as usize;
-        for j in 0..k {
-            out.push(a + (b - a) * (j as f64 / k as f64));
+/// The grid as an obstacle: the contact is its first point inside the head; a path lays down
+/// its tested positions.
+impl Obstacle for Grid {
+    type Contact = Option<Hit>;
+
+    fn contact(&self, tool: &ToolSolid, _index: usize, sample: &Sample) -> Option<Hit> {
+        self.hit(tool, sample.tip)
+    }
+
+    fn lay(&mut self, _index: usize, _stretch: &Stretch<'_>, samples: &[Sample]) {
+        for s in samples {
+            self.add(s.tip);
         }
     }
-    if let (false, Some(&last)) = (closed && n > 2, points.last()) {
-        out.push(last);
-    }
-    out
 }
 
-/// Replays `program` with `head` (see the module docs).
-pub fn replay(program: &Program, head: &Head) -> Collisions {
+/// Replays `program` with `head` (see the module docs): the walk of its paths, in print order,
+/// positions at most [`CELL_MM`] apart; scaffold paths are laid down but not tested.
+pub fn replay(program: &Program, head: &ToolSolid) -> Collisions {
     let mut found = Collisions::default();
     let Some(mut grid) = Grid::new(program) else {
         return found;
     };
-    for layer in &program.layers {
-        for path in layer.paths() {
-            let pts = samples(&path.points, path.closed);
-            if path.role != Role::Scaffold
-                && let Some((p, (q, part))) =
-                    pts.iter().find_map(|&p| grid.hit(head, p).map(|h| (p, h)))
-            {
-                found.count += 1;
-                if found.listed.len() < MAX_LISTED {
-                    found.listed.push(Collision {
-                        layer: layer.index,
-                        role: path.role.type_name(),
-                        nozzle: [p.x, p.y, p.z],
-                        material: [q.x, q.y, q.z],
-                        part,
-                    });
-                }
+    let paths: Vec<(usize, &crate::program::Toolpath)> = program
+        .layers
+        .iter()
+        .flat_map(|layer| layer.paths().map(move |path| (layer.index, path)))
+        .collect();
+    let stretches = paths.iter().map(|(_, path)| Stretch {
+        points: &path.points,
+        closed: path.closed,
+        tested: path.role != Role::Scaffold,
+    });
+    walk(
+        head,
+        &mut grid,
+        stretches,
+        Spacing::Horizontal(CELL_MM),
+        |i, _, hit| {
+            let Some(hit) = hit else {
+                return Next::Sample;
+            };
+            let (layer, path) = paths[i];
+            found.count += 1;
+            if found.listed.len() < MAX_LISTED {
+                let (p, q) = (hit.nozzle, hit.material);
+                found.listed.push(Collision {
+                    layer,
+                    role: path.role.type_name(),
+                    nozzle: [p.x, p.y, p.z],
+                    material: [q.x, q.y, q.z],
+                    part: hit.part,
+                });
             }
-            for p in pts {
-                grid.add(p);
-            }
-        }
-    }
+            Next::Stretch
+        },
+    );
     found
 }
 
@@ -209,12 +214,7 @@ mod tests {
 
     #[test]
     fn a_wall_beside_a_low_path_is_hit_and_a_far_one_is_not() {
-        let head = Head {
-            angle_deg: 45.0,
-            height: 5.0,
-            carriage_radius: 0.0,
-            carriage_clearance: 10.0,
-        };
+        let head = ToolSolid::fff_head(45.0, 5.0, 0.0, 10.0);
         let wall = path(
             vec![Point3::new(10.0, 0.0, 3.0), Point3::new(10.0, 5.0, 3.0)],
             Role::ExternalPerimeter,
@@ -237,7 +237,7 @@ mod tests {
         };
         let hit = replay(&program(vec![wall.clone(), near]), &head);
         assert_eq!(hit.count, 1);
-        assert_eq!(hit.listed[0].part, HeadPart::Cone);
+        assert_eq!(hit.listed[0].part, ToolPart::Cone);
         assert!((hit.listed[0].material[0] - 10.0).abs() < 1e-9);
         assert_eq!(replay(&program(vec![wall, far]), &head).count, 0);
     }
