@@ -682,6 +682,7 @@ mod tests {
             height: 0.2,
             speed: 20.0,
             tool_axis: None,
+            segments: None,
         };
         let plain = build_program(std::slice::from_ref(&plastic), &ProgramParams::default());
         let mut extras = LayerExtras::default();

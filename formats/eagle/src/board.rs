@@ -193,11 +193,12 @@ pub(crate) fn read(doc: &Doc<'_>, version: String, brd: &Node) -> Result<Board, 
         if doc.opt_u32(w, "layer")? != Some(LAYER_DIMENSION) {
             continue;
         }
+        let [x1, y1, x2, y2] = wire_ends(doc, w)?;
         outline.push(OutlineSegment {
-            x1: doc.f64(w, "x1")?,
-            y1: doc.f64(w, "y1")?,
-            x2: doc.f64(w, "x2")?,
-            y2: doc.f64(w, "y2")?,
+            x1,
+            y1,
+            x2,
+            y2,
             curve: doc.opt_f64(w, "curve")?.unwrap_or(0.0),
         });
     }
@@ -222,14 +223,25 @@ fn signal_wires(doc: &Doc<'_>, signal: &Node) -> Result<Vec<SignalWire>, EagleEr
         if !(1..=16).contains(&layer) {
             continue;
         }
+        let [x1, y1, x2, y2] = wire_ends(doc, w)?;
         out.push(SignalWire {
-            x1: doc.f64(w, "x1")?,
-            y1: doc.f64(w, "y1")?,
-            x2: doc.f64(w, "x2")?,
-            y2: doc.f64(w, "y2")?,
+            x1,
+            y1,
+            x2,
+            y2,
             width: doc.opt_f64(w, "width")?.unwrap_or(0.0),
             layer,
         });
     }
     Ok(out)
+}
+
+/// A `<wire>`'s end points `[x1, y1, x2, y2]`, mm.
+fn wire_ends(doc: &Doc<'_>, w: &Node) -> Result<[f64; 4], EagleError> {
+    Ok([
+        doc.f64(w, "x1")?,
+        doc.f64(w, "y1")?,
+        doc.f64(w, "x2")?,
+        doc.f64(w, "y2")?,
+    ])
 }

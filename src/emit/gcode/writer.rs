@@ -726,16 +726,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         self.travel_to(self.machine(&path.points[0], tool));
         self.wait_for_tool(tool);
         self.unretract();
-        let type_name = path.role.type_name();
-        if self.type_name != Some(type_name) {
-            self.line(&format!(";TYPE:{type_name}"));
-            self.type_name = Some(type_name);
-        }
-        let w = fmt_xyz(path.width);
-        if self.width.as_deref() != Some(w.as_str()) {
-            self.line(&format!(";WIDTH:{w}"));
-            self.width = Some(w);
-        }
+        self.markers(path);
         let h = fmt_xyz(path.height);
         if self.height.as_deref() != Some(h.as_str()) {
             self.line(&format!(";HEIGHT:{h}"));

@@ -251,7 +251,7 @@ impl<S: GcodeSink> Writer<'_, S> {
     }
 
     /// `;TYPE:` and `;WIDTH:` of `path`, when they change.
-    fn markers(&mut self, path: &Toolpath) {
+    pub(super) fn markers(&mut self, path: &Toolpath) {
         let type_name = path.role.type_name();
         if self.type_name != Some(type_name) {
             self.line(&format!(";TYPE:{type_name}"));
