@@ -331,3 +331,91 @@ fn gcode_commands_refuse_other_files() {
         }
     }
 }
+
+#[test]
+fn jet_conform_calibrate_and_compensate_refuse_to_overwrite_an_input() {
+    let tmp = temp_dir();
+    let copy = |rel: &str| {
+        let to = tmp.path().join(Path::new(rel).file_name().expect("name"));
+        std::fs::copy(sample(rel), &to).expect("copy");
+        to
+    };
+    let pivot = copy("robot/pivot.csv");
+    let star = copy("jet/star8.svg");
+    let spiral = copy("conform/spiral.svg");
+    let film = copy("conform/wrinkled_film.xyz");
+    let circle = tmp.path().join("circle.csv");
+    let p = conduit([
+        "compensate".as_ref(),
+        "pattern".as_ref(),
+        "circle".as_ref(),
+        "--size".as_ref(),
+        "10".as_ref(),
+        "--surface".as_ref(),
+        "sphere:15".as_ref(),
+        "-o".as_ref(),
+        os(&circle),
+    ]);
+    assert!(p.status.success(), "{}", stderr(&p));
+    let runs: Vec<(Vec<&std::ffi::OsStr>, &Path)> = vec![
+        (
+            vec![
+                "calibrate".as_ref(),
+                "tcp".as_ref(),
+                os(&pivot),
+                "--report".as_ref(),
+                os(&pivot),
+            ],
+            &pivot,
+        ),
+        (
+            vec![
+                "jet".as_ref(),
+                os(&star),
+                "--width".as_ref(),
+                "20".as_ref(),
+                "--layers".as_ref(),
+                "2".as_ref(),
+                "--layer-height".as_ref(),
+                "5".as_ref(),
+                "-o".as_ref(),
+                os(&star),
+            ],
+            &star,
+        ),
+        (
+            vec![
+                "conform".as_ref(),
+                "--surface".as_ref(),
+                os(&film),
+                "--design".as_ref(),
+                os(&spiral),
+                "-o".as_ref(),
+                os(&spiral),
+            ],
+            &spiral,
+        ),
+        (
+            vec![
+                "compensate".as_ref(),
+                os(&circle),
+                "--simulate".as_ref(),
+                "sphere:15".as_ref(),
+                "-o".as_ref(),
+                os(&circle),
+            ],
+            &circle,
+        ),
+    ];
+    for (args, input) in runs {
+        let before = std::fs::read(input).expect("read");
+        let o = conduit(&args);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("refusing to overwrite the input"),
+            "{}",
+            stderr(&o)
+        );
+        assert_eq!(std::fs::read(input).expect("read"), before, "{args:?}");
+    }
+}
