@@ -92,6 +92,23 @@ impl Target {
 /// Follows `path`'s symbolic links (also a dangling one: its target is created) and says how
 /// the file it leads to is written.
 fn resolve(path: &Path) -> io::Result<Target> {
+    // The kernel follows the links first: `/dev/fd/N` and `/dev/stdout` are links whose
+    // text (`pipe:[…]`) names no path, yet open to the pipe.
+    match fs::metadata(path) {
+        Ok(m) if m.is_file() => {
+            let linked = fs::symlink_metadata(path).is_ok_and(|l| l.file_type().is_symlink());
+            return Ok(Target::Regular(if linked {
+                fs::canonicalize(path)?
+            } else {
+                path.to_path_buf()
+            }));
+        }
+        Ok(m) if m.is_dir() => return Err(io::Error::other("it is a folder")),
+        Ok(_) => return Ok(Target::Special(path.to_path_buf())),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e),
+    }
+    // Nothing there yet, or a dangling link: the file its last link names is created.
     let mut p = path.to_path_buf();
     for _ in 0..MAX_LINKS {
         match fs::symlink_metadata(&p) {
@@ -102,9 +119,7 @@ fn resolve(path: &Path) -> io::Result<Target> {
                     None => link,
                 };
             }
-            Ok(m) if m.is_file() => return Ok(Target::Regular(p)),
-            Ok(m) if m.is_dir() => return Err(io::Error::other("it is a folder")),
-            Ok(_) => return Ok(Target::Special(p)),
+            Ok(_) => return Ok(Target::Regular(p)),
             Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Target::Regular(p)),
             Err(e) => return Err(e),
         }
