@@ -419,3 +419,19 @@ fn jet_conform_calibrate_and_compensate_refuse_to_overwrite_an_input() {
         assert_eq!(std::fs::read(input).expect("read"), before, "{args:?}");
     }
 }
+
+#[test]
+fn help_into_a_full_stdout_fails_and_into_a_closed_one_does_not() {
+    let o = with_closed_stdout(&["--help".as_ref()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        println!("skipped: /dev/full not available");
+        return;
+    };
+    let o = Command::new(env!("CARGO_BIN_EXE_conduit"))
+        .arg("--help")
+        .stdout(full)
+        .output()
+        .expect("conduit runs");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+}

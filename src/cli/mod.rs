@@ -100,8 +100,15 @@ pub fn run() -> ExitCode {
         Err(e) => {
             // --help and --version are not errors.
             let code = if e.use_stderr() { EXIT_USAGE } else { 0 };
-            let _ = e.print();
-            return ExitCode::from(code);
+            // Help that cannot be written (`--help > /dev/full`) fails like any other output; a
+            // closed pipe (`--help | head -1`) does not.
+            return match e.print() {
+                Err(io) if !e.use_stderr() && io.kind() != std::io::ErrorKind::BrokenPipe => {
+                    eprintln!("error: cannot write to standard output: {io}");
+                    ExitCode::from(EXIT_FAILURE)
+                }
+                _ => ExitCode::from(code),
+            };
         }
     };
     let result = match cli.command {
