@@ -16,6 +16,7 @@ mod electronics;
 mod electronics_corpus;
 mod golden;
 mod jet;
+mod outputs;
 mod postprocess;
 mod postprocess_e2e;
 mod preview;

@@ -8,9 +8,8 @@ use super::{Failure, config::resolve};
 use anyhow::{Context, anyhow};
 use conduit::robot::frames::{self, FrameFit, OutlierRule, PairKind};
 use conduit::robot::tcp::{self, Pivot, PoseSource};
-use conduit::scene::write_atomically;
+use conduit::scene::OutputSet;
 use serde::Serialize;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `conduit calibrate`.
@@ -95,10 +94,13 @@ fn read(path: &Path) -> anyhow::Result<String> {
     std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))
 }
 
-fn write_report(path: &Path, value: &impl Serialize) -> anyhow::Result<()> {
+/// Writes the JSON report, never over one of the run's `inputs`.
+fn write_report(path: &Path, value: &impl Serialize, inputs: &[&PathBuf]) -> Result<(), Failure> {
     let json = serde_json::to_vec_pretty(value).context("serialising the report")?;
-    write_atomically(path, |f| f.write_all(&json))
-        .with_context(|| format!("{}: cannot write report", path.display()))
+    let mut outputs = OutputSet::new(inputs);
+    outputs.add(path, &json)?;
+    outputs.commit()?;
+    Ok(())
 }
 
 /// The JSON report of `conduit calibrate tcp`.
@@ -121,45 +123,48 @@ fn run_tcp(args: TcpArgs) -> Result<(), Failure> {
         PoseSource::Quaternions => "positions and quaternions",
         PoseSource::Joints => "joint angles through [robot] dh",
     };
-    println!("{file}: {} flange poses ({source})", p.poses);
-    println!(
+    outln!("{file}: {} flange poses ({source})", p.poses)?;
+    outln!(
         "TCP offset in the flange frame: {} mm (1 sigma {} mm)",
         list(&p.tcp, 4, ", "),
         list(&p.tcp_sigma, 4, ", ")
-    );
-    println!(
+    )?;
+    outln!(
         "pivot in the base frame: {} mm (1 sigma {} mm)",
         list(&p.pivot, 4, ", "),
         list(&p.pivot_sigma, 4, ", ")
-    );
-    println!(
+    )?;
+    outln!(
         "residuals: rms {} mm, worst pose {} (line {}) {} mm",
         fixed(p.rms, 4),
         p.worst.pose,
         p.worst.line,
         fixed(p.worst.residual, 4)
-    );
-    println!("pose\tline\tresidual_mm");
+    )?;
+    outln!("pose\tline\tresidual_mm")?;
     for r in &p.residuals {
-        println!("{}\t{}\t{}", r.pose, r.line, fixed(r.residual, 4));
+        outln!("{}\t{}\t{}", r.pose, r.line, fixed(r.residual, 4))?;
     }
-    println!(
+    outln!(
         "condition number {} (singular values {}; refused above {})",
         fixed(p.condition, 2),
         list(&p.singular_values, 4, ", "),
         tcp::MAX_CONDITION
-    );
-    println!(
+    )?;
+    outln!(
         "paste into [robot] (pivot calibration measures the position; the rotation is the \
          configured one):"
-    );
-    println!(
+    )?;
+    outln!(
         "tool_frame = [{}, {}]",
         list(&p.tcp, 4, ", "),
         list(&cfg.robot.tool_frame[3..], 4, ", ")
-    );
+    )?;
     if let Some(path) = &args.report {
-        write_report(path, &TcpReport { file, result: &p })?;
+        let inputs: Vec<&PathBuf> = std::iter::once(&args.poses)
+            .chain(&args.config.config)
+            .collect();
+        write_report(path, &TcpReport { file, result: &p }, &inputs)?;
     }
     Ok(())
 }
@@ -179,8 +184,8 @@ fn run_register(args: RegisterArgs) -> Result<(), Failure> {
     let a = frames::read_measured(&read(&args.a)?).map_err(|e| anyhow!("{fa}: {e}"))?;
     let b = frames::read_measured(&read(&args.b)?).map_err(|e| anyhow!("{fb}: {e}"))?;
     let f = frames::register_frames(&a, &b, rule).map_err(|e| anyhow!("{fa} and {fb}: {e}"))?;
-    print_transform(&fa, &fb, &f);
-    print_residuals(&f);
+    print_transform(&fa, &fb, &f)?;
+    print_residuals(&f)?;
     warn_outliers(&f);
     if let Some(path) = &args.report {
         write_report(
@@ -190,6 +195,7 @@ fn run_register(args: RegisterArgs) -> Result<(), Failure> {
                 b: fb,
                 result: &f,
             },
+            &[&args.a, &args.b],
         )?;
     }
     Ok(())
@@ -211,49 +217,51 @@ fn outlier_rule(outlier: Option<f64>) -> Result<OutlierRule, Failure> {
 /// Prints the transform from frame A (file `fa`) to frame B (file `fb`): the pairs, the 4×4
 /// matrix, translation with quaternion and Euler angles, and the `[robot] workpiece_frame`
 /// line.
-fn print_transform(fa: &str, fb: &str, f: &FrameFit) {
+fn print_transform(fa: &str, fb: &str, f: &FrameFit) -> Result<(), Failure> {
     let kind = match f.kind {
         PairKind::Points => "point",
         PairKind::Poses => "pose",
     };
-    println!(
+    outln!(
         "{fa} -> {fb}: {} {kind} pairs, {} used; b = T*a (least squares)",
-        f.pairs, f.used
-    );
+        f.pairs,
+        f.used
+    )?;
     if let Some(l) = f.axis_length {
-        println!(
+        outln!(
             "poses weigh their orientation over axes {} mm long",
             fixed(l, 3)
-        );
+        )?;
     }
-    println!("4x4 matrix:");
+    outln!("4x4 matrix:")?;
     for row in &f.matrix {
         let cells: Vec<String> = row
             .iter()
             .map(|v| format!("{:>15}", fixed(*v, 9)))
             .collect();
-        println!("{}", cells.join(""));
+        outln!("{}", cells.join(""))?;
     }
-    println!(
+    outln!(
         "translation {} mm, quaternion (w, x, y, z) {}",
         list(&f.translation, 4, ", "),
         list(&f.quaternion, 9, ", ")
-    );
+    )?;
     let [ea, eb, ec] = f.euler_zyx_deg;
-    println!(
+    outln!(
         "xyz {} mm, ZYX Euler (about z, y, x) {} deg",
         list(&f.translation, 4, ", "),
         list(&f.euler_zyx_deg, 6, ", ")
-    );
-    println!(
+    )?;
+    outln!(
         "as [robot] workpiece_frame (A = program frame, B = robot base): workpiece_frame = [{}, {}]",
         list(&f.translation, 4, ", "),
         list(&[ec, eb, ea], 6, ", ")
-    );
+    )?;
+    Ok(())
 }
 
 /// Prints the residuals: their rms and outlier threshold, then one row per pair.
-fn print_residuals(f: &FrameFit) {
+fn print_residuals(f: &FrameFit) -> Result<(), Failure> {
     let rule = match f.rule {
         OutlierRule::Fixed(_) => "--outlier".to_owned(),
         OutlierRule::Median => format!(
@@ -262,34 +270,35 @@ fn print_residuals(f: &FrameFit) {
             frames::THRESHOLD_FLOOR
         ),
     };
-    println!(
+    outln!(
         "residuals: rms {} mm over the pairs used; outlier threshold {} mm ({rule})",
         fixed(f.rms, 4),
         fixed(f.threshold, 4)
-    );
+    )?;
     let poses = f.kind == PairKind::Poses;
-    println!(
+    outln!(
         "pair\tline_a\tline_b\tresidual_mm{}",
         if poses {
             "\tposition_mm\tangle_deg"
         } else {
             ""
         }
-    );
+    )?;
     for r in &f.residuals {
         let extra = match r.angle_deg {
             Some(d) if poses => format!("\t{}\t{}", fixed(r.position, 4), fixed(d, 4)),
             _ => String::new(),
         };
-        println!(
+        outln!(
             "{}\t{}\t{}\t{}{extra}{}",
             r.pair,
             r.line_a,
             r.line_b,
             fixed(r.residual, 4),
             if r.outlier { "\toutlier" } else { "" }
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// Warns about the outliers left out of the fit and those kept in it.

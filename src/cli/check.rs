@@ -3,20 +3,41 @@
 use super::{Failure, args::CheckArgs, config::resolve};
 use anyhow::Context;
 use conduit::check::check;
+use conduit::scene::FileKind;
+use std::path::Path;
+
+/// Reads a G-code input, refusing a file that is something else (an STL, a 3MF, …) by its
+/// content, or by its extension when the content does not look like G-code either.
+pub(crate) fn read_gcode_file(path: &Path) -> anyhow::Result<Vec<u8>> {
+    let bytes =
+        std::fs::read(path).with_context(|| format!("{}: cannot read file", path.display()))?;
+    let other = match FileKind::sniff(&bytes) {
+        Some(FileKind::Gcode) => None,
+        Some(kind) => Some(kind),
+        None => FileKind::from_extension(path).filter(|k| *k != FileKind::Gcode),
+    };
+    if let Some(kind) = other {
+        let name = serde_json::to_value(kind)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_uppercase))
+            .unwrap_or_default();
+        anyhow::bail!("{}: not a G-code file (it reads as {name})", path.display());
+    }
+    Ok(bytes)
+}
 
 pub(crate) fn run(args: CheckArgs) -> Result<(), Failure> {
     let cfg = resolve(&args.config)?;
-    let bytes = std::fs::read(&args.file)
-        .with_context(|| format!("{}: cannot read file", args.file.display()))?;
+    let bytes = read_gcode_file(&args.file)?;
     let gcode = conduit_gcode::parse(&bytes).with_context(|| format!("{}", args.file.display()))?;
     let report = check(&gcode, &cfg.check_params());
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&report).context("serialising the report")?
-        );
+        )?;
     } else {
-        println!("{}: {report}", args.file.display());
+        outln!("{}: {report}", args.file.display())?;
     }
     if report.has_errors() {
         eprintln!(

@@ -12,7 +12,7 @@ use conduit::pipeline::compensate as walk;
 use conduit::robot::compensate::substrate::{self, Substrate, SurfaceSpec};
 use conduit::robot::compensate::{Params, Path as PosePath, gaps};
 use conduit::robot::pattern::{self, PatternParams, Shape};
-use conduit::scene::write_atomically;
+use conduit::scene::OutputSet;
 use conduit_poses::Pose;
 use serde::Serialize;
 use std::io::Write;
@@ -276,21 +276,26 @@ fn leading_comments(text: &str) -> Vec<String> {
         .collect()
 }
 
-/// Writes `poses` after the `comments` lines, all or nothing.
-fn write_table(path: &Path, comments: &[String], poses: &[Pose]) -> anyhow::Result<()> {
+/// The table of `poses` after the `comments` lines, staged as `path`.
+fn add_table(
+    outputs: &mut OutputSet,
+    path: &Path,
+    comments: &[String],
+    poses: &[Pose],
+) -> Result<(), Failure> {
     let mut buf: Vec<u8> = Vec::new();
     for c in comments {
-        writeln!(buf, "{c}")?;
+        writeln!(buf, "{c}").map_err(anyhow::Error::from)?;
     }
     conduit_poses::write_poses(poses, &mut buf)
         .with_context(|| format!("{}: cannot write poses", path.display()))?;
-    write_atomically(path, |f| f.write_all(&buf))
-        .with_context(|| format!("{}: cannot write", path.display()))
+    outputs.add(path, &buf)?;
+    Ok(())
 }
 
-/// With `--program`, writes the compensated `poses` (their dispensing runs) as a robot or
+/// With `--program`, stages the compensated `poses` (their dispensing runs) as a robot or
 /// five-axis program.
-fn write_program(job: &Job, poses: &[Pose]) -> Result<(), Failure> {
+fn add_program(outputs: &mut OutputSet, job: &Job, poses: &[Pose]) -> Result<(), Failure> {
     let (Some(out), Some(name)) = (&job.args.program, &job.args.dialect) else {
         return Ok(());
     };
@@ -308,16 +313,33 @@ fn write_program(job: &Job, poses: &[Pose]) -> Result<(), Failure> {
         &job.cfg,
     )
     .map_err(anyhow::Error::from)?;
-    write_atomically(out, |f| f.write_all(&text))
-        .with_context(|| format!("{}: cannot write the program", out.display()))?;
+    outputs.add(out, &text)?;
     Ok(())
 }
 
-/// Writes a JSON report, all or nothing.
-fn write_report(path: &Path, report: &impl Serialize) -> anyhow::Result<()> {
+/// Stages a JSON report.
+fn add_report(
+    outputs: &mut OutputSet,
+    path: &Path,
+    report: &impl Serialize,
+) -> Result<(), Failure> {
     let json = serde_json::to_vec_pretty(report).context("serialising the report")?;
-    write_atomically(path, |f| f.write_all(&json))
-        .with_context(|| format!("{}: cannot write report", path.display()))
+    outputs.add(path, &json)?;
+    Ok(())
+}
+
+/// The output set of a compensation run: its outputs may not overwrite the path, the gaps, a
+/// simulated surface's file or the config.
+fn output_set(job: &Job) -> OutputSet {
+    let a = job.args;
+    let mut set = OutputSet::new([&job.path]);
+    for p in [&a.gaps, &a.config.config].into_iter().flatten() {
+        set.input(p);
+    }
+    if let Some(spec) = &a.simulate {
+        set.input(Path::new(spec));
+    }
+    set
 }
 
 /// One pass over measured gaps.
@@ -347,11 +369,13 @@ fn measured(job: &Job, gaps_path: &Path) -> Result<(), Failure> {
         (&on, &gaps_path.display().to_string()),
         params,
     );
-    write_table(output, &done.comments, &done.poses)?;
-    write_program(job, &done.poses)?;
+    let mut outputs = output_set(job);
+    add_table(&mut outputs, output, &done.comments, &done.poses)?;
+    add_program(&mut outputs, job, &done.poses)?;
     if let Some(r) = &args.report {
-        write_report(r, &done.report)?;
+        add_report(&mut outputs, r, &done.report)?;
     }
+    outputs.commit()?;
     let (b, c) = (done.report.before_mm, done.report.correction_mm);
     eprintln!(
         "{}: {} poses; gap before {:.4}..{:.4} mm (variation {:.1} µm, RMS {:.1} µm about {:.1} µm); \
@@ -389,16 +413,17 @@ fn simulated(job: &Job, spec: &str) -> Result<(), Failure> {
     )
     .map_err(anyhow::Error::from)?;
     let done = &sim.path;
-    write_table(output, &done.comments, &done.poses)?;
-    write_program(job, &done.poses)?;
+    let mut outputs = output_set(job);
+    add_table(&mut outputs, output, &done.comments, &done.poses)?;
+    add_program(&mut outputs, job, &done.poses)?;
     if let Some(r) = &args.readings_out {
         let table = sim.readings_table().map_err(anyhow::Error::from)?;
-        write_atomically(r, |f| f.write_all(table.as_bytes()))
-            .with_context(|| format!("{}: cannot write", r.display()))?;
+        outputs.add(r, table.as_bytes())?;
     }
     if let Some(r) = &args.report {
-        write_report(r, &done.report)?;
+        add_report(&mut outputs, r, &done.report)?;
     }
+    outputs.commit()?;
     let figures: Vec<String> = done
         .report
         .variation_um
@@ -477,7 +502,10 @@ fn run_pattern(args: PatternArgs) -> Result<(), Failure> {
         },
         params.gap
     )];
-    write_table(&args.output, &comments, &poses)?;
+    let mut outputs = OutputSet::new(args.config.config.iter());
+    outputs.input(Path::new(&args.surface));
+    add_table(&mut outputs, &args.output, &comments, &poses)?;
+    outputs.commit()?;
     eprintln!(
         "{}: {shape}, {} poses on {}",
         args.output.display(),

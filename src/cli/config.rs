@@ -33,7 +33,7 @@ pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
 
 pub(crate) fn run(args: ConfigArgs) -> Result<(), Failure> {
     if args.defaults {
-        print!("{}", config::defaults_toml());
+        out!("{}", config::defaults_toml())?;
         return Ok(());
     }
     if let Some(path) = &args.check {
@@ -41,7 +41,7 @@ pub(crate) fn run(args: ConfigArgs) -> Result<(), Failure> {
             config: Some(path.clone()),
             set: Vec::new(),
         })?;
-        print!("{}", cfg.to_toml_string());
+        out!("{}", cfg.to_toml_string())?;
     }
     Ok(())
 }

@@ -12,9 +12,8 @@ use conduit::conform::{ConformParams, ConformReport, Placement};
 use conduit::emit::robot::Dialect;
 use conduit::geom::Point3;
 use conduit::pipeline::conform::{self as walk, ConformJob, ConformOutput, ConformWalkError, Refs};
-use conduit::scene::{Content, LoadOptions, load, write_atomically};
+use conduit::scene::{Content, LoadOptions, OutputSet, load};
 use serde::Serialize;
-use std::io::Write;
 
 pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
     let mut cfg = resolve(&args.config)?;
@@ -58,7 +57,7 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
             .unwrap_or_default(),
     };
     let out = walk::run(job, &cfg, |_| {}).map_err(|e| located(e, &args))?;
-    write_outputs(&args, &out, dialect.is_some())?;
+    write_outputs(&args, &out)?;
     match out.moves {
         Some(moves) => print_program_summary(&args, &dialect_name, &out, moves),
         None => print_gcode_summary(&args, cfg.conform.corrections, &out.report),
@@ -129,21 +128,24 @@ fn refs(args: &ConformArgs) -> Result<Refs, Failure> {
     })
 }
 
-/// Writes the program and, when asked for, the JSON report.
-fn write_outputs(args: &ConformArgs, out: &ConformOutput, robot: bool) -> Result<(), Failure> {
-    write_atomically(&args.out, |f| f.write_all(&out.program)).with_context(|| {
-        let what = if robot { "the program" } else { "G-code" };
-        format!("{}: cannot write {what}", args.out.display())
-    })?;
+/// Writes the program and, when asked for, the JSON report: both or neither, never over an
+/// input.
+fn write_outputs(args: &ConformArgs, out: &ConformOutput) -> Result<(), Failure> {
+    let mut outputs = OutputSet::new(
+        [&args.surface, &args.design]
+            .into_iter()
+            .chain(&args.config.config),
+    );
+    outputs.add(&args.out, &out.program)?;
     if let Some(path) = &args.report {
         let full = FullReport {
             conform: &out.report,
             orientation: &out.orientation,
         };
         let json = serde_json::to_vec_pretty(&full).context("serialising the report")?;
-        write_atomically(path, |f| f.write_all(&json))
-            .with_context(|| format!("{}: cannot write report", path.display()))?;
+        outputs.add(path, &json)?;
     }
+    outputs.commit()?;
     Ok(())
 }
 

@@ -3,7 +3,7 @@
 use super::{Failure, args::ConvertArgs, progress};
 use anyhow::Context;
 use conduit::geom::Tolerances;
-use conduit::scene::{LoadOptions, MeshFormat, load_scene, save};
+use conduit::scene::{LoadOptions, MeshFormat, OutputSet, load_scene, save};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -17,6 +17,12 @@ struct Job {
 
 pub(crate) fn run(args: ConvertArgs) -> Result<(), Failure> {
     let jobs = plan(&args)?;
+    // No output may overwrite an input (`convert x.stl -o x.stl`, or a batch whose folder holds
+    // the inputs): refused before any work.
+    let inputs = OutputSet::new(&args.inputs);
+    for job in &jobs {
+        inputs.check(&job.output)?;
+    }
     let opts = LoadOptions::default();
     let bar = progress::bar(jobs.len(), "converting");
     let results: Vec<Result<(), anyhow::Error>> = jobs

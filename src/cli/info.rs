@@ -55,15 +55,15 @@ pub(crate) fn run(args: InfoArgs) -> Result<(), Failure> {
                 Err(e) => json!({ "file": path.display().to_string(), "error": e }),
             })
             .collect();
-        serde_json::to_writer_pretty(&mut out, &array).map_err(anyhow::Error::from)?;
-        writeln!(out).map_err(anyhow::Error::from)?;
+        serde_json::to_writer_pretty(&mut out, &array).map_err(|e| Failure::stdout(e.into()))?;
+        writeln!(out).map_err(Failure::stdout)?;
     } else {
         for r in reports.iter().flatten() {
-            write_text(&mut out, r, 0).map_err(anyhow::Error::from)?;
-            writeln!(out).map_err(anyhow::Error::from)?;
+            write_text(&mut out, r, 0).map_err(Failure::stdout)?;
+            writeln!(out).map_err(Failure::stdout)?;
         }
     }
-    out.flush().map_err(anyhow::Error::from)?;
+    out.flush().map_err(Failure::stdout)?;
     for e in reports.iter().filter_map(|r| r.as_ref().err()) {
         eprintln!("error: {e}");
     }

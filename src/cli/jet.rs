@@ -6,8 +6,7 @@ use super::{Failure, config::resolve};
 use anyhow::Context;
 use conduit::jet::{self, JetParams, ModelInput, accumulation};
 use conduit::pipeline::jet::{self as walk, JetOutput};
-use conduit::scene::write_atomically;
-use std::io::Write;
+use conduit::scene::OutputSet;
 
 /// Micrometres per millimetre.
 const UM: f64 = 1000.0;
@@ -26,6 +25,8 @@ pub(crate) fn run(args: JetArgs) -> Result<(), Failure> {
             "--width, --layers, --layer-height and -o are required".to_owned(),
         ));
     };
+    let mut outputs = OutputSet::new(args.designs.iter().chain(&args.config.config));
+    outputs.check(&output)?;
     let cfg = resolve(&args.config)?;
     let params = JetParams {
         width: width / UM,
@@ -51,13 +52,12 @@ pub(crate) fn run(args: JetArgs) -> Result<(), Failure> {
         stats,
         report,
     } = walk::run(&outlines, names, &params, &cfg).map_err(anyhow::Error::from)?;
-    write_atomically(&output, |f| f.write_all(&gcode))
-        .with_context(|| format!("{}: cannot write G-code", output.display()))?;
+    outputs.add(&output, &gcode)?;
     if let Some(path) = &args.report {
         let json = serde_json::to_vec_pretty(&report).context("serialising the report")?;
-        write_atomically(path, |f| f.write_all(&json))
-            .with_context(|| format!("{}: cannot write report", path.display()))?;
+        outputs.add(path, &json)?;
     }
+    outputs.commit()?;
     let corners: usize = report.structures.iter().map(|s| s.corners.len()).sum();
     let count = |a| {
         report
@@ -141,16 +141,19 @@ fn model(args: JetModelArgs) -> Result<(), Failure> {
             })
             .collect();
         let text = serde_json::to_string_pretty(&json).context("serialising")?;
-        println!("{text}");
+        outln!("{text}")?;
         return Ok(());
     }
-    println!(
+    outln!(
         "angle {} deg, radius {} um, width {} um, height {} um, leveling factor {factor}",
-        args.angle, args.radius, args.width, args.height
-    );
-    println!("roi_um\tL_in\tL_out\td_in\td_out\th_in-h_out_um\tpredicted_um");
+        args.angle,
+        args.radius,
+        args.width,
+        args.height
+    )?;
+    outln!("roi_um\tL_in\tL_out\td_in\td_out\th_in-h_out_um\tpredicted_um")?;
     for (i, r) in &rows {
-        println!(
+        outln!(
             "{:.3}\t{:.3}\t{:.3}\t{:.5}\t{:.5}\t{:.4}\t{:.4}",
             i.roi,
             r.l_in,
@@ -159,7 +162,7 @@ fn model(args: JetModelArgs) -> Result<(), Failure> {
             r.d_out,
             r.difference,
             r.difference * factor
-        );
+        )?;
     }
     Ok(())
 }

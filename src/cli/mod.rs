@@ -1,5 +1,35 @@
 //! Command-line front end: clap arguments are turned into validated options before any work runs
 //! (`args`), then each command runs (`info`, `convert`). Errors are printed with their cause chain.
+//!
+//! Standard output is written with [`outln!`] and [`out!`], which return write errors instead of
+//! panicking as `println!` does; standard error with `eprintln!`, shadowed below by a version
+//! that ignores write errors (there is nowhere left to report them).
+
+/// Writes a line to standard output; a write error becomes a [`Failure`] (a closed pipe a
+/// quiet end, anything else an error), never a panic. Use as `outln!("...")?`.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*).map_err($crate::cli::Failure::stdout)
+    }};
+}
+
+/// [`outln!`] without the line end.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($arg)*).map_err($crate::cli::Failure::stdout)
+    }};
+}
+
+/// `eprintln!` that ignores write errors instead of panicking: a message that cannot reach a
+/// closed or full standard error has nowhere else to go, and the exit code still tells.
+macro_rules! eprintln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
 
 mod args;
 mod calibrate;
@@ -17,6 +47,7 @@ mod route;
 mod slice;
 
 use clap::Parser;
+use std::io::Write;
 use std::process::ExitCode;
 
 /// Exit code for bad input or failed work.
@@ -32,6 +63,28 @@ pub(crate) enum Failure {
     Work(anyhow::Error),
     /// Some files failed and were reported already: exit 1 with nothing more to say.
     Reported,
+    /// Standard output was closed by its reader (`conduit check FILE | head`): exit 0 quietly.
+    StdoutClosed,
+}
+
+impl Failure {
+    /// The failure of a write to standard output. A closed pipe ends the run quietly with exit
+    /// 0, as ripgrep does (git dies of SIGPIPE instead, 141 in the shell): the reader chose to
+    /// stop, and a non-zero status would fail `set -o pipefail` scripts that only wanted the
+    /// first lines. Any other error (a full disk: `> /dev/full`) fails the run, exit 1.
+    pub(crate) fn stdout(e: std::io::Error) -> Failure {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            Failure::StdoutClosed
+        } else {
+            Failure::Work(anyhow::Error::new(e).context("cannot write to standard output"))
+        }
+    }
+}
+
+impl From<conduit::scene::OutputError> for Failure {
+    fn from(e: conduit::scene::OutputError) -> Self {
+        Failure::Work(e.into())
+    }
 }
 
 impl From<anyhow::Error> for Failure {
@@ -47,8 +100,15 @@ pub fn run() -> ExitCode {
         Err(e) => {
             // --help and --version are not errors.
             let code = if e.use_stderr() { EXIT_USAGE } else { 0 };
-            let _ = e.print();
-            return ExitCode::from(code);
+            // Help that cannot be written (`--help > /dev/full`) fails like any other output; a
+            // closed pipe (`--help | head -1`) does not.
+            return match e.print() {
+                Err(io) if !e.use_stderr() && io.kind() != std::io::ErrorKind::BrokenPipe => {
+                    eprintln!("error: cannot write to standard output: {io}");
+                    ExitCode::from(EXIT_FAILURE)
+                }
+                _ => ExitCode::from(code),
+            };
         }
     };
     let result = match cli.command {
@@ -65,28 +125,19 @@ pub fn run() -> ExitCode {
         args::Command::Calibrate(a) => calibrate::run(a),
         args::Command::Compensate(a) => compensate::run(*a),
     };
+    // Output still buffered (a last line without its end) fails here rather than unseen at exit.
+    let result = result.and_then(|()| std::io::stdout().flush().map_err(Failure::stdout));
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) | Err(Failure::StdoutClosed) => ExitCode::SUCCESS,
         Err(Failure::Usage(msg)) => {
             eprintln!("error: {msg}");
             eprintln!("For more information, try '--help'.");
             ExitCode::from(EXIT_USAGE)
         }
         Err(Failure::Work(e)) => {
-            if is_broken_pipe(&e) {
-                return ExitCode::SUCCESS;
-            }
             eprintln!("error: {e:#}");
             ExitCode::from(EXIT_FAILURE)
         }
         Err(Failure::Reported) => ExitCode::from(EXIT_FAILURE),
     }
-}
-
-/// Output piped into `head` and closed early is not a failure.
-fn is_broken_pipe(e: &anyhow::Error) -> bool {
-    e.chain().any(|c| {
-        c.downcast_ref::<std::io::Error>()
-            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
-    })
 }

@@ -11,13 +11,23 @@ use conduit::config::{Config, HostSettings};
 use conduit::pipeline::postprocess::{Edit, HostPrint, edit, edit_circuit};
 use conduit::postprocess::rewrite::SUMMARY_PREFIX;
 use conduit::postprocess::{detect_host, output_name_file, read_gcode};
-use conduit::scene::write_atomically;
-use std::io::Write;
+use conduit::scene::OutputSet;
 
 pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
     let path = &args.file;
-    let bytes =
-        std::fs::read(path).with_context(|| format!("{}: cannot read file", path.display()))?;
+    // The G-code is rewritten in place (the plugin mode); no other output may overwrite it or
+    // the other inputs.
+    let mut outputs = OutputSet::new([path]);
+    for p in [&args.circuit, &args.placement, &args.config.config]
+        .into_iter()
+        .flatten()
+    {
+        outputs.input(p);
+    }
+    if let Some(report) = &args.report {
+        outputs.check(report)?;
+    }
+    let bytes = super::check::read_gcode_file(path)?;
     let gcode = read_gcode(&bytes).with_context(|| path.display().to_string())?;
     let host = detect_host(&gcode);
     let settings = HostSettings::collect(&gcode, host.host, host_environment());
@@ -30,7 +40,7 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
             match edit(&gcode, &print, None, &config).with_context(|| path.display().to_string())? {
                 Edit::Unchanged => (false, None),
                 Edit::Rewritten(edited) => {
-                    write_edited(path, &edited)?;
+                    add_edited(&mut outputs, path, &edited)?;
                     (true, None)
                 }
             }
@@ -38,24 +48,23 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
         Some(e) => {
             let done = edit_circuit(&gcode, &print, e, &config)
                 .with_context(|| path.display().to_string())?;
-            write_edited(path, &done.gcode)?;
-            for line in &done.summary {
-                let text = line.strip_prefix(SUMMARY_PREFIX).unwrap_or(line);
-                eprintln!("{}:{text}", path.display());
-            }
+            add_edited(&mut outputs, path, &done.gcode)?;
             (true, Some(done))
         }
     };
     if let Some(name) = &args.output_name {
         let target = output_name_file(path);
-        write_atomically(&target, |f| writeln!(f, "{name}"))
-            .with_context(|| format!("{}: cannot write", target.display()))?;
+        outputs.add(&target, format!("{name}\n").as_bytes())?;
     }
     let report = print.report(changed, done.as_ref());
     if let Some(report_path) = &args.report {
         let json = serde_json::to_vec_pretty(&report).context("serialising the report")?;
-        write_atomically(report_path, |f| f.write_all(&json))
-            .with_context(|| format!("{}: cannot write report", report_path.display()))?;
+        outputs.add(report_path, &json)?;
+    }
+    outputs.commit()?;
+    for line in done.iter().flat_map(|d| &d.summary) {
+        let text = line.strip_prefix(SUMMARY_PREFIX).unwrap_or(line);
+        eprintln!("{}:{text}", path.display());
     }
     let outcome = if changed {
         "rewritten"
@@ -66,10 +75,19 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Writes the edited file in place of the host's (a temporary file beside it, then a rename).
-fn write_edited(path: &std::path::Path, edited: &conduit_gcode::Gcode) -> anyhow::Result<()> {
-    write_atomically(path, |f| edited.write_to(f))
-        .with_context(|| format!("{}: cannot write G-code", path.display()))
+/// Stages the edited file in place of the host's (a temporary file beside it, renamed with the
+/// run's other outputs).
+fn add_edited(
+    outputs: &mut OutputSet,
+    path: &std::path::Path,
+    edited: &conduit_gcode::Gcode,
+) -> Result<(), Failure> {
+    let mut bytes = Vec::new();
+    edited
+        .write_to(&mut bytes)
+        .with_context(|| format!("{}: cannot write G-code", path.display()))?;
+    outputs.add_in_place(path, &bytes)?;
+    Ok(())
 }
 
 /// The environment of the call as text; variables that are not UTF-8 are skipped (only the

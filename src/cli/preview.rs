@@ -7,8 +7,7 @@ use conduit::check::{Firmware, moves};
 use conduit::emit::preview::{
     CONTACT_SHEET, PreviewParams, SIDE_VIEWS, layered_by_markers, render,
 };
-use conduit::scene::write_atomically;
-use std::io::Write;
+use conduit::scene::OutputSet;
 
 pub(crate) fn run(args: PreviewArgs) -> Result<(), Failure> {
     let params = PreviewParams {
@@ -16,19 +15,20 @@ pub(crate) fn run(args: PreviewArgs) -> Result<(), Failure> {
         tile_px: args.tile,
     };
     let file = args.file.display();
-    let bytes = std::fs::read(&args.file).with_context(|| format!("{file}: cannot read file"))?;
+    let bytes = super::check::read_gcode_file(&args.file)?;
     let gcode = conduit_gcode::parse(&bytes).with_context(|| format!("{file}"))?;
     // Marlin's modes; the flavour matters only for Klipper's `G91` making E relative.
     let moves = layered_by_markers(&gcode, moves(&gcode, Firmware::Marlin));
     let drawn = render(&moves, &params).with_context(|| format!("{file}"))?;
     let dir = &args.out_dir;
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot write", dir.display()))?;
+    // All the files or none: a run that fails on the tenth layer leaves no mix of new and old.
+    let mut outputs = OutputSet::new([&args.file]);
     for (name, bytes) in &drawn.files {
-        let path = dir.join(name);
-        write_atomically(&path, |f| f.write_all(bytes))
-            .with_context(|| format!("{}: cannot write", path.display()))?;
+        outputs.add(&dir.join(name), bytes)?;
     }
-    println!(
+    outputs.commit()?;
+    outln!(
         "{file}: {} layers: {} SVG files and {} (every {} layer(s), {} tiles), side views {} in {}",
         drawn.layers,
         drawn.layers,
@@ -37,6 +37,6 @@ pub(crate) fn run(args: PreviewArgs) -> Result<(), Failure> {
         drawn.tiles,
         SIDE_VIEWS.join(", "),
         dir.display()
-    );
+    )?;
     Ok(())
 }

@@ -7,10 +7,19 @@ use conduit::circuit::Electronics;
 use conduit::circuit::{Circuit, Placement};
 use conduit::emit::route_svg::{layer_svg, view_box};
 use conduit::pipeline::route_scene;
-use conduit::scene::write_atomically;
-use std::io::Write;
+use conduit::scene::OutputSet;
 
 pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
+    let mut outputs = OutputSet::new(&args.models);
+    for p in [&args.circuit, &args.placement]
+        .into_iter()
+        .chain(&args.config.config)
+    {
+        outputs.input(p);
+    }
+    if let Some(report) = &args.report {
+        outputs.check(report)?;
+    }
     let cfg = resolve(&args.config)?;
     let scene = super::slice::load_models(&args.models)?;
     let electronics = Electronics {
@@ -25,15 +34,14 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
         for (i, layer) in view.layers.iter().enumerate() {
             let path = args.out_dir.join(format!("layer_{:04}.svg", i + 1));
             let svg = layer_svg(layer, bounds, cfg.route.conductive_width);
-            write_atomically(&path, |f| f.write_all(svg.as_bytes()))
-                .with_context(|| format!("{}: cannot write", path.display()))?;
+            outputs.add(&path, svg.as_bytes())?;
         }
     }
     if let Some(report) = &args.report {
         let json = serde_json::to_vec_pretty(&view.report).context("serialising the report")?;
-        write_atomically(report, |f| f.write_all(&json))
-            .with_context(|| format!("{}: cannot write report", report.display()))?;
+        outputs.add(report, &json)?;
     }
+    outputs.commit()?;
     let lead = format!(
         "{}: {} layers drawn; ",
         args.out_dir.display(),

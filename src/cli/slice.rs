@@ -6,9 +6,9 @@ use conduit::circuit::Electronics;
 use conduit::circuit::stage::pnp_records;
 use conduit::circuit::{Circuit, Placement};
 use conduit::pipeline::{Stage, slice_clfff, slice_scene_with};
-use conduit::scene::{LoadOptions, Scene, load_scene, write_atomically};
+use conduit::scene::{LoadOptions, OutputSet, Scene, load_scene};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 
 pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     let mut cfg = resolve(&args.config)?;
@@ -21,6 +21,11 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     if args.split_sections {
         cfg.curved.split_sections = true;
     }
+    let mut outputs = inputs(&args);
+    outputs.check(&args.output)?;
+    if let Some(report) = &args.report {
+        outputs.check(report)?;
+    }
     if cfg.curved.mode == conduit::config::CurvedMode::Clfff {
         if args.circuit.is_some() {
             return Err(anyhow::anyhow!(
@@ -28,7 +33,7 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
             )
             .into());
         }
-        return run_clfff(&args, &cfg);
+        return run_clfff(&args, &cfg, outputs);
     }
     let scene = load_models(&args.models)?;
     let electronics = match (&args.circuit, &args.placement) {
@@ -46,28 +51,29 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         })
         .with_context(|| format!("slicing {}", args.models[0].display()))?;
     bar.finish_and_clear();
-    write_atomically(&args.output, |f| f.write_all(&gcode))
-        .with_context(|| format!("{}: cannot write G-code", args.output.display()))?;
+    outputs.add(&args.output, &gcode)?;
     if let Some(e) = &electronics {
         let records = pnp_records(&e.circuit, &summary.parts);
         let pos = args.output.with_extension("pos");
-        write_atomically(&pos, |f| conduit_pnp::write_kicad_pos(&records, f))
+        let mut bytes = Vec::new();
+        conduit_pnp::write_kicad_pos(&records, &mut bytes)
             .with_context(|| format!("{}: cannot write positions", pos.display()))?;
+        outputs.add(&pos, &bytes)?;
         let xml = args.output.with_extension("openpnp.xml");
         let name = args
             .output
             .file_stem()
             .map_or_else(|| "board".to_owned(), |s| s.to_string_lossy().into_owned());
-        write_atomically(&xml, |f| {
-            conduit_pnp::write_openpnp_board(&name, &records, f)
-        })
-        .with_context(|| format!("{}: cannot write OpenPnP board", xml.display()))?;
+        let mut bytes = Vec::new();
+        conduit_pnp::write_openpnp_board(&name, &records, &mut bytes)
+            .with_context(|| format!("{}: cannot write OpenPnP board", xml.display()))?;
+        outputs.add(&xml, &bytes)?;
     }
     if let Some(report) = &args.report {
         let json = serde_json::to_vec_pretty(&summary).context("serialising the report")?;
-        write_atomically(report, |f| f.write_all(&json))
-            .with_context(|| format!("{}: cannot write report", report.display()))?;
+        outputs.add(report, &json)?;
     }
+    outputs.commit()?;
     let total: f64 = summary.gcode.tools.iter().map(|t| t.filament_mm).sum();
     eprintln!(
         "{}: {} layers, {:.0} mm filament, estimated {:.0} min",
@@ -102,7 +108,11 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
 
 /// `conduit slice --curved clfff`: one G-code file, or one per section with
 /// `--split-sections` (`OUT.scaffold.gcode`, `OUT.buffer.gcode`, `OUT.model.gcode`).
-fn run_clfff(args: &SliceArgs, cfg: &conduit::config::Config) -> Result<(), Failure> {
+fn run_clfff(
+    args: &SliceArgs,
+    cfg: &conduit::config::Config,
+    mut outputs: OutputSet,
+) -> Result<(), Failure> {
     let scene = load_models(&args.models)?;
     let bar = stage_bar();
     let (files, summary) = slice_clfff(&scene, cfg, |stage| {
@@ -112,13 +122,27 @@ fn run_clfff(args: &SliceArgs, cfg: &conduit::config::Config) -> Result<(), Fail
     .with_context(|| format!("slicing {}", args.models[0].display()))?;
     bar.finish_and_clear();
     let split = cfg.curved.split_sections;
+    let mut written = Vec::with_capacity(files.len());
     for file in &files {
         let path = match (split, file.sections.first()) {
             (true, Some(s)) => s.file_name(&args.output),
             _ => args.output.clone(),
         };
-        write_atomically(&path, |f| f.write_all(&file.gcode))
-            .with_context(|| format!("{}: cannot write G-code", path.display()))?;
+        outputs.add(&path, &file.gcode)?;
+        written.push((path, file));
+    }
+    let mut summary = summary;
+    if split {
+        for s in &mut summary.clfff.sections {
+            s.file = Some(s.section.file_name(&args.output).display().to_string());
+        }
+    }
+    if let Some(report) = &args.report {
+        let json = serde_json::to_vec_pretty(&summary).context("serialising the report")?;
+        outputs.add(report, &json)?;
+    }
+    outputs.commit()?;
+    for (path, file) in written {
         let total: f64 = file.stats.tools.iter().map(|t| t.filament_mm).sum();
         let names: Vec<&str> = file.sections.iter().map(|s| s.name()).collect();
         eprintln!(
@@ -129,17 +153,6 @@ fn run_clfff(args: &SliceArgs, cfg: &conduit::config::Config) -> Result<(), Fail
             total,
             file.stats.estimated_time_s / 60.0
         );
-    }
-    let mut summary = summary;
-    if split {
-        for s in &mut summary.clfff.sections {
-            s.file = Some(s.section.file_name(&args.output).display().to_string());
-        }
-    }
-    if let Some(report) = &args.report {
-        let json = serde_json::to_vec_pretty(&summary).context("serialising the report")?;
-        write_atomically(report, |f| f.write_all(&json))
-            .with_context(|| format!("{}: cannot write report", report.display()))?;
     }
     let r = &summary.clfff;
     let model_layers = r
@@ -188,6 +201,18 @@ pub(crate) fn print_routing(r: &conduit::circuit::ElectronicsReport, lead: &str)
             w.net, w.from, w.to
         );
     }
+}
+
+/// The output set of a slice: none of its outputs may be one of the run's input files.
+fn inputs(args: &SliceArgs) -> OutputSet {
+    let mut set = OutputSet::new(&args.models);
+    for p in [&args.circuit, &args.placement, &args.config.config]
+        .into_iter()
+        .flatten()
+    {
+        set.input(p);
+    }
+    set
 }
 
 /// One scene of every object of `models`, in order; reader warnings go to stderr.

@@ -2,10 +2,12 @@
 //!
 //! Place in the pipeline: the first step of every command (and the last of `convert`). Format
 //! crates under `formats/` describe files; this module converts what they return into [`Scene`]s of
-//! [`crate::mesh::Mesh`]es in millimetres, and back.
+//! [`crate::mesh::Mesh`]es in millimetres, and back. Every command's output files go through
+//! `output` ([`OutputSet`], [`write_atomically`]): never clobbering an input, a device or a link.
 
 mod detect;
 mod load;
+mod output;
 mod save;
 
 pub use detect::FileKind;
@@ -13,9 +15,8 @@ pub use load::{
     Content, LoadError, LoadErrorKind, LoadOptions, LoadedFile, MeshDetails, ThreeMfDetails, load,
     load_scene,
 };
-pub use save::{
-    MeshFormat, SaveError, SaveErrorKind, placed_meshes, save, to_3mf_model, write_atomically,
-};
+pub use output::{OutputError, OutputSet, write_atomically};
+pub use save::{MeshFormat, SaveError, SaveErrorKind, placed_meshes, save, to_3mf_model};
 
 use crate::geom::Transform;
 use crate::mesh::Mesh;

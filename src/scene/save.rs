@@ -1,7 +1,8 @@
-//! Writing scenes as STL, 3MF or OBJ. Every file is written to a temporary file beside the target
-//! and renamed into place, so a failed run never leaves a partial file.
+//! Writing scenes as STL, 3MF or OBJ, through [`super::output`]: a failed run never leaves a
+//! partial file, and a device, pipe or symbolic link given as the output is kept.
 
 use super::Scene;
+use super::output::write_atomically;
 use crate::mesh::Mesh;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -64,34 +65,6 @@ pub enum SaveErrorKind {
     /// A coordinate does not fit the output format (STL stores 32-bit floats).
     #[error("{0}")]
     Unrepresentable(String),
-}
-
-/// Writes `path` atomically: `fill` writes into a temporary file in the same folder, which is renamed
-/// over `path` only when `fill` succeeds.
-pub fn write_atomically<F, E>(path: &Path, fill: F) -> Result<(), E>
-where
-    F: FnOnce(&mut std::fs::File) -> Result<(), E>,
-    E: From<std::io::Error>,
-{
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".conduit-").suffix(".tmp");
-    // Temporary files are private (0600) by default; the output should get the permissions of
-    // an ordinary new file (0666 less the umask), or keep those of the file it replaces.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let mode = std::fs::metadata(path).map_or(0o666, |m| m.permissions().mode() & 0o7777);
-        builder.permissions(std::fs::Permissions::from_mode(mode));
-    }
-    let mut tmp = builder.tempfile_in(&dir)?;
-    fill(tmp.as_file_mut())?;
-    tmp.as_file_mut().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
 }
 
 /// The scene's objects with their transforms applied.
