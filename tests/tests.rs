@@ -12,6 +12,7 @@ mod compensate;
 mod conform;
 mod conformance;
 mod curved;
+mod docs;
 mod electronics;
 mod electronics_corpus;
 mod golden;
