@@ -118,9 +118,38 @@ impl Checker<'_> {
         }
     }
 
+    /// Reports the parameters of a move (`G0`-`G3`) or position (`G92`) command that did not
+    /// read as numbers.
+    fn unreadable_parameters(&mut self, line: &Line) {
+        let is_position_command =
+            matches!(line.command(), Some((b'G', n)) if [0.0, 1.0, 2.0, 3.0, 92.0].contains(&n));
+        if !is_position_command {
+            return;
+        }
+        for span in &line.unparsed {
+            let token = &line.text[span.clone()];
+            if !token.first().is_some_and(u8::is_ascii_alphabetic) {
+                continue;
+            }
+            // Printable ASCII only, so one finding stays one line.
+            let shown: String = token
+                .iter()
+                .take(24)
+                .map(|&b| if b.is_ascii_graphic() { b as char } else { '?' })
+                .collect();
+            self.report(
+                Severity::Error,
+                FindingKind::UnreadableParameter,
+                line.number,
+                format!("`{shown}` is not a number; this move would not go where it is meant to"),
+            );
+        }
+    }
+
     fn step(&mut self, line: &Line) {
         // The machine applies motion and the modal state (units, modes, G92, homing, tool);
         // the checker adds heaters, time and statistics.
+        self.unreadable_parameters(line);
         let tool_before = self.machine.tool();
         if let Some(mv) = self.machine.step(line) {
             self.motion(&mv);

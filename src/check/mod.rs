@@ -230,6 +230,10 @@ pub enum FindingKind {
     ExcessiveExtrusion,
     /// Error: an `R` arc whose radius is shorter than half its chord, or an arc without centre.
     InvalidArc,
+    /// Error: a move or position command has a parameter whose value is not a number (`XNaN`,
+    /// `Yinf`, `X` alone): firmware would skip that axis or reject the line, so the machine does
+    /// not go where the file's author meant.
+    UnreadableParameter,
 }
 
 impl FindingKind {
@@ -245,6 +249,7 @@ impl FindingKind {
             FindingKind::LostExtrusionReset => "lost_extrusion_reset",
             FindingKind::ExcessiveExtrusion => "excessive_extrusion",
             FindingKind::InvalidArc => "invalid_arc",
+            FindingKind::UnreadableParameter => "unreadable_parameter",
         }
     }
 }

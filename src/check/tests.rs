@@ -399,3 +399,23 @@ fn bare_coordinates_continue_the_last_motion() {
     assert_eq!(r.stats.extrusion_moves, 3);
     assert!(close(filament(&r, 0), 3.0, 1e-12));
 }
+
+#[test]
+fn parameters_that_are_not_numbers_are_errors_on_moves_only() {
+    let r =
+        run("M104 S210\nM109 S210\nG1 X10 Y10 F1200\nG1 XNaN Y5\nG92 Einf\nM106 Sx\nG1 X5 Y5\n");
+    assert_eq!(
+        kinds(&r),
+        [
+            (Severity::Error, FindingKind::UnreadableParameter),
+            (Severity::Error, FindingKind::UnreadableParameter),
+        ]
+    );
+    assert_eq!(r.findings[0].line, 4);
+    assert!(
+        r.findings[0].message.contains("`XNaN`"),
+        "{}",
+        r.findings[0].message
+    );
+    assert_eq!(r.findings[1].line, 5);
+}
