@@ -273,3 +273,66 @@ fn missing_config_circuit_and_placement_are_named_with_their_cause_once() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn convert_takes_a_folder_makes_the_output_folder_and_says_what_it_wrote() {
+    let dir = temp_dir();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).expect("input folder");
+    for name in ["cube_20mm.stl", "l_bracket.obj"] {
+        std::fs::copy(sample(name), input.join(name)).expect("sample copied");
+    }
+    std::fs::write(input.join("notes.txt"), "not a mesh").expect("other file");
+    let out_dir = dir.path().join("made/here");
+    let o = conduit(&[
+        "convert".as_ref(),
+        input.as_os_str(),
+        "--to".as_ref(),
+        "3mf".as_ref(),
+        "--out-dir".as_ref(),
+        out_dir.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let names: Vec<String> = files_in(&out_dir)
+        .iter()
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    assert_eq!(names, ["cube_20mm.3mf", "l_bracket.3mf"]);
+    let said = String::from_utf8_lossy(&o.stdout).into_owned();
+    let lines: Vec<&str> = said.lines().collect();
+    assert_eq!(lines.len(), 2, "{said}");
+    assert!(
+        lines[0].ends_with("cube_20mm.3mf: 1 object, 12 triangles"),
+        "{said}"
+    );
+    assert!(
+        lines[1].ends_with("l_bracket.3mf: 1 object, 20 triangles"),
+        "{said}"
+    );
+    // One failed conversion: one line naming the file, no batch summary.
+    let broken = dir.path().join("broken.stl");
+    std::fs::write(&broken, "solid x\nfacet\n").expect("broken file");
+    let o = conduit(&[
+        "convert".as_ref(),
+        broken.as_os_str(),
+        "-o".as_ref(),
+        dir.path().join("x.stl").as_os_str(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("broken.stl"), "{err}");
+    // An empty folder is a usage error naming it.
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).expect("empty folder");
+    let o = conduit(&[
+        "convert".as_ref(),
+        empty.as_os_str(),
+        "--to".as_ref(),
+        "stl".as_ref(),
+        "--out-dir".as_ref(),
+        out_dir.as_os_str(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("no mesh files"), "{}", stderr(&o));
+}

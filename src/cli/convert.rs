@@ -1,9 +1,13 @@
 //! `conduit convert`: mesh files to STL, 3MF or OBJ, many in parallel.
+//!
+//! An input may be a folder: its mesh files (by extension, not recursive) in name order. Each
+//! conversion prints one line (`IN -> OUT: N objects, M triangles`); a failed one prints its
+//! error, and a batch with failures ends with the count.
 
 use super::{Failure, args::ConvertArgs, progress};
 use anyhow::Context;
 use conduit::geom::Tolerances;
-use conduit::scene::{LoadOptions, MeshFormat, OutputSet, load_scene, save};
+use conduit::scene::{FileKind, LoadOptions, MeshFormat, OutputSet, load_scene, save};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -16,16 +20,17 @@ struct Job {
 }
 
 pub(crate) fn run(args: ConvertArgs) -> Result<(), Failure> {
-    let jobs = plan(&args)?;
+    let inputs = expand_folders(&args.inputs)?;
+    let jobs = plan(&args, &inputs)?;
     // No output may overwrite an input (`convert x.stl -o x.stl`, or a batch whose folder holds
     // the inputs): refused before any work.
-    let inputs = OutputSet::new(&args.inputs);
+    let inputs = OutputSet::new(&inputs);
     for job in &jobs {
         inputs.check(&job.output)?;
     }
     let opts = LoadOptions::default();
     let bar = progress::bar(jobs.len(), "converting");
-    let results: Vec<Result<(), anyhow::Error>> = jobs
+    let results: Vec<anyhow::Result<Converted>> = jobs
         .par_iter()
         .map(|job| {
             let r = convert_one(job, &opts, args.repair);
@@ -35,21 +40,78 @@ pub(crate) fn run(args: ConvertArgs) -> Result<(), Failure> {
         .collect();
     bar.finish_and_clear();
     let mut failed = 0;
-    for r in &results {
-        if let Err(e) = r {
-            failed += 1;
-            eprintln!("error: {e:#}");
+    for (job, r) in jobs.iter().zip(&results) {
+        match r {
+            Ok(c) => outln!(
+                "{} -> {}: {} object{}, {} triangles",
+                job.input.display(),
+                job.output.display(),
+                c.objects,
+                if c.objects == 1 { "" } else { "s" },
+                c.triangles
+            )?,
+            Err(e) => {
+                failed += 1;
+                eprintln!("error: {e:#}");
+            }
         }
     }
     if failed > 0 {
-        eprintln!("{failed} of {} conversions failed", jobs.len());
+        if jobs.len() > 1 {
+            eprintln!("{failed} of {} conversions failed", jobs.len());
+        }
         return Err(Failure::Reported);
     }
     Ok(())
 }
 
+/// What one conversion wrote.
+struct Converted {
+    objects: usize,
+    triangles: usize,
+}
+
+/// The inputs with every folder replaced by its mesh files (known extensions, not recursive,
+/// in name order); a folder without any is an error naming it.
+fn expand_folders(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, Failure> {
+    let mut out = Vec::with_capacity(inputs.len());
+    for input in inputs {
+        if !input.is_dir() {
+            out.push(input.clone());
+            continue;
+        }
+        let entries = std::fs::read_dir(input)
+            .with_context(|| format!("{}: cannot read the folder", input.display()))?;
+        let mut meshes: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                p.is_file()
+                    && matches!(
+                        FileKind::from_extension(p),
+                        Some(
+                            FileKind::Stl
+                                | FileKind::ThreeMf
+                                | FileKind::Obj
+                                | FileKind::Off
+                                | FileKind::Ply
+                        )
+                    )
+            })
+            .collect();
+        if meshes.is_empty() {
+            return Err(Failure::Usage(format!(
+                "{}: the folder holds no mesh files (.stl, .3mf, .obj, .off, .ply)",
+                input.display()
+            )));
+        }
+        meshes.sort();
+        out.extend(meshes);
+    }
+    Ok(out)
+}
+
 /// Turns the arguments into jobs, rejecting ambiguous or colliding outputs before any work runs.
-fn plan(args: &ConvertArgs) -> Result<Vec<Job>, Failure> {
+fn plan(args: &ConvertArgs, inputs: &[PathBuf]) -> Result<Vec<Job>, Failure> {
     let ascii = |f: MeshFormat| {
         if args.ascii && f == MeshFormat::Stl {
             MeshFormat::StlAscii
@@ -58,7 +120,7 @@ fn plan(args: &ConvertArgs) -> Result<Vec<Job>, Failure> {
         }
     };
     if let Some(out) = &args.output {
-        if args.inputs.len() != 1 {
+        if inputs.len() != 1 {
             return Err(Failure::Usage(
                 "-o takes exactly one input; use --to and --out-dir for several".into(),
             ));
@@ -70,7 +132,7 @@ fn plan(args: &ConvertArgs) -> Result<Vec<Job>, Failure> {
             ))
         })?;
         return Ok(vec![Job {
-            input: args.inputs[0].clone(),
+            input: inputs[0].clone(),
             output: out.clone(),
             format: ascii(format),
         }]);
@@ -80,15 +142,12 @@ fn plan(args: &ConvertArgs) -> Result<Vec<Job>, Failure> {
             "give -o OUT, or --to FORMAT with --out-dir DIR".into(),
         ));
     };
-    if !dir.is_dir() {
-        return Err(Failure::Usage(format!(
-            "{}: output folder does not exist",
-            dir.display()
-        )));
-    }
+    // A missing output folder is made, as every command's --out-dir does.
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create the output folder", dir.display()))?;
     let mut seen: BTreeMap<PathBuf, &Path> = BTreeMap::new();
     let mut jobs = Vec::with_capacity(args.inputs.len());
-    for input in &args.inputs {
+    for input in inputs {
         let stem = input
             .file_stem()
             .ok_or_else(|| Failure::Usage(format!("{}: not a file name", input.display())))?;
@@ -110,7 +169,7 @@ fn plan(args: &ConvertArgs) -> Result<Vec<Job>, Failure> {
     Ok(jobs)
 }
 
-fn convert_one(job: &Job, opts: &LoadOptions, repair: bool) -> anyhow::Result<()> {
+fn convert_one(job: &Job, opts: &LoadOptions, repair: bool) -> anyhow::Result<Converted> {
     let (mut scene, _warnings) = load_scene(&job.input, opts)?;
     if scene.triangle_count() == 0 {
         anyhow::bail!("{}: no triangles to convert", job.input.display());
@@ -123,5 +182,8 @@ fn convert_one(job: &Job, opts: &LoadOptions, repair: bool) -> anyhow::Result<()
     }
     save(&scene, &job.output, job.format)
         .with_context(|| format!("converting {}", job.input.display()))?;
-    Ok(())
+    Ok(Converted {
+        objects: scene.objects.len(),
+        triangles: scene.triangle_count(),
+    })
 }
