@@ -336,3 +336,51 @@ fn convert_takes_a_folder_makes_the_output_folder_and_says_what_it_wrote() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("no mesh files"), "{}", stderr(&o));
 }
+
+#[test]
+fn completions_and_manual_pages_come_from_the_grammar() {
+    let o = conduit(&["completions", "bash"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let script = String::from_utf8_lossy(&o.stdout).into_owned();
+    for word in [
+        "conduit",
+        "slice",
+        "postprocess",
+        "--placement",
+        "--dialect",
+    ] {
+        assert!(script.contains(word), "bash completion lacks {word}");
+    }
+    let dir = temp_dir();
+    let path = dir.path().join("conduit.bash");
+    std::fs::write(&path, &script).expect("script written");
+    let syntax = std::process::Command::new("bash")
+        .arg("-n")
+        .arg(&path)
+        .output()
+        .expect("bash runs");
+    assert!(
+        syntax.status.success(),
+        "{}",
+        String::from_utf8_lossy(&syntax.stderr)
+    );
+    let pages = dir.path().join("man");
+    let o = conduit(&["man".as_ref(), "--out-dir".as_ref(), pages.as_os_str()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let slice = std::fs::read_to_string(pages.join("conduit-slice.1")).expect("slice page");
+    assert!(
+        slice.starts_with(".ie") || slice.contains(".TH conduit-slice"),
+        "{slice}"
+    );
+    assert!(
+        slice.contains("placement"),
+        "the slice page documents --placement"
+    );
+    for page in [
+        "conduit.1",
+        "conduit-calibrate-tcp.1",
+        "conduit-jet-model.1",
+    ] {
+        assert!(pages.join(page).is_file(), "{page} written");
+    }
+}

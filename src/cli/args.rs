@@ -59,6 +59,27 @@ pub enum Command {
     /// Gap compensation: move a robot path along its tool axis by the measured gaps (or gaps
     /// simulated on a known surface with a robot error model), pass after pass.
     Compensate(Box<super::compensate::CompensateArgs>),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell), e.g.
+    /// `conduit completions bash > ~/.local/share/bash-completion/completions/conduit`.
+    Completions(CompletionsArgs),
+    /// Write the manual pages (roff): `conduit.1` and one `conduit-COMMAND.1` per command.
+    Man(ManArgs),
+}
+
+/// `conduit completions`.
+#[derive(Debug, Args)]
+pub struct CompletionsArgs {
+    /// The shell to complete for.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
+}
+
+/// `conduit man`.
+#[derive(Debug, Args)]
+pub struct ManArgs {
+    /// Folder for the pages (made when missing).
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: PathBuf,
 }
 
 /// Where settings come from: a config file plus `--set` overrides.

@@ -38,6 +38,7 @@ mod compensate;
 mod config;
 mod conform;
 mod convert;
+mod manual;
 mod info;
 mod jet;
 mod postprocess;
@@ -124,6 +125,8 @@ pub fn run() -> ExitCode {
         args::Command::Jet(a) => jet::run(a),
         args::Command::Calibrate(a) => calibrate::run(a),
         args::Command::Compensate(a) => compensate::run(*a),
+        args::Command::Completions(a) => manual::completions(a),
+        args::Command::Man(a) => manual::man(a),
     };
     // Output still buffered (a last line without its end) fails here rather than unseen at exit.
     let result = result.and_then(|()| std::io::stdout().flush().map_err(Failure::stdout));
