@@ -284,7 +284,7 @@ fn convert_takes_a_folder_makes_the_output_folder_and_says_what_it_wrote() {
     }
     std::fs::write(input.join("notes.txt"), "not a mesh").expect("other file");
     let out_dir = dir.path().join("made/here");
-    let o = conduit(&[
+    let o = conduit([
         "convert".as_ref(),
         input.as_os_str(),
         "--to".as_ref(),
@@ -312,7 +312,7 @@ fn convert_takes_a_folder_makes_the_output_folder_and_says_what_it_wrote() {
     // One failed conversion: one line naming the file, no batch summary.
     let broken = dir.path().join("broken.stl");
     std::fs::write(&broken, "solid x\nfacet\n").expect("broken file");
-    let o = conduit(&[
+    let o = conduit([
         "convert".as_ref(),
         broken.as_os_str(),
         "-o".as_ref(),
@@ -325,7 +325,7 @@ fn convert_takes_a_folder_makes_the_output_folder_and_says_what_it_wrote() {
     // An empty folder is a usage error naming it.
     let empty = dir.path().join("empty");
     std::fs::create_dir(&empty).expect("empty folder");
-    let o = conduit(&[
+    let o = conduit([
         "convert".as_ref(),
         empty.as_os_str(),
         "--to".as_ref(),
@@ -365,7 +365,7 @@ fn completions_and_manual_pages_come_from_the_grammar() {
         String::from_utf8_lossy(&syntax.stderr)
     );
     let pages = dir.path().join("man");
-    let o = conduit(&["man".as_ref(), "--out-dir".as_ref(), pages.as_os_str()]);
+    let o = conduit(["man".as_ref(), "--out-dir".as_ref(), pages.as_os_str()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let slice = std::fs::read_to_string(pages.join("conduit-slice.1")).expect("slice page");
     assert!(
