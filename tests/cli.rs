@@ -339,7 +339,7 @@ fn convert_takes_a_folder_makes_the_output_folder_and_says_what_it_wrote() {
 
 #[test]
 fn completions_and_manual_pages_come_from_the_grammar() {
-    let o = conduit(&["completions", "bash"]);
+    let o = conduit(["completions", "bash"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let script = String::from_utf8_lossy(&o.stdout).into_owned();
     for word in [

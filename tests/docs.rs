@@ -17,7 +17,7 @@ fn sh_blocks(markdown: &str) -> Vec<Vec<String>> {
     let mut current: Option<Vec<String>> = None;
     for line in markdown.lines() {
         match (&mut current, line.trim_start()) {
-            (None, fence) if fence == "```sh" => current = Some(Vec::new()),
+            (None, "```sh") => current = Some(Vec::new()),
             (Some(_), "```") => blocks.extend(current.take()),
             (Some(lines), _) => lines.push(line.to_owned()),
             (None, _) => {}
