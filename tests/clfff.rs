@@ -747,3 +747,26 @@ fn clfff_sandwich_of_a_thick_dish_has_skins_on_its_surfaces_and_a_planar_core_be
         assert!(l["max_deviation"].as_f64().is_some_and(|d| d < 1e-6), "{l}");
     }
 }
+
+#[test]
+fn a_solid_given_to_plain_curved_layers_is_refused_not_printed_as_a_plate() {
+    let dir = temp_dir();
+    let out = dir.path().join("cube.gcode");
+    let o = Command::new(env!("CARGO_BIN_EXE_conduit"))
+        .args(["slice", "--curved", "clfff", "-o"])
+        .arg(&out)
+        .arg(sample("cube_20mm.stl"))
+        .output()
+        .expect("the conduit binary runs");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("20.00 mm thick") && err.contains("curved.layers = 3 prints 0.60 mm"),
+        "{err}"
+    );
+    assert!(
+        !out.exists(),
+        "no G-code for a job that would leave the model out"
+    );
+}

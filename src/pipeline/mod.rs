@@ -100,19 +100,19 @@ pub enum PipelineError {
         tools: usize,
     },
     /// Slice parameters are unusable.
-    #[error("{0}")]
+    #[error(transparent)]
     SliceParams(#[from] crate::slice::SliceParamsError),
     /// Region parameters are unusable.
-    #[error("{0}")]
+    #[error(transparent)]
     Regions(#[from] RegionError),
     /// Writing G-code failed.
-    #[error("{0}")]
+    #[error(transparent)]
     Emit(#[from] crate::emit::gcode::EmitError),
     /// The circuit's placement does not fit.
-    #[error("{0}")]
+    #[error(transparent)]
     Electronics(#[from] electronics::ElectronicsError),
     /// A curved-layer (clfff) print cannot be planned.
-    #[error("{0}")]
+    #[error(transparent)]
     Clfff(#[from] crate::curved::clfff::ClfffError),
 }
 

@@ -82,7 +82,7 @@ pub enum PostprocessError {
     /// # How to fix
     /// The message names the problem; correct the placement, or pass a conduit config with
     /// `-c` whose `route.conductive_tool` is one of its `[tools.N]`.
-    #[error("{0}")]
+    #[error(transparent)]
     Electronics(#[from] ElectronicsError),
     /// The file prints nothing conduit can place a circuit in.
     ///
@@ -122,7 +122,7 @@ pub enum PostprocessError {
     ///
     /// # How to fix
     /// The message names the tool or template; correct the config given with `-c`.
-    #[error("{0}")]
+    #[error(transparent)]
     Emit(#[from] EmitError),
 }
 

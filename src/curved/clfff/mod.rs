@@ -112,6 +112,24 @@ pub enum ClfffError {
     /// The sandwich's planar core could not be made into regions.
     #[error("sandwich core: {0}")]
     Regions(#[from] crate::region::RegionError),
+    /// The model is much thicker than the curved layers asked for, so most of it would not be
+    /// printed (a solid given to plain curved layers).
+    ///
+    /// How to fix: `curved.layers = 0` follows the thickness; a solid part wants
+    /// `curved.sandwich = true` (curved skins around a planar core).
+    #[error(
+        "the model is {thickness:.2} mm thick, but curved.layers = {layers} prints {printed:.2} mm \
+         of it: set curved.layers = 0 to follow the thickness, or curved.sandwich = true for a \
+         solid part"
+    )]
+    ThickerThanLayers {
+        /// The shell's median thickness, mm.
+        thickness: f64,
+        /// `curved.layers`.
+        layers: usize,
+        /// What those layers print, mm.
+        printed: f64,
+    },
 }
 
 /// What [`plan`] produces.
@@ -210,6 +228,16 @@ impl Shape {
         } else {
             ((thickness / h).round() as usize).max(1)
         };
+        // Plain curved layers print `n·h` over the bottom surface; a model thicker than that by
+        // more than a layer is mostly left out. (A sandwich fills its thickness with the core.)
+        let printed = n as f64 * h;
+        if !c.sandwich && thickness > printed + h {
+            return Err(ClfffError::ThickerThanLayers {
+                thickness,
+                layers: c.layers,
+                printed,
+            });
+        }
         let rim = Rim::new(&out, &shell);
         let area = outline::scaffold_area(&out, c.scaffold_margin);
         Ok(Self {
