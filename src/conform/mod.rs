@@ -163,7 +163,7 @@ fn check_design(
         points.iter().enumerate().find_map(|(i, q)| {
             q.iter()
                 .copied()
-                .find(|v| !(v.abs() <= crate::surface::MAX_EXTENT))
+                .find(|v| !v.is_finite() || v.abs() > crate::surface::MAX_EXTENT)
                 .map(|v| (i, v))
         })
     };

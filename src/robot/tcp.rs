@@ -200,7 +200,7 @@ pub fn flange_poses(text: &str, dh: &[[f64; 4]]) -> Result<FlangePoses, TcpError
                 .vector
                 .iter()
                 .copied()
-                .find(|v| !(v.abs() <= conduit_poses::MAX_POSITION));
+                .find(|v| !v.is_finite() || v.abs() > conduit_poses::MAX_POSITION);
             match beyond {
                 Some(value) => Err(TcpError::PoseOutOfRange { line, value }),
                 None => Ok(pose),

@@ -300,7 +300,11 @@ pub fn read(bytes: &[u8], tolerance_mm: f64) -> Result<Design, DxfError> {
             }
         };
         let pts = in_millimetres(points, mm_per_unit, closed);
-        if let Some(v) = pts.iter().flatten().find(|v| !(v.abs() <= MAX_EXTENT_MM)) {
+        if let Some(v) = pts
+            .iter()
+            .flatten()
+            .find(|v| !v.is_finite() || v.abs() > MAX_EXTENT_MM)
+        {
             return Err(e.error(format!(
                 "a point at {v:e} mm is beyond the {MAX_EXTENT_MM} mm working extent (check the coordinates, radii, bulges and $INSUNITS)"
             )));
