@@ -484,16 +484,22 @@ mod tests {
     }
 
     #[test]
-    fn a_thin_wide_cloud_gives_an_error_not_a_panic() {
-        // Collinear within 1e-30 mm over 10 m: no triangle, and the fold grid stays bounded.
-        let pts = [
+    fn a_thin_wide_cloud_is_refused_or_built_never_a_panic() {
+        // The fuzzed cloud: 1e20 mm wide, 1e-30 mm deep (its fold grid overflowed its count).
+        let wide = [
             [0.0, 0.0, 0.0],
-            [1e4, 0.0, 0.0],
+            [1e20, 0.0, 0.0],
             [0.0, 1e-30, 0.0],
-            [5e3, 1e-30, 1.0],
+            [5e19, 1e-30, 1.0],
         ];
-        let e = Surface::from_cloud(&pts, 1.0).map(|_| ());
-        assert!(e.is_err(), "{e:?}");
+        let e = Surface::from_cloud(&wide, 1.0).map(|_| ());
+        assert!(
+            matches!(e, Err(SurfaceError::OutOfRange { index: 2, .. })),
+            "{e:?}"
+        );
+        // As wide as allowed and as thin: slivers, but a bounded grid and no panic.
+        let thin = wide.map(|p| [p[0] * 1e-16, p[1], p[2]]);
+        let _ = Surface::from_cloud(&thin, 1.0);
     }
 
     #[test]
