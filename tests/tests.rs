@@ -21,6 +21,7 @@ mod outputs;
 mod postprocess;
 mod postprocess_e2e;
 mod preview;
+mod regressions_conform;
 mod robot;
 mod roundtrip;
 mod slice;

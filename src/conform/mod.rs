@@ -93,6 +93,46 @@ pub enum ConformError {
     /// How to fix: the SVG must hold paths or shapes (text is not read).
     #[error("the design has no paths")]
     EmptyDesign,
+    /// A placed design point lies beyond [`crate::surface::MAX_EXTENT`] (10 m) from the
+    /// machine origin along an axis, or is not a number.
+    ///
+    /// How to fix: check the SVG's coordinates and units (`width`/`height`/`viewBox`) and the
+    /// `--place` scale.
+    #[error(
+        "path {path}{}: point {point} at {value:e} mm is beyond the {} mm working extent",
+        id.as_deref().map(|i| format!(" (id \"{i}\")")).unwrap_or_default(),
+        crate::surface::MAX_EXTENT
+    )]
+    DesignOutOfRange {
+        /// 1-based number of the path, in document order.
+        path: usize,
+        /// The `id` of its SVG element, when it has one.
+        id: Option<String>,
+        /// 1-based number of the point in the path.
+        point: usize,
+        /// The offending coordinate, mm.
+        value: f64,
+    },
+    /// The design, cut two points per inner diameter, would have more than
+    /// [`MAX_DESIGN_POINTS`] points.
+    ///
+    /// How to fix: print the design in parts, or check its scale (a design in the wrong units
+    /// is 25.4 or 1000 times too long).
+    #[error(
+        "the design is {length:.0} mm of paths: {points} points at {step} mm spacing, more than the {max} a run plans (path {path} reaches the limit)"
+    )]
+    DesignTooLong {
+        /// Total length of the placed paths, mm.
+        length: f64,
+        /// Points the paths would be cut into, at least.
+        points: f64,
+        /// Point spacing (half the inner diameter), mm.
+        step: f64,
+        /// The limit, [`MAX_DESIGN_POINTS`].
+        max: usize,
+        /// 1-based number of the path at which the count passes the limit.
+        path: usize,
+    },
     /// The G-code could not be written.
     ///
     /// How to fix: see the message (usually a `[printer]` or tool snippet setting).
@@ -103,6 +143,77 @@ pub enum ConformError {
     /// How to fix: a custom G-code snippet in the configuration is not valid G-code.
     #[error("re-reading the written G-code: {0}")]
     Reread(#[from] conduit_gcode::GcodeError),
+}
+
+/// Most points a design is cut into for one run (two per inner diameter): 40 000 points is
+/// 5 m of trace at the default 0.25 mm nozzle, longer than the traces of a conformal print,
+/// and keeps a run within seconds (every point is corrected in each of the five modes and
+/// checked with the whole nozzle: a few thousand points a second).
+pub const MAX_DESIGN_POINTS: usize = 40_000;
+
+/// Checks the placed paths before they are cut into points: every coordinate finite and
+/// within [`crate::surface::MAX_EXTENT`], and the total number of points at most
+/// [`MAX_DESIGN_POINTS`].
+fn check_design(
+    design: &conduit_svg::Design,
+    placed: &[design::PlanarPath],
+    step: f64,
+) -> Result<(), ConformError> {
+    let beyond = |points: &[[f64; 2]]| {
+        points.iter().enumerate().find_map(|(i, q)| {
+            q.iter()
+                .copied()
+                .find(|v| !v.is_finite() || v.abs() > crate::surface::MAX_EXTENT)
+                .map(|v| (i, v))
+        })
+    };
+    // As drawn first (the path at fault is named), then as placed (moved and scaled).
+    let numbered = design.paths.iter().enumerate();
+    let drawn = numbered
+        .clone()
+        .map(|(k, p)| (k, p.id.clone(), &p.points[..]));
+    let as_placed = numbered
+        .filter(|(_, p)| p.points.len() >= 2)
+        .zip(placed)
+        .map(|((k, s), p)| (k, s.id.clone(), &p.points[..]));
+    for (k, id, pts) in drawn.chain(as_placed) {
+        if let Some((i, value)) = beyond(pts) {
+            return Err(ConformError::DesignOutOfRange {
+                path: k + 1,
+                id,
+                point: i + 1,
+                value,
+            });
+        }
+    }
+    let mut points = 0.0;
+    let mut length = 0.0;
+    let numbers = numbered_kept(design);
+    for (k, p) in placed.iter().enumerate() {
+        let l = p.length();
+        length += l;
+        points += (l / step).ceil().max(1.0) + 1.0;
+        if points > MAX_DESIGN_POINTS as f64 {
+            // The rest is summed for the message only.
+            let rest: f64 = placed[k + 1..].iter().map(design::PlanarPath::length).sum();
+            return Err(ConformError::DesignTooLong {
+                length: length + rest,
+                points: points + rest / step,
+                step,
+                max: MAX_DESIGN_POINTS,
+                path: numbers.get(k).map_or(k, |n| n + 1),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The 0-based number in `design` of each path [`design::place`] keeps.
+fn numbered_kept(design: &conduit_svg::Design) -> Vec<usize> {
+    let kept = design.paths.iter().enumerate();
+    kept.filter(|(_, p)| p.points.len() >= 2)
+        .map(|(k, _)| k)
+        .collect()
 }
 
 /// Validated parameters of a run.
@@ -228,6 +339,7 @@ pub fn on_surface(
     if placed.is_empty() {
         return Err(ConformError::EmptyDesign);
     }
+    check_design(design, &placed, params.nozzle.inner / 2.0)?;
     let planar: Vec<design::PlanarPath> = placed
         .iter()
         .map(|p| design::discretise(p, params.nozzle.inner / 2.0))
@@ -417,4 +529,66 @@ pub fn machine_params(
     }
     out.printer.retract_before_travel = 0.0;
     Ok(out)
+}
+
+#[cfg(test)]
+mod bound_tests {
+    use super::*;
+
+    fn design(points: Vec<[f64; 2]>) -> conduit_svg::Design {
+        conduit_svg::Design {
+            width_mm: None,
+            height_mm: None,
+            paths: vec![conduit_svg::DesignPath {
+                id: Some("trace".to_owned()),
+                points,
+                closed: false,
+            }],
+        }
+    }
+
+    fn placed(d: &conduit_svg::Design) -> Vec<design::PlanarPath> {
+        let at = Placement {
+            x: 0.0,
+            y: 0.0,
+            rot_deg: 0.0,
+            scale: 1.0,
+        };
+        design::place(d, &at)
+    }
+
+    #[test]
+    fn a_design_point_beyond_the_extent_is_named() {
+        let d = design(vec![[0.0, 0.0], [1e9, 0.0]]);
+        let e = check_design(&d, &placed(&d), 0.125);
+        assert!(
+            matches!(
+                &e,
+                Err(ConformError::DesignOutOfRange {
+                    path: 1,
+                    point: 2,
+                    ..
+                })
+            ),
+            "{e:?}"
+        );
+        let msg = e.err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(msg.contains("id \"trace\"") && !msg.contains('\n'), "{msg}");
+    }
+
+    #[test]
+    fn a_design_too_long_to_cut_is_refused_before_cutting() {
+        // 9 m back and forth 10 times: 90 m, 720 000 points at 0.125 mm.
+        let zigzag = (0..=10)
+            .map(|i| [if i % 2 == 0 { -4500.0 } else { 4500.0 }, i as f64])
+            .collect();
+        let d = design(zigzag);
+        let e = check_design(&d, &placed(&d), 0.125);
+        assert!(
+            matches!(e, Err(ConformError::DesignTooLong { path: 1, .. })),
+            "{e:?}"
+        );
+        let ok = design(vec![[0.0, 0.0], [100.0, 0.0]]);
+        assert!(check_design(&ok, &placed(&ok), 0.125).is_ok());
+    }
 }

@@ -71,6 +71,25 @@ pub enum TcpError {
         /// What failed.
         source: KinematicsError,
     },
+    /// A flange pose (from forward kinematics) is not finite or lies beyond
+    /// [`conduit_poses::MAX_POSITION`].
+    ///
+    /// How to fix: check the joint angles on the line and the arm model (`[robot] dh`).
+    #[error("line {line}: flange position {value:e} mm is not finite or beyond the working extent")]
+    PoseOutOfRange {
+        /// 1-based line number.
+        line: usize,
+        /// The offending coordinate, mm.
+        value: f64,
+    },
+    /// The solver did not converge, or its results are not finite numbers.
+    ///
+    /// How to fix: check the poses for stray rows (positions in mm, unit quaternions).
+    #[error("the pivot solution is not a finite number ({what}); check the poses for stray rows")]
+    NotFinite {
+        /// What was not finite.
+        what: &'static str,
+    },
     /// Fewer than three poses.
     ///
     /// How to fix: record at least three (better eight or more) poses around the pivot.
@@ -92,6 +111,11 @@ pub enum TcpError {
         max: f64,
     },
 }
+
+/// Most sweeps the singular value decomposition of the pivot system may take: a well-posed
+/// 3m×6 system converges in a few dozen; input that does not converge is refused rather than
+/// iterated for ever.
+pub const MAX_SVD_ITERATIONS: usize = 1000;
 
 /// Where the flange poses of a table came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -168,8 +192,19 @@ pub fn flange_poses(text: &str, dh: &[[f64; 4]]) -> Result<FlangePoses, TcpError
         .zip(&table.lines)
         .map(|(row, &line)| {
             let q: Vec<f64> = cols.iter().map(|&c| row[c]).collect();
-            arm.forward(&q)
-                .map_err(|source| TcpError::Kinematics { line, source })
+            let pose = arm
+                .forward(&q)
+                .map_err(|source| TcpError::Kinematics { line, source })?;
+            let beyond = pose
+                .translation
+                .vector
+                .iter()
+                .copied()
+                .find(|v| !v.is_finite() || v.abs() > conduit_poses::MAX_POSITION);
+            match beyond {
+                Some(value) => Err(TcpError::PoseOutOfRange { line, value }),
+                None => Ok(pose),
+            }
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok(FlangePoses {
@@ -241,7 +276,10 @@ pub fn pivot(
             b[3 * i + row] = -p[row];
         }
     }
-    let svd = a.svd(true, true);
+    let not_finite = |what| TcpError::NotFinite { what };
+    let svd = a
+        .try_svd(true, true, 5.0 * f64::EPSILON, MAX_SVD_ITERATIONS)
+        .ok_or(not_finite("the decomposition did not converge"))?;
     let mut sv: Vec<f64> = svd.singular_values.iter().copied().collect();
     sv.sort_by(|x, y| y.total_cmp(x));
     let (largest, smallest) = (sv[0], sv[5]);
@@ -292,13 +330,24 @@ pub fn pivot(
             * s2
     };
     let sigma = |k0: usize| [0, 1, 2].map(|k| variance(k0 + k).sqrt());
+    let (tcp_sigma, pivot_sigma) = (sigma(0), sigma(3));
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if !finite(&[tcp.x, tcp.y, tcp.z, c.x, c.y, c.z]) {
+        return Err(not_finite("the tip offset or the pivot"));
+    }
+    if !finite(&[rms, worst.residual]) {
+        return Err(not_finite("the residuals"));
+    }
+    if !finite(&tcp_sigma) || !finite(&pivot_sigma) {
+        return Err(not_finite("the standard errors"));
+    }
     Ok(Pivot {
         source,
         poses: m,
         tcp: [tcp.x, tcp.y, tcp.z],
         pivot: [c.x, c.y, c.z],
-        tcp_sigma: sigma(0),
-        pivot_sigma: sigma(3),
+        tcp_sigma,
+        pivot_sigma,
         rms,
         worst,
         residuals,
@@ -311,6 +360,31 @@ pub fn pivot(
 mod tests {
     use super::*;
     use nalgebra::Unit;
+
+    #[test]
+    fn results_that_are_not_finite_are_an_error() {
+        let mut p = poses(
+            Vector3::new(1.0, 2.0, 150.0),
+            Point3::new(500.0, 0.0, 100.0),
+            25.0,
+        );
+        p[3].translation.vector.x = 1e300;
+        let e = pivot(&p, &[], PoseSource::Quaternions);
+        assert!(matches!(e, Err(TcpError::NotFinite { .. })), "{e:?}");
+    }
+
+    #[test]
+    fn a_table_with_a_far_or_overflowing_row_is_refused_by_line() {
+        let text = "x,y,z,qw,qx,qy,qz\n1,2,3,1,0,0,0\n1,2,3,-0.2,-1e308,0.4,0.1\n";
+        let e = flange_poses(text, &[]);
+        assert!(
+            matches!(
+                e,
+                Err(TcpError::Table(TableError::QuaternionLength { line: 3 }))
+            ),
+            "{e:?}"
+        );
+    }
 
     /// Flange poses holding the tip `t` on `c`: tilted by `tilt` degrees toward eight
     /// directions, each also turned about the tool axis.

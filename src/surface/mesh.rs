@@ -52,6 +52,32 @@ pub enum SurfaceError {
     /// The triangulation of a cloud failed.
     #[error("triangulating the point cloud: {0}")]
     Triangulation(String),
+    /// A point lies farther than [`MAX_EXTENT`] from the origin along an axis: a stray point
+    /// (or a file in other units) that would size the surface's grids by its distance.
+    ///
+    /// How to fix: remove the outlier from the scan, or export it in millimetres.
+    #[error(
+        "{element} {index}: coordinate {value:e} mm is beyond the {MAX_EXTENT} mm working extent (a stray point or a file not in mm)"
+    )]
+    OutOfRange {
+        /// What is numbered: `"point"` (a cloud) or `"triangle"` (a mesh).
+        element: &'static str,
+        /// 1-based number of the point or triangle, in file order.
+        index: usize,
+        /// The offending coordinate, mm.
+        value: f64,
+    },
+}
+
+/// Largest coordinate (absolute, per axis) of a surface, mm: 10 m. No bed, robot cell or scanner
+/// volume this tool drives comes near it, and every grid over a surface is sized from its
+/// extent, so one far stray point would otherwise make the grids (or the work over them) grow
+/// with its distance.
+pub const MAX_EXTENT: f64 = 10_000.0;
+
+/// The first coordinate of `p` that is beyond [`MAX_EXTENT`].
+fn out_of_range(p: &[f64; 3]) -> Option<f64> {
+    p.iter().copied().find(|v| v.abs() > MAX_EXTENT)
 }
 
 /// What was done to a point cloud to make a surface of it.
@@ -131,11 +157,18 @@ impl Surface {
     pub fn from_triangles(tris: Vec<[Point3; 3]>) -> Result<Self, SurfaceError> {
         let mut triangles = Vec::with_capacity(tris.len());
         let mut normals = Vec::with_capacity(tris.len());
-        for c in tris {
+        for (i, c) in tris.into_iter().enumerate() {
             if c.iter()
                 .any(|p| !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()))
             {
                 return Err(SurfaceError::NotFinite);
+            }
+            if let Some(value) = c.iter().find_map(|p| out_of_range(&[p.x, p.y, p.z])) {
+                return Err(SurfaceError::OutOfRange {
+                    element: "triangle",
+                    index: i + 1,
+                    value,
+                });
             }
             let n = (c[1] - c[0]).cross(&(c[2] - c[0]));
             let len = n.norm();
@@ -223,6 +256,17 @@ impl Surface {
         if points.iter().flatten().any(|v| !v.is_finite()) {
             return Err(SurfaceError::NotFinite);
         }
+        if let Some((i, value)) = points
+            .iter()
+            .enumerate()
+            .find_map(|(i, p)| out_of_range(p).map(|v| (i, v)))
+        {
+            return Err(SurfaceError::OutOfRange {
+                element: "point",
+                index: i + 1,
+                value,
+            });
+        }
         if points.len() < 3 {
             return Err(SurfaceError::Empty);
         }
@@ -235,8 +279,9 @@ impl Surface {
         // A cell about twice the mean point spacing: a cell of a single-layer scan then holds a
         // few points of one layer, a folded scan points of both layers.
         let cell = (2.0 * (area / points.len() as f64).sqrt()).max(1e-6);
-        let nx = (((hi[0] - lo[0]) / cell) as usize + 1).min(1 << 15);
-        let ny = (((hi[1] - lo[1]) / cell) as usize + 1).min(1 << 15);
+        // Counted in f64 and capped before the cast, so no extent overflows the count.
+        let cells = |w: f64| ((w / cell).floor().min(f64::from(1 << 15) - 1.0) as usize) + 1;
+        let (nx, ny) = (cells(hi[0] - lo[0]), cells(hi[1] - lo[1]));
         let key = |p: &[f64; 3]| {
             let i = (((p[0] - lo[0]) / cell) as usize).min(nx - 1);
             let j = (((p[1] - lo[1]) / cell) as usize).min(ny - 1);
@@ -401,6 +446,61 @@ fn cell_of(lo: Point3, cell: f64, dims: [usize; 2], x: f64, y: f64) -> [usize; 2
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_far_stray_point_is_refused_by_number() {
+        let pts = [
+            [50.0, 50.0, 1.0],
+            [80.0, 50.0, 1.0],
+            [50.0, 80.0, 1.0],
+            [1e18, 60.0, 1.0],
+        ];
+        let e = Surface::from_cloud(&pts, 1.0).map(|_| ());
+        assert!(
+            matches!(
+                e,
+                Err(SurfaceError::OutOfRange {
+                    element: "point",
+                    index: 4,
+                    ..
+                })
+            ),
+            "{e:?}"
+        );
+        let far = Point3::new(0.0, 2e4, 0.0);
+        let tri = [Point3::origin(), Point3::new(1.0, 0.0, 0.0), far];
+        let e = Surface::from_triangles(vec![tri]).map(|_| ());
+        assert!(
+            matches!(
+                e,
+                Err(SurfaceError::OutOfRange {
+                    element: "triangle",
+                    index: 1,
+                    ..
+                })
+            ),
+            "{e:?}"
+        );
+    }
+
+    #[test]
+    fn a_thin_wide_cloud_is_refused_or_built_never_a_panic() {
+        // The fuzzed cloud: 1e20 mm wide, 1e-30 mm deep (its fold grid overflowed its count).
+        let wide = [
+            [0.0, 0.0, 0.0],
+            [1e20, 0.0, 0.0],
+            [0.0, 1e-30, 0.0],
+            [5e19, 1e-30, 1.0],
+        ];
+        let e = Surface::from_cloud(&wide, 1.0).map(|_| ());
+        assert!(
+            matches!(e, Err(SurfaceError::OutOfRange { index: 2, .. })),
+            "{e:?}"
+        );
+        // As wide as allowed and as thin: slivers, but a bounded grid and no panic.
+        let thin = wide.map(|p| [p[0] * 1e-16, p[1], p[2]]);
+        let _ = Surface::from_cloud(&thin, 1.0);
+    }
 
     #[test]
     fn a_ramp_cloud_gives_exact_heights_and_a_folded_cloud_is_noted() -> Result<(), SurfaceError> {

@@ -26,6 +26,6 @@ pub mod replay;
 pub mod tool;
 
 pub use height_field::{HeightField, SurfaceHit, SurfaceTriangle, densify_path};
-pub use mesh::{CloudInfo, Surface, SurfaceError};
+pub use mesh::{CloudInfo, MAX_EXTENT, Surface, SurfaceError};
 pub use replay::{Hit, Next, Obstacle, Sample, Spacing, Stretch, walk};
 pub use tool::{Piece, PieceShape, ToolPart, ToolSolid};

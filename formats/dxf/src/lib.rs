@@ -258,6 +258,15 @@ impl Entity<'_> {
     }
 }
 
+/// Largest coordinate (absolute, per axis) of a flattened point, mm: 10 m, beyond any bed or
+/// substrate a design is printed on. A larger one is a stray value or a file in other units,
+/// and every later step (fills, layers, lengths) would grow with it.
+pub const MAX_EXTENT_MM: f64 = 10_000.0;
+
+/// Largest bulge (tan of a quarter of the segment's sweep) of a polyline vertex, absolute: a
+/// sweep of 359.9998°. A larger one puts the arc's centre at infinity or makes it non-finite.
+pub const MAX_BULGE: f64 = 1e6;
+
 /// Reads an ASCII DXF document into polylines in millimetres, flattening arcs and bulges so
 /// that no point of a curve is farther than `tolerance_mm` from its polyline.
 pub fn read(bytes: &[u8], tolerance_mm: f64) -> Result<Design, DxfError> {
@@ -291,6 +300,15 @@ pub fn read(bytes: &[u8], tolerance_mm: f64) -> Result<Design, DxfError> {
             }
         };
         let pts = in_millimetres(points, mm_per_unit, closed);
+        if let Some(v) = pts
+            .iter()
+            .flatten()
+            .find(|v| !v.is_finite() || v.abs() > MAX_EXTENT_MM)
+        {
+            return Err(e.error(format!(
+                "a point at {v:e} mm is beyond the {MAX_EXTENT_MM} mm working extent (check the coordinates, radii, bulges and $INSUNITS)"
+            )));
+        }
         if pts.len() < 2 {
             continue;
         }
@@ -379,6 +397,13 @@ fn centre_and_radius(e: &Entity, m: f64) -> Result<([f64; 2], f64), DxfError> {
     if r <= 0.0 {
         return Err(e.error(format!("radius must be > 0, got {r}")));
     }
+    // In drawing units, loose enough for a drawing in µm: this keeps the arc finite; its
+    // points are held to the extent in mm once flattened.
+    if r > MAX_EXTENT_MM * 1e3 {
+        return Err(e.error(format!(
+            "radius {r:e} is beyond the {MAX_EXTENT_MM} mm working extent"
+        )));
+    }
     Ok((c, r))
 }
 
@@ -429,7 +454,7 @@ fn lwpolyline(e: &Entity, tol: f64) -> Result<Flattened, DxfError> {
             }
             42 => {
                 if let Some(v) = verts.last_mut() {
-                    v.1 = m * e.num(p)?;
+                    v.1 = m * bulge(e, e.num(p)?, p.line)?;
                 }
             }
             _ => {}
@@ -437,6 +462,17 @@ fn lwpolyline(e: &Entity, tol: f64) -> Result<Flattened, DxfError> {
     }
     let closed = flags & 1 == 1;
     Ok(("LWPOLYLINE", bulged(&verts, closed, tol), closed))
+}
+
+/// `b`, the bulge read on `line` of entity `e`, when it is at most [`MAX_BULGE`].
+fn bulge(e: &Entity, b: f64, line: usize) -> Result<f64, DxfError> {
+    if b.abs() <= MAX_BULGE {
+        Ok(b)
+    } else {
+        Err(e.error(format!(
+            "line {line}: bulge {b:e} is beyond ±{MAX_BULGE:e} (a sweep of almost 360°)"
+        )))
+    }
 }
 
 /// A `POLYLINE`: its vertices are the `VERTEX` entities that follow it (from `entities[*k]`)
@@ -464,7 +500,7 @@ fn polyline(
         match v.kind {
             "VERTEX" => verts.push((
                 [m * v.need(10)?, v.need(20)?],
-                m * v.get(42)?.unwrap_or(0.0),
+                m * bulge(v, v.get(42)?.unwrap_or(0.0), v.line)?,
             )),
             "SEQEND" => break,
             other => {
@@ -548,6 +584,29 @@ fn bulged(verts: &[([f64; 2], f64)], closed: bool, tol: f64) -> Vec<[f64; 2]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn huge_bulges_radii_and_coordinates_are_refused_by_entity() {
+        let bulge =
+            doc("0\nLWPOLYLINE\n8\n0\n90\n2\n70\n0\n10\n0\n20\n0\n42\n1e308\n10\n0\n20\n1\n");
+        let e = read(&bulge, 0.01);
+        assert!(
+            matches!(&e, Err(DxfError::Entity { message, .. }) if message.contains("bulge")),
+            "{e:?}"
+        );
+        let circle = doc("0\nCIRCLE\n8\n0\n10\n0\n20\n0\n40\n1e308\n");
+        let e = read(&circle, 0.01);
+        assert!(
+            matches!(&e, Err(DxfError::Entity { message, .. }) if message.contains("radius")),
+            "{e:?}"
+        );
+        let far = doc("0\nLINE\n8\n0\n10\n0\n20\n0\n11\n0\n21\n1e308\n");
+        let e = read(&far, 0.01);
+        assert!(
+            matches!(&e, Err(DxfError::Entity { message, .. }) if message.contains("extent")),
+            "{e:?}"
+        );
+    }
 
     fn doc(entities: &str) -> Vec<u8> {
         format!("0\nSECTION\n2\nENTITIES\n{entities}0\nENDSEC\n0\nEOF\n").into_bytes()

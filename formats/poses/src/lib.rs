@@ -86,6 +86,30 @@ pub enum TableError {
         /// 1-based line number.
         line: usize,
     },
+    /// A pose's quaternion is so long that its length is not a finite number.
+    ///
+    /// How to fix: write a unit quaternion `qw,qx,qy,qz`.
+    #[error(
+        "line {line}: the quaternion's length is not a finite number (write a unit quaternion)"
+    )]
+    QuaternionLength {
+        /// 1-based line number.
+        line: usize,
+    },
+    /// A pose's position is farther than [`MAX_POSITION`] from the origin along an axis.
+    ///
+    /// How to fix: write positions in millimetres; remove the stray row.
+    #[error(
+        "line {line}, column `{column}`: {value:e} mm is beyond the {MAX_POSITION} mm working extent"
+    )]
+    Position {
+        /// 1-based line number.
+        line: usize,
+        /// The column's name.
+        column: &'static str,
+        /// The value read.
+        value: f64,
+    },
     /// A `dispense` field is not 0 or 1.
     ///
     /// How to fix: write 0 (off) or 1 (on).
@@ -237,6 +261,11 @@ pub struct Pose {
 /// The pose columns, in the order [`write_poses`] writes them.
 pub const POSE_COLUMNS: [&str; 8] = ["x", "y", "z", "qw", "qx", "qy", "qz", "dispense"];
 
+/// Largest pose coordinate (absolute, per axis), mm: 10 m, beyond the reach of any robot cell
+/// this format serves; a larger value is a stray or a file in other units, and would carry
+/// hundreds of digits into the results.
+pub const MAX_POSITION: f64 = 10_000.0;
+
 /// Reads poses from CSV text with the columns `x,y,z,qw,qx,qy,qz` (any order, other columns
 /// ignored) and an optional `dispense` (default 1). Quaternions are normalised.
 pub fn read_poses(text: &str) -> Result<Vec<Pose>, TableError> {
@@ -249,8 +278,21 @@ pub fn read_poses(text: &str) -> Result<Vec<Pose>, TableError> {
         .map(|(r, &line)| {
             let q = [r[idx[3]], r[idx[4]], r[idx[5]], r[idx[6]]];
             let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+            if !n.is_finite() {
+                return Err(TableError::QuaternionLength { line });
+            }
             if n < 1e-9 {
                 return Err(TableError::ZeroQuaternion { line });
+            }
+            for (k, column) in POSE_COLUMNS[..3].iter().enumerate() {
+                let value = r[idx[k]];
+                if value.abs() > MAX_POSITION {
+                    return Err(TableError::Position {
+                        line,
+                        column,
+                        value,
+                    });
+                }
             }
             let on = match dispense.map(|c| r[c]) {
                 None => true,
@@ -304,6 +346,25 @@ pub fn write_poses(poses: &[Pose], out: &mut impl io::Write) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn huge_positions_and_overflowing_quaternions_are_refused_by_line() {
+        let head = "x,y,z,qw,qx,qy,qz\n1,2,3,1,0,0,0\n";
+        let far = format!("{head}1e308,0,0,1,0,0,0\n");
+        assert!(matches!(
+            read_poses(&far),
+            Err(TableError::Position {
+                line: 3,
+                column: "x",
+                ..
+            })
+        ));
+        let long = format!("{head}1,2,3,-0.2,-1e308,0.4,0.1\n");
+        assert_eq!(
+            read_poses(&long),
+            Err(TableError::QuaternionLength { line: 3 })
+        );
+    }
 
     #[test]
     fn comments_blank_lines_and_spaces_are_skipped_and_columns_found_by_name() {
