@@ -669,7 +669,9 @@ impl Config {
             ("printer.max_height", p.max_height),
         ] {
             if v > MAX_MACHINE_SIZE {
-                problems.push(format!("{key} must be at most {MAX_MACHINE_SIZE} mm, got {v}"));
+                problems.push(format!(
+                    "{key} must be at most {MAX_MACHINE_SIZE} mm, got {v}"
+                ));
             }
         }
         // A skirt farther out than the bed is wide would be printed off the bed.
@@ -688,7 +690,10 @@ impl Config {
         }
         for (key, v) in [
             ("printer.bed_temperature", p.bed_temperature),
-            ("printer.first_layer_bed_temperature", p.first_layer_bed_temperature),
+            (
+                "printer.first_layer_bed_temperature",
+                p.first_layer_bed_temperature,
+            ),
         ] {
             if !(0.0..=MAX_TEMPERATURE).contains(&v) {
                 problems.push(format!(

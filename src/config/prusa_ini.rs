@@ -202,9 +202,7 @@ impl Pairs {
             Some(v) if v >= 0.0 && v.fract() == 0.0 && v < usize::MAX as f64 => {
                 Ok(Some(v as usize))
             }
-            Some(v) if v >= 0.0 && v.fract() == 0.0 => {
-                Err(self.err(key, "too large for a count"))
-            }
+            Some(v) if v >= 0.0 && v.fract() == 0.0 => Err(self.err(key, "too large for a count")),
             Some(_) => Err(self.err(key, "expected a whole number ≥ 0")),
             None => Ok(None),
         }

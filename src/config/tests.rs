@@ -384,7 +384,10 @@ fn keys_that_size_work_have_ranges_naming_the_key() {
         ),
     ] {
         let problems = problems(src);
-        assert!(problems.iter().any(|p| p == expected), "{src}: {problems:?}");
+        assert!(
+            problems.iter().any(|p| p == expected),
+            "{src}: {problems:?}"
+        );
     }
 }
 

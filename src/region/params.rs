@@ -275,8 +275,7 @@ impl RegionParams {
         } else {
             NOZZLE_RANGE[1]
         };
-        if self.layer_height > 0.0
-            && !(MIN_LAYER_HEIGHT..=max_height).contains(&self.layer_height)
+        if self.layer_height > 0.0 && !(MIN_LAYER_HEIGHT..=max_height).contains(&self.layer_height)
         {
             errors.push(ParamError::OutOfRange {
                 field: "layer_height",
@@ -288,7 +287,11 @@ impl RegionParams {
         for (field, value, max) in [
             ("perimeters", self.perimeters, MAX_PERIMETERS),
             ("top_solid_layers", self.top_solid_layers, MAX_SOLID_LAYERS),
-            ("bottom_solid_layers", self.bottom_solid_layers, MAX_SOLID_LAYERS),
+            (
+                "bottom_solid_layers",
+                self.bottom_solid_layers,
+                MAX_SOLID_LAYERS,
+            ),
             ("skirt_loops", self.skirt_loops, MAX_SKIRT_LOOPS),
         ] {
             if value > max {
