@@ -556,7 +556,10 @@ mod tests {
             assert!(!line.contains("]("), "markdown link left: {line}");
         }
         // Defaults printed as values are not repeated in the comment above them.
-        assert!(doc.contains("# Height of the first layer, mm.\nfirst_layer_height = 0.2\n"));
+        assert!(doc.contains(
+            "# Height of the first layer, mm, from 0.01 to 2 × `nozzle_diameter`.\n\
+             first_layer_height = 0.2\n"
+        ));
     }
 
     #[test]

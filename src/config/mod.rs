@@ -69,8 +69,17 @@ use crate::program::Role;
 pub use crate::program::machine::{
     DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, PnpSettings, Printer, Tool, ToolKind,
 };
-use crate::region::{InfillPatternKind, RegionParams};
+use crate::region::{InfillPatternKind, MIN_LAYER_HEIGHT, NOZZLE_RANGE, RegionParams};
 use crate::toolpaths::{ProgramParams, RoleSpeeds, ToolPathParams};
+
+/// Fastest speed of any move, mm/s: the fastest FFF printers travel at about 1000 mm/s; a
+/// larger number is a typo, and would make every time estimate meaningless.
+const MAX_SPEED: f64 = 1000.0;
+/// Largest bed side and print height, mm: 10 m covers large-format and construction printers
+/// and keeps layer counts and skirt offsets bounded.
+const MAX_MACHINE_SIZE: f64 = 10_000.0;
+/// Hottest nozzle or bed, °C: high-temperature printers (PEEK, PEI) reach about 450 °C.
+const MAX_TEMPERATURE: f64 = 500.0;
 
 /// Everything a conduit run is configured with. See the [module docs](self) for the file format.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -117,9 +126,11 @@ pub enum SolidPattern {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct SliceSettings {
-    /// Number of perimeter loops per island, the external one included. Default 2.
+    /// Number of perimeter loops per island, the external one included, 0 to 100. Default 2.
     pub perimeters: usize,
-    /// Extrusion width of the external (outermost) loop, mm. Default 0.45.
+    /// Extrusion width of the external (outermost) loop, mm. Every width is at least
+    /// `nozzle_diameter`, more than `layer_height` and at most 3 × `nozzle_diameter` (10 mm at
+    /// most). Default 0.45.
     pub external_perimeter_width: f64,
     /// Extrusion width of the inner loops, mm. Default 0.45.
     pub perimeter_width: f64,
@@ -132,9 +143,10 @@ pub struct SliceSettings {
     /// Extrusion width of every extrusion on the first layer (loops, infill, gap fill, skirt),
     /// mm; a wider first layer sticks better and evens out an uneven bed. Default 0.45.
     pub first_layer_width: f64,
-    /// Number of solid layers under every upward-facing surface. Default 3.
+    /// Number of solid layers under every upward-facing surface, 0 to 100. Default 3.
     pub top_solid_layers: usize,
-    /// Number of solid layers over every downward-facing surface (and at the bed). Default 3.
+    /// Number of solid layers over every downward-facing surface (and at the bed), 0 to 100.
+    /// Default 3.
     pub bottom_solid_layers: usize,
     /// Density of sparse infill, 0 (none) to 1 (solid). Lines are `spacing / density` apart.
     /// Default 0.2.
@@ -151,7 +163,7 @@ pub struct SliceSettings {
     /// top of this, so they reach under the perimeters of a part standing on them (see
     /// `region::skins`). Default 3, PrusaSlicer's `EXTERNAL_INFILL_MARGIN`: a top skin that
     /// ends flush with the sparse infill below it sags into the gaps at its edge, and a bridge
-    /// needs its lines anchored well beyond the edge of the air it spans.
+    /// needs its lines anchored well beyond the edge of the air it spans. 0 to 100 mm.
     pub solid_infill_margin: f64,
     /// Sparse areas smaller than this (mm²) are filled solid instead: in a small area sparse
     /// lines are short, mostly turns and anchors, and add little stiffness, while a solid fill
@@ -164,17 +176,18 @@ pub struct SliceSettings {
     /// Print the external loop of each island first (better dimensional accuracy, worse
     /// overhangs). Default false: inner loops first.
     pub external_perimeters_first: bool,
-    /// Number of skirt loops around the first layer. Default 0 (no skirt).
+    /// Number of skirt loops around the first layer, 0 to 100. Default 0 (no skirt).
     pub skirt_loops: usize,
-    /// Clear gap between the first layer's islands and the inner edge of the skirt, mm. Default 6.
+    /// Clear gap between the first layer's islands and the inner edge of the skirt, mm, from 0
+    /// to the larger side of `printer.bed_size`. Default 6.
     pub skirt_distance: f64,
-    /// Nozzle diameter, mm. Default 0.4. Used by [`RegionParams::validate`]: widths below it are
-    /// rejected.
+    /// Nozzle diameter, mm, 0.05 to 5. Default 0.4. Used by [`RegionParams::validate`]: widths
+    /// below it are rejected.
     pub nozzle_diameter: f64,
-    /// Layer height, mm, used in the spacing formula when no per-layer heights are given.
-    /// Default 0.2.
+    /// Layer height, mm, used in the spacing formula when no per-layer heights are given: from
+    /// 0.01 to `nozzle_diameter`. Default 0.2.
     pub layer_height: f64,
-    /// Height of the first layer, mm. Default 0.2.
+    /// Height of the first layer, mm, from 0.01 to 2 × `nozzle_diameter`. Default 0.2.
     pub first_layer_height: f64,
     /// Pattern of top solid infill. Default `"rectilinear"`.
     pub top_fill_pattern: SolidPattern,
@@ -182,9 +195,11 @@ pub struct SliceSettings {
     pub bottom_fill_pattern: SolidPattern,
     /// Generate support material. Default false.
     pub support_material: bool,
-    /// Width of the brim around the first layer, mm; 0 = none. Default 0.
+    /// Width of the brim around the first layer, mm, from 0 (none) to the larger side of
+    /// `printer.bed_size`. Default 0.
     pub brim_width: f64,
-    /// Speed of inner perimeters, mm/s. Default 45.
+    /// Speed of inner perimeters, mm/s. Every speed is more than 0 and at most 1000 mm/s.
+    /// Default 45.
     pub perimeter_speed: f64,
     /// Speed of external perimeters, mm/s. Default 25.
     pub external_perimeter_speed: f64,
@@ -553,6 +568,7 @@ impl Config {
         );
         let s = &self.slice;
         let p = &self.printer;
+        problems.extend(self.range_problems());
         for (key, v) in [
             ("slice.first_layer_height", s.first_layer_height),
             ("slice.perimeter_speed", s.perimeter_speed),
@@ -602,6 +618,133 @@ impl Config {
         } else {
             Err(ConfigError::Invalid { problems })
         }
+    }
+
+    /// The upper (and lower) bounds of the keys that size work, beyond the positivity checks
+    /// of [`Config::validate`]: a number a real printer never uses (10¹⁸ perimeters, 10⁻⁹ mm
+    /// layers, 10⁸ skirt loops) would otherwise turn into billions of loops or layers.
+    fn range_problems(&self) -> Vec<String> {
+        let s = &self.slice;
+        let p = &self.printer;
+        let mut problems = Vec::new();
+        let nozzle = if (NOZZLE_RANGE[0]..=NOZZLE_RANGE[1]).contains(&s.nozzle_diameter) {
+            s.nozzle_diameter
+        } else {
+            NOZZLE_RANGE[1]
+        };
+        // A thick first layer evens out an uneven bed (PrusaSlicer's `150%` of a 0.3 mm layer
+        // is 0.45 mm on a 0.4 mm nozzle); past two nozzle diameters the bead is no longer
+        // pressed onto the bed.
+        let max_first = ((2.0 * nozzle) * 1e6).round() / 1e6;
+        let h = s.first_layer_height;
+        if h > 0.0 && !(MIN_LAYER_HEIGHT..=max_first).contains(&h) {
+            problems.push(format!(
+                "slice.first_layer_height must be between {MIN_LAYER_HEIGHT} mm and \
+                 2 × slice.nozzle_diameter ({max_first} mm), got {h}"
+            ));
+        }
+        for (key, v) in [
+            ("slice.perimeter_speed", s.perimeter_speed),
+            ("slice.external_perimeter_speed", s.external_perimeter_speed),
+            ("slice.infill_speed", s.infill_speed),
+            ("slice.solid_infill_speed", s.solid_infill_speed),
+            ("slice.top_solid_infill_speed", s.top_solid_infill_speed),
+            ("slice.bridge_speed", s.bridge_speed),
+            ("slice.gap_fill_speed", s.gap_fill_speed),
+            ("slice.first_layer_speed", s.first_layer_speed),
+            ("slice.skirt_speed", s.skirt_speed),
+            ("slice.conductive_speed", s.conductive_speed),
+            ("printer.travel_speed", p.travel_speed),
+            ("printer.retract_speed", p.retract_speed),
+            ("printer.deretract_speed", p.deretract_speed),
+            ("printer.max_print_speed", p.max_print_speed),
+        ] {
+            if v > MAX_SPEED {
+                problems.push(format!("{key} must be at most {MAX_SPEED} mm/s, got {v}"));
+            }
+        }
+        for (key, v) in [
+            ("printer.bed_size[0]", p.bed_size[0]),
+            ("printer.bed_size[1]", p.bed_size[1]),
+            ("printer.max_height", p.max_height),
+        ] {
+            if v > MAX_MACHINE_SIZE {
+                problems.push(format!(
+                    "{key} must be at most {MAX_MACHINE_SIZE} mm, got {v}"
+                ));
+            }
+        }
+        // A skirt farther out than the bed is wide would be printed off the bed.
+        let bed = p.bed_size[0].max(p.bed_size[1]);
+        if s.skirt_distance > bed {
+            problems.push(format!(
+                "slice.skirt_distance must be at most the bed size ({bed} mm), got {}",
+                s.skirt_distance
+            ));
+        }
+        if !(s.brim_width.is_finite() && (0.0..=bed).contains(&s.brim_width)) {
+            problems.push(format!(
+                "slice.brim_width must be between 0 and the bed size ({bed} mm), got {}",
+                s.brim_width
+            ));
+        }
+        for (key, v) in [
+            ("printer.bed_temperature", p.bed_temperature),
+            (
+                "printer.first_layer_bed_temperature",
+                p.first_layer_bed_temperature,
+            ),
+        ] {
+            if !(0.0..=MAX_TEMPERATURE).contains(&v) {
+                problems.push(format!(
+                    "{key} must be between 0 and {MAX_TEMPERATURE} °C, got {v}"
+                ));
+            }
+        }
+        for (key, v) in [
+            ("printer.bed_origin[0]", p.bed_origin[0]),
+            ("printer.bed_origin[1]", p.bed_origin[1]),
+            ("printer.retract_length", p.retract_length),
+            ("printer.retract_before_travel", p.retract_before_travel),
+            ("printer.retract_lift", p.retract_lift),
+            ("printer.fan_min_speed", p.fan_min_speed),
+            ("printer.fan_max_speed", p.fan_max_speed),
+            ("slice.infill_angle_deg", s.infill_angle_deg),
+        ] {
+            if !v.is_finite() {
+                problems.push(format!("{key} must be a finite number, got {v}"));
+            }
+        }
+        for (i, t) in self.tools.iter().enumerate() {
+            for (key, v) in [
+                ("temperature", Some(t.temperature)),
+                ("first_layer_temperature", Some(t.first_layer_temperature)),
+                ("standby_temperature", t.standby_temperature),
+            ] {
+                if let Some(v) = v
+                    && !(0.0..=MAX_TEMPERATURE).contains(&v)
+                {
+                    problems.push(format!(
+                        "tools.{i}.{key} must be between 0 and {MAX_TEMPERATURE} °C, got {v}"
+                    ));
+                }
+            }
+            for (key, v) in [
+                ("offset[0]", Some(t.offset[0])),
+                ("offset[1]", Some(t.offset[1])),
+                ("filament_density", Some(t.filament_density)),
+                ("paste_flow_mm3_s", Some(t.paste_flow_mm3_s)),
+                ("retract_length", t.retract_length),
+                ("travel_lift", t.travel_lift),
+            ] {
+                if let Some(v) = v
+                    && !v.is_finite()
+                {
+                    problems.push(format!("tools.{i}.{key} must be a finite number, got {v}"));
+                }
+            }
+        }
+        problems
     }
 
     /// Settings the planar pipeline does not apply yet, when they ask for something other than

@@ -189,8 +189,20 @@ impl Pairs {
 
     /// An integer count.
     fn count(&mut self, key: &str) -> Result<Option<usize>, ConfigError> {
+        // A plain integer is read exactly (through f64, 2⁶³ − 1 would read as 2⁶³).
+        let exact = self
+            .raw(key)
+            .and_then(|raw| raw.split(',').next())
+            .and_then(|first| first.trim().parse::<usize>().ok());
+        if exact.is_some() {
+            return Ok(exact);
+        }
         match self.num(key)? {
-            Some(v) if v >= 0.0 && v.fract() == 0.0 => Ok(Some(v as usize)),
+            // `as` would saturate a larger number to usize::MAX, hiding what was written.
+            Some(v) if v >= 0.0 && v.fract() == 0.0 && v < usize::MAX as f64 => {
+                Ok(Some(v as usize))
+            }
+            Some(v) if v >= 0.0 && v.fract() == 0.0 => Err(self.err(key, "too large for a count")),
             Some(_) => Err(self.err(key, "expected a whole number ≥ 0")),
             None => Ok(None),
         }

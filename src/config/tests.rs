@@ -316,3 +316,104 @@ fn errors_name_the_key_and_suggest_the_closest() {
         Some("--set curved.max_anlge: unknown key `max_anlge`; did you mean `max_angle`?")
     );
 }
+
+/// The problems `validate` finds in `src`.
+fn problems(src: &str) -> Vec<String> {
+    match parse(src) {
+        Err(ConfigError::Invalid { problems }) => problems,
+        other => panic!("{src:?}: expected invalid, got {other:?}"),
+    }
+}
+
+#[test]
+fn keys_that_size_work_have_ranges_naming_the_key() {
+    for (src, expected) in [
+        (
+            "[slice]\nperimeters = 1000000000000000000\n",
+            "slice.perimeters must be at most 100, got 1000000000000000000",
+        ),
+        (
+            "[slice]\nskirt_loops = 100000000\n",
+            "slice.skirt_loops must be at most 100, got 100000000",
+        ),
+        (
+            "[slice]\ntop_solid_layers = 101\n",
+            "slice.top_solid_layers must be at most 100, got 101",
+        ),
+        (
+            "[slice]\nbottom_solid_layers = 5000\n",
+            "slice.bottom_solid_layers must be at most 100, got 5000",
+        ),
+        (
+            "[slice]\nlayer_height = 1e-9\n",
+            "slice.layer_height must be between 0.01 and 0.4 mm, got 0.000000001",
+        ),
+        (
+            "[slice]\nlayer_height = 0.5\n",
+            "slice.layer_height must be between 0.01 and 0.4 mm, got 0.5",
+        ),
+        (
+            "[slice]\nfirst_layer_height = 0.001\n",
+            "slice.first_layer_height must be between 0.01 mm and 2 × slice.nozzle_diameter \
+             (0.8 mm), got 0.001",
+        ),
+        (
+            "[slice]\nperimeter_width = 1e39\n",
+            "slice.perimeter_width must be at most 1.2 mm (3 × nozzle_diameter, at most 10 mm), \
+             got 1000000000000000000000000000000000000000",
+        ),
+        (
+            "[slice]\nskirt_distance = 1e12\n",
+            "slice.skirt_distance must be at most the bed size (250 mm), got 1000000000000",
+        ),
+        (
+            "[slice]\nsolid_infill_margin = 500\n",
+            "slice.solid_infill_margin must be between 0 and 100 mm, got 500",
+        ),
+        (
+            "[slice]\ninfill_speed = 1e9\n",
+            "slice.infill_speed must be at most 1000 mm/s, got 1000000000",
+        ),
+        (
+            "[printer]\nmax_height = 1e9\n",
+            "printer.max_height must be at most 10000 mm, got 1000000000",
+        ),
+        (
+            "[printer]\nfirst_layer_bed_temperature = nan\n",
+            "printer.first_layer_bed_temperature must be between 0 and 500 °C, got NaN",
+        ),
+    ] {
+        let problems = problems(src);
+        assert!(
+            problems.iter().any(|p| p == expected),
+            "{src}: {problems:?}"
+        );
+    }
+}
+
+#[test]
+fn values_at_the_bounds_are_valid() -> Result<(), ConfigError> {
+    let cfg = parse(
+        "[slice]\nperimeters = 100\nskirt_loops = 100\ntop_solid_layers = 100\n\
+         bottom_solid_layers = 100\nlayer_height = 0.4\nfirst_layer_height = 0.01\n\
+         perimeter_width = 1.2\nskirt_distance = 250\ninfill_speed = 1000\n",
+    )?;
+    assert_eq!(cfg.slice.perimeters, 100);
+    Ok(())
+}
+
+#[test]
+fn ini_counts_too_large_for_a_count_name_the_key() {
+    let err = prusa_ini::from_ini_str("perimeters = 1e39\n").err();
+    assert!(
+        matches!(&err, Some(ConfigError::Ini { key, message, .. })
+            if key == "perimeters" && message == "too large for a count"),
+        "{err:?}"
+    );
+    let err = prusa_ini::from_ini_str("skirts = 9223372036854775807\n").err();
+    let text = err.map(|e| e.to_string()).unwrap_or_default();
+    assert!(
+        text.contains("slice.skirt_loops must be at most 100, got 9223372036854775807"),
+        "{text}"
+    );
+}

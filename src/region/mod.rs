@@ -34,7 +34,11 @@ pub mod skirt;
 #[cfg(test)]
 mod test_util;
 
-pub use params::{InfillPatternKind, ParamError, RegionParams, Spacings, spacing};
+pub use params::{
+    InfillPatternKind, MAX_PERIMETERS, MAX_SKIRT_LOOPS, MAX_SOLID_INFILL_MARGIN, MAX_SOLID_LAYERS,
+    MAX_WIDTH, MAX_WIDTH_NOZZLES, MIN_LAYER_HEIGHT, NOZZLE_RANGE, ParamError, RegionParams,
+    Spacings, spacing,
+};
 pub use perimeters::{PerimeterLoop, Perimeters, make_perimeters};
 pub use skins::{SkinAreas, SolidRole, detect_skins};
 pub use skirt::make_skirt;

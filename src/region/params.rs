@@ -114,6 +114,31 @@ impl Default for RegionParams {
     }
 }
 
+/// Most perimeter loops per island: 100 loops of 0.45 mm make a 45 mm wall, past which any
+/// real part is solid; the bound keeps a mistyped count from sizing the loop plan.
+pub const MAX_PERIMETERS: usize = 100;
+/// Most top or bottom solid layers: 100 layers are 20 mm of solid shell at 0.2 mm (a thicker
+/// shell is a solid part, `infill_density = 1`); skin detection keeps a window of this many
+/// layers per layer.
+pub const MAX_SOLID_LAYERS: usize = 100;
+/// Most skirt loops: a skirt primes the nozzle and marks the print area; 100 loops of 0.45 mm
+/// are a 45 mm band, more than any print uses.
+pub const MAX_SKIRT_LOOPS: usize = 100;
+/// Thinnest layer, mm: below 10 µm no FFF machine positions z reliably, and the layer count
+/// (print height / layer height) would run into the millions.
+pub const MIN_LAYER_HEIGHT: f64 = 0.01;
+/// Smallest and largest nozzle diameter, mm: micro nozzles start at 0.05 mm, large-format
+/// pellet extruders end around 5 mm.
+pub const NOZZLE_RANGE: [f64; 2] = [0.05, 5.0];
+/// Widest extrusion, in nozzle diameters (PrusaSlicer's limit): a wider bead is no longer
+/// pressed flat under the nozzle's tip.
+pub const MAX_WIDTH_NOZZLES: f64 = 3.0;
+/// Widest extrusion, mm, whatever the nozzle.
+pub const MAX_WIDTH: f64 = 10.0;
+/// Largest `solid_infill_margin`, mm: the margin anchors a skin on the infill around it; a few
+/// mm do that, and past 100 mm the whole layer is solid anyway.
+pub const MAX_SOLID_INFILL_MARGIN: f64 = 100.0;
+
 /// One problem found by [`RegionParams::validate`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamError {
@@ -144,6 +169,46 @@ pub enum ParamError {
         nozzle: f64,
         /// The layer height.
         height: f64,
+    },
+    /// An extrusion is wider than a nozzle can lay down.
+    ///
+    /// How to fix: use widths up to 3 nozzle diameters (and at most 10 mm); the usual width is
+    /// about 1.1 nozzle diameters.
+    #[error("{field} must be at most {max} mm (3 × nozzle_diameter, at most 10 mm), got {width}")]
+    TooWide {
+        /// The field name.
+        field: &'static str,
+        /// The width given.
+        width: f64,
+        /// The widest allowed for this nozzle.
+        max: f64,
+    },
+    /// A count is larger than any print uses.
+    ///
+    /// How to fix: give a count up to the bound named in the message (and in the key's
+    /// documentation, `conduit config --defaults`).
+    #[error("{field} must be at most {max}, got {value}")]
+    TooMany {
+        /// The field name.
+        field: &'static str,
+        /// The count given.
+        value: usize,
+        /// The largest count allowed.
+        max: usize,
+    },
+    /// A length is outside the range a printer can use.
+    ///
+    /// How to fix: give a length within the bounds named in the message.
+    #[error("{field} must be between {min} and {max} mm, got {value}")]
+    OutOfRange {
+        /// The field name.
+        field: &'static str,
+        /// The value given.
+        value: f64,
+        /// The smallest value allowed.
+        min: f64,
+        /// The largest value allowed.
+        max: f64,
     },
     /// A fraction is outside its range.
     ///
@@ -195,6 +260,44 @@ impl RegionParams {
                 errors.push(ParamError::NotPositive { field, value });
             }
         }
+        let nozzle_ok = (NOZZLE_RANGE[0]..=NOZZLE_RANGE[1]).contains(&self.nozzle_diameter);
+        if self.nozzle_diameter > 0.0 && !nozzle_ok {
+            errors.push(ParamError::OutOfRange {
+                field: "nozzle_diameter",
+                value: self.nozzle_diameter,
+                min: NOZZLE_RANGE[0],
+                max: NOZZLE_RANGE[1],
+            });
+        }
+        // A layer higher than the nozzle is wide is not pressed onto the one below.
+        let max_height = if nozzle_ok {
+            self.nozzle_diameter
+        } else {
+            NOZZLE_RANGE[1]
+        };
+        if self.layer_height > 0.0 && !(MIN_LAYER_HEIGHT..=max_height).contains(&self.layer_height)
+        {
+            errors.push(ParamError::OutOfRange {
+                field: "layer_height",
+                value: self.layer_height,
+                min: MIN_LAYER_HEIGHT,
+                max: max_height,
+            });
+        }
+        for (field, value, max) in [
+            ("perimeters", self.perimeters, MAX_PERIMETERS),
+            ("top_solid_layers", self.top_solid_layers, MAX_SOLID_LAYERS),
+            (
+                "bottom_solid_layers",
+                self.bottom_solid_layers,
+                MAX_SOLID_LAYERS,
+            ),
+            ("skirt_loops", self.skirt_loops, MAX_SKIRT_LOOPS),
+        ] {
+            if value > max {
+                errors.push(ParamError::TooMany { field, value, max });
+            }
+        }
         for (field, width) in [
             ("external_perimeter_width", self.external_perimeter_width),
             ("perimeter_width", self.perimeter_width),
@@ -209,6 +312,12 @@ impl RegionParams {
                     width,
                     nozzle: self.nozzle_diameter,
                     height: self.layer_height,
+                });
+            } else if width > self.max_width() {
+                errors.push(ParamError::TooWide {
+                    field,
+                    width,
+                    max: self.max_width(),
                 });
             }
         }
@@ -229,6 +338,14 @@ impl RegionParams {
                 errors.push(ParamError::Negative { field, value });
             }
         }
+        if self.solid_infill_margin > MAX_SOLID_INFILL_MARGIN {
+            errors.push(ParamError::OutOfRange {
+                field: "solid_infill_margin",
+                value: self.solid_infill_margin,
+                min: 0.0,
+                max: MAX_SOLID_INFILL_MARGIN,
+            });
+        }
         if !self.infill_angle_deg.is_finite() {
             errors.push(ParamError::NotFinite {
                 field: "infill_angle_deg",
@@ -236,6 +353,13 @@ impl RegionParams {
             });
         }
         errors
+    }
+
+    /// The widest extrusion allowed (mm): [`MAX_WIDTH_NOZZLES`] nozzle diameters, at most
+    /// [`MAX_WIDTH`].
+    pub fn max_width(&self) -> f64 {
+        // Rounded to a micrometre so 3 × 0.4 reads 1.2 in a message.
+        ((MAX_WIDTH_NOZZLES * self.nozzle_diameter).min(MAX_WIDTH) * 1e6).round() / 1e6
     }
 
     /// Spacings for one layer of height `height` (mm).

@@ -54,6 +54,32 @@ fn take_unused(sorted: &[(u64, u32)], key: u64, used: &mut [bool]) -> Option<usi
     None
 }
 
+/// Marks every segment identical to an earlier one (same edges, same points) as used, so only
+/// the first copy is chained. Duplicate triangles (a file listing one face thousands of times)
+/// cut identical segments; each copy would otherwise be an open chain of its own, and the gap
+/// stage pairs every open endpoint with every other at the same point: quadratic in the copies.
+/// A closed, manifold mesh has no two such segments (two triangles share at most one edge), so
+/// its loops are unchanged. `starts` is the segments sorted by start edge.
+fn mark_duplicates(segments: &[Segment], starts: &[(u64, u32)], used: &mut [bool]) {
+    let key = |i: u32| {
+        let s = &segments[i as usize];
+        (s.a_edge, s.b_edge, s.a.x, s.a.y, s.b.x, s.b.y)
+    };
+    for run in starts.chunk_by(|x, y| x.0 == y.0) {
+        if run.len() < 2 {
+            continue;
+        }
+        // Within a run of one start edge, by the rest of the key, then by index.
+        let mut ids: Vec<u32> = run.iter().map(|&(_, i)| i).collect();
+        ids.sort_unstable_by_key(|&i| (key(i), i));
+        for pair in ids.windows(2) {
+            if key(pair[0]) == key(pair[1]) {
+                used[pair[1] as usize] = true;
+            }
+        }
+    }
+}
+
 /// Appends `p` unless it repeats the last point.
 fn push_point(points: &mut Vec<Point2>, p: Point2) {
     if points.last() != Some(&p) {
@@ -76,6 +102,7 @@ pub(super) fn chain_segments(segments: &[Segment], max_gap: Coord) -> Loops {
     let starts = sorted(|s| s.a_edge);
     let ends = sorted(|s| s.b_edge);
     let mut used = vec![false; n];
+    mark_duplicates(segments, &starts, &mut used);
     let mut out = Loops::default();
     let mut open: Vec<Vec<Point2>> = Vec::new();
     let mut forward: Vec<usize> = Vec::new();
