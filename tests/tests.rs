@@ -20,6 +20,7 @@ mod outputs;
 mod postprocess;
 mod postprocess_e2e;
 mod preview;
+mod regressions_route;
 mod robot;
 mod roundtrip;
 mod slice;
