@@ -882,7 +882,10 @@ mod tests {
         let pts = supersample(a, b, 500_000.0);
         assert_eq!(pts.len(), MAX_SAMPLES as usize + 1);
         assert_eq!((pts[0], pts[pts.len() - 1]), (a, b));
-        assert_eq!(supersample(a, Point2::from_mm(0.0, 2.0), 500_000.0).len(), 5);
+        assert_eq!(
+            supersample(a, Point2::from_mm(0.0, 2.0), 500_000.0).len(),
+            5
+        );
         let ring = [a, Point2::from_mm(1.0, 0.0), Point2::from_mm(1.0, -1e9), b];
         let n = sample_ring(&ring, &[], 500_000.0).len();
         assert!(n as f64 <= MAX_SAMPLES + 8.0, "{n}");
