@@ -22,6 +22,7 @@ mod postprocess;
 mod postprocess_e2e;
 mod preview;
 mod regressions_conform;
+mod regressions_route;
 mod regressions_slice;
 mod robot;
 mod roundtrip;

@@ -116,7 +116,50 @@ pub struct Pad {
     pub smd: bool,
 }
 
+/// A number for a message: plain below a million, in scientific notation above, so a value of
+/// 1e308 read from a file does not print 309 digits.
+pub(crate) fn short_number(v: f64) -> String {
+    if v.abs() < 1e6 {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// The largest distance of a pad centre from its package origin, and the largest pad side or
+/// diameter, mm (100 mm). The largest packages placed in a print (battery holders, connectors,
+/// displays) measure a few centimetres; a pad beyond this is a typo or a corrupted file, and
+/// pads within it keep every cavity, keep-out and routing grid sized from them bounded.
+pub const MAX_PAD_MM: f64 = 100.0;
+
+/// The largest magnitude of a pad rotation, degrees (ten turns).
+pub const MAX_PAD_ROTATION_DEG: f64 = 3_600.0;
+
 impl Pad {
+    /// The first number of the pad that is not finite, negative where it is a size, or beyond
+    /// [`MAX_PAD_MM`] / [`MAX_PAD_ROTATION_DEG`]: its key and value.
+    pub fn bad_number(&self) -> Option<(&'static str, f64)> {
+        let sizes: &[(&'static str, f64)] = match self.shape {
+            PadShape::Round { diameter } => &[("diameter", diameter)],
+            PadShape::Rect { width, height } | PadShape::Oblong { width, height } => {
+                &[("dx", width), ("dy", height)]
+            }
+        };
+        let ok = |v: f64, limit: f64| v.is_finite() && v.abs() <= limit;
+        [("x", self.x), ("y", self.y)]
+            .into_iter()
+            .find(|&(_, v)| !ok(v, MAX_PAD_MM))
+            .or_else(|| {
+                (!ok(self.rotation_deg, MAX_PAD_ROTATION_DEG)).then_some(("rot", self.rotation_deg))
+            })
+            .or_else(|| {
+                sizes
+                    .iter()
+                    .copied()
+                    .find(|&(_, v)| !ok(v, MAX_PAD_MM) || v < 0.0)
+            })
+    }
+
     fn from_eagle(p: &conduit_eagle::Pad) -> Self {
         Pad {
             name: p.name.clone(),
@@ -256,6 +299,25 @@ pub enum CircuitError {
         /// What the EAGLE reader found.
         error: Box<conduit_eagle::EagleError>,
     },
+    /// A pad whose position, size or rotation is not finite or beyond its bound
+    /// ([`MAX_PAD_MM`], [`MAX_PAD_ROTATION_DEG`]).
+    #[error(
+        "{path}: part {part} pad {pad}: {key} = {} is not a finite number within ±{limit}", short_number(*value)
+    )]
+    BadPad {
+        /// The file.
+        path: PathBuf,
+        /// The part.
+        part: String,
+        /// The pad.
+        pad: String,
+        /// The attribute (`x`, `y`, `dx`, `dy`, `diameter`, `rot`).
+        key: &'static str,
+        /// The value read.
+        value: f64,
+        /// The bound (mm, or degrees for `rot`).
+        limit: f64,
+    },
     /// The file is an EAGLE library, which holds no circuit.
     #[error("{path}: an EAGLE library (.lbr) holds no circuit; pass a schematic or a board")]
     Library {
@@ -319,17 +381,49 @@ impl Circuit {
             path: path.to_path_buf(),
             error,
         })?;
-        match conduit_eagle::read(&bytes) {
-            Ok(conduit_eagle::Document::Schematic(s)) => Ok(Self::from_schematic(&s)),
-            Ok(conduit_eagle::Document::Board(b)) => Ok(Self::from_board(&b)),
-            Ok(conduit_eagle::Document::Library) => Err(CircuitError::Library {
-                path: path.to_path_buf(),
-            }),
-            Err(error) => Err(CircuitError::Eagle {
-                path: path.to_path_buf(),
-                error: Box::new(error),
-            }),
+        let circuit = match conduit_eagle::read(&bytes) {
+            Ok(conduit_eagle::Document::Schematic(s)) => Self::from_schematic(&s),
+            Ok(conduit_eagle::Document::Board(b)) => Self::from_board(&b),
+            Ok(conduit_eagle::Document::Library) => {
+                return Err(CircuitError::Library {
+                    path: path.to_path_buf(),
+                });
+            }
+            Err(error) => {
+                return Err(CircuitError::Eagle {
+                    path: path.to_path_buf(),
+                    error: Box::new(error),
+                });
+            }
+        };
+        circuit.check_pads(path)?;
+        Ok(circuit)
+    }
+
+    /// Checks every pad of every part with [`Pad::bad_number`].
+    ///
+    /// # Errors
+    /// [`CircuitError::BadPad`] for the first bad pad, naming `path`, the part and the pad.
+    pub fn check_pads(&self, path: &Path) -> Result<(), CircuitError> {
+        for part in &self.parts {
+            for pad in &part.pads {
+                if let Some((key, value)) = pad.bad_number() {
+                    return Err(CircuitError::BadPad {
+                        path: path.to_path_buf(),
+                        part: part.name.clone(),
+                        pad: pad.name.clone(),
+                        key,
+                        value,
+                        limit: if key == "rot" {
+                            MAX_PAD_ROTATION_DEG
+                        } else {
+                            MAX_PAD_MM
+                        },
+                    });
+                }
+            }
         }
+        Ok(())
     }
 
     /// The part named `name`.
@@ -534,6 +628,41 @@ pub(crate) mod tests {
                 .is_some_and(|m| m.contains("junk.brd") && m.contains("not an EAGLE file")),
             "{e:?}"
         );
+    }
+
+    #[test]
+    fn wild_pads_are_refused_naming_the_file_part_and_pad() {
+        let dir = tempfile::tempdir().ok();
+        let Some(dir) = dir else { return };
+        let text = std::fs::read_to_string(sample_dir().join("led_coin.sch")).unwrap_or_default();
+        let smd = r#"<smd name="2" x="0.95" y="0" dx="1" dy="1.3" layer="1"/>"#;
+        assert!(text.contains(smd));
+        for (bad, want) in [
+            (
+                r#"<smd name="2" x="0.95" y="-1e9" dx="1" dy="1.3" layer="1"/>"#,
+                "y = -1e9",
+            ),
+            (
+                r#"<smd name="2" x="0.95" y="0" dx="1" dy="2147483648" layer="1"/>"#,
+                "dy = 2.147483648e9",
+            ),
+            (
+                r#"<smd name="2" x="0.95" y="0" dx="-1" dy="1.3" layer="1"/>"#,
+                "dx = -1",
+            ),
+        ] {
+            let path = dir.path().join("wild.sch");
+            std::fs::write(&path, text.replacen(smd, bad, 1)).ok();
+            let msg = Circuit::load(&path)
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            assert!(
+                msg.contains("wild.sch: part R1 pad 2: ") && msg.contains(want),
+                "{want:?} not in {msg:?}"
+            );
+        }
+        assert!(sample().check_pads(Path::new("x.sch")).is_ok());
     }
 
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) {

@@ -31,6 +31,22 @@ use serde::Deserialize;
 
 use super::{Circuit, PinRef};
 
+/// The largest distance of a part or waypoint from the origin of its frame, mm (10 m).
+///
+/// No printer bed, robot cell or printed object conduit works on comes near 10 m, so a position
+/// beyond it is a typo or a corrupted file. The bound also keeps every position, scaled to
+/// nanometres, far inside `i64` (1e13 nm against 9.2e18), so sums and `±1` on layer keys
+/// cannot overflow, and it bounds every grid or loop the router sizes from positions.
+pub const MAX_POSITION_MM: f64 = 10_000.0;
+
+/// The largest part height, footprint height or body side, mm (1 m): far above any part
+/// placed in a print, small enough that cavities and keep-outs sized by it stay bounded.
+pub const MAX_PART_SIZE_MM: f64 = 1_000.0;
+
+/// The largest rotation or tilt magnitude, degrees (ten turns): larger angles are not
+/// written by any tool and lose all precision in `sin`/`cos`.
+pub const MAX_ANGLE_DEG: f64 = 3_600.0;
+
 /// What part and waypoint coordinates are relative to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -194,7 +210,7 @@ pub struct Placement {
 }
 
 /// One thing wrong in a placement, found by [`Placement::validate`].
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Problem {
     /// A placed part the circuit does not have.
     UnknownPart {
@@ -251,6 +267,20 @@ pub enum Problem {
         /// The key.
         key: &'static str,
     },
+    /// A finite number beyond its bound ([`MAX_POSITION_MM`], [`MAX_PART_SIZE_MM`] or
+    /// [`MAX_ANGLE_DEG`]).
+    OutOfRange {
+        /// What it belongs to, e.g. `part "R1"`.
+        item: String,
+        /// The key.
+        key: &'static str,
+        /// The value read.
+        value: f64,
+        /// The largest magnitude allowed.
+        limit: f64,
+        /// The unit of both, `mm` or `°`.
+        unit: &'static str,
+    },
 }
 
 impl std::fmt::Display for Problem {
@@ -282,6 +312,17 @@ impl std::fmt::Display for Problem {
             Problem::BadNumber { item, key } => write!(
                 f,
                 "placement: {item}: {key} must be a finite number (and not negative for sizes)"
+            ),
+            Problem::OutOfRange {
+                item,
+                key,
+                value,
+                limit,
+                unit,
+            } => write!(
+                f,
+                "placement: {item}: {key} = {} {unit} is beyond the limit of ±{limit} {unit}",
+                super::short_number(*value)
             ),
         }
     }
@@ -363,7 +404,8 @@ impl Placement {
     /// Reads a placement by file extension: `.toml` or `.3de`.
     ///
     /// # Errors
-    /// [`PlacementError::WithPath`] around the parse error, or [`PlacementError::Io`] /
+    /// [`PlacementError::WithPath`] around the parse error or the numbers
+    /// [`Placement::check_numbers`] refuses, or [`PlacementError::Io`] /
     /// [`PlacementError::UnknownFormat`].
     pub fn load(path: &Path) -> Result<Self, PlacementError> {
         let ext = path
@@ -383,15 +425,20 @@ impl Placement {
             path: path.to_path_buf(),
             error,
         })?;
-        parse(&text).map_err(|e| PlacementError::WithPath {
-            path: path.to_path_buf(),
-            error: Box::new(e),
-        })
+        parse(&text)
+            .and_then(|p| p.check_numbers().map(|()| p))
+            .map_err(|e| PlacementError::WithPath {
+                path: path.to_path_buf(),
+                error: Box::new(e),
+            })
     }
 
     /// Parses the TOML form (see the module documentation). Unknown keys are errors.
+    ///
+    /// # Errors
+    /// [`PlacementError::Toml`] for invalid TOML or keys.
     pub fn from_toml(text: &str) -> Result<Self, PlacementError> {
-        toml::from_str(text).map_err(|e: toml::de::Error| {
+        let placement: Self = toml::from_str(text).map_err(|e: toml::de::Error| {
             let before = |at: usize| &text.as_bytes()[..at.min(text.len())];
             PlacementError::Toml {
                 line: e.span().map_or(0, |s| {
@@ -399,7 +446,8 @@ impl Placement {
                 }),
                 message: e.message().trim().to_owned(),
             }
-        })
+        })?;
+        Ok(placement)
     }
 
     /// The elements of an EAGLE board as parts lying on the plane `z`, shifted by `offset`
@@ -441,41 +489,78 @@ impl Placement {
         self.nets.iter().find(|n| n.name == name)
     }
 
-    /// Checks the placement against `circuit` and returns every problem: unknown or repeated
-    /// parts and nets, wire ends on pins that do not exist or belong to another net, unknown or
-    /// badly named waypoints, and numbers that are not finite (or negative sizes).
-    pub fn validate(&self, circuit: &Circuit) -> Result<(), PlacementError> {
+    /// Checks every number of the placement: finite, sizes not negative, positions within
+    /// [`MAX_POSITION_MM`], sizes within [`MAX_PART_SIZE_MM`], angles within
+    /// [`MAX_ANGLE_DEG`]. [`Placement::load`] runs it, so a placement file with a wild number is
+    /// refused where it is read, naming the file; [`Placement::validate`] reports the same.
+    ///
+    /// # Errors
+    /// [`PlacementError::Invalid`] listing each number, by part or waypoint and key.
+    pub fn check_numbers(&self) -> Result<(), PlacementError> {
+        let problems = self.number_problems();
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(PlacementError::Invalid(problems))
+        }
+    }
+
+    /// The problems [`Placement::check_numbers`] reports.
+    fn number_problems(&self) -> Vec<Problem> {
         let mut problems = Vec::new();
-        let mut bad = |item: String, key: &'static str, ok: bool| {
-            if !ok {
-                problems.push(Problem::BadNumber { item, key });
+        let mut check = |item: &dyn Fn() -> String,
+                         key: &'static str,
+                         value: f64,
+                         limit: f64,
+                         unit: &'static str,
+                         size: bool| {
+            if !value.is_finite() || (size && value < 0.0) {
+                problems.push(Problem::BadNumber { item: item(), key });
+            } else if value.abs() > limit {
+                problems.push(Problem::OutOfRange {
+                    item: item(),
+                    key,
+                    value,
+                    limit,
+                    unit,
+                });
             }
         };
         for p in &self.parts {
             let item = || format!("part \"{}\"", p.name);
-            for (key, v) in [("x", p.x), ("y", p.y), ("z", p.z), ("rotation", p.rotation)] {
-                bad(item(), key, v.is_finite());
+            for (key, v) in [("x", p.x), ("y", p.y), ("z", p.z)] {
+                check(&item, key, v, MAX_POSITION_MM, "mm", false);
             }
-            bad(item(), "tilt", p.tilt.iter().all(|v| v.is_finite()));
+            check(&item, "rotation", p.rotation, MAX_ANGLE_DEG, "°", false);
+            for v in p.tilt {
+                check(&item, "tilt", v, MAX_ANGLE_DEG, "°", false);
+            }
             for (key, v) in [
                 ("body_height", p.body_height),
                 ("footprint_height", p.footprint_height),
             ] {
-                bad(item(), key, v.is_finite() && v >= 0.0);
+                check(&item, key, v, MAX_PART_SIZE_MM, "mm", true);
             }
-            let size_ok = p
-                .body_size
-                .is_none_or(|s| s.iter().all(|v| v.is_finite() && *v >= 0.0));
-            bad(item(), "body_size", size_ok);
+            for v in p.body_size.into_iter().flatten() {
+                check(&item, "body_size", v, MAX_PART_SIZE_MM, "mm", true);
+            }
         }
         for n in &self.nets {
             for w in &n.waypoints {
                 let item = || format!("net {} waypoint \"{}\"", n.name, w.name);
                 for (key, v) in [("x", w.x), ("y", w.y), ("z", w.z)] {
-                    bad(item(), key, v.is_finite());
+                    check(&item, key, v, MAX_POSITION_MM, "mm", false);
                 }
             }
         }
+        problems
+    }
+
+    /// Checks the placement against `circuit` and returns every problem: unknown or repeated
+    /// parts and nets, wire ends on pins that do not exist or belong to another net, unknown or
+    /// badly named waypoints, and numbers that are not finite (or negative sizes).
+    pub fn validate(&self, circuit: &Circuit) -> Result<(), PlacementError> {
+        let mut problems = self.number_problems();
         for (i, p) in self.parts.iter().enumerate() {
             if circuit.part(&p.name).is_none() {
                 problems.push(Problem::UnknownPart {
@@ -693,6 +778,45 @@ pub(crate) mod tests {
             panic!()
         };
         assert_eq!(problems.len(), 6);
+    }
+
+    #[test]
+    fn wild_numbers_are_refused_where_the_file_is_read() {
+        let dir = tempfile::tempdir().ok();
+        let Some(dir) = dir else { return };
+        let path = dir.path().join("far.toml");
+        let text = r#"
+            [[part]]
+            name = "BAT1"
+            x = 0
+            y = -1e9
+            z = 1e39
+            rotation = 1e300
+            body_size = [1e9, 1.0]
+            [[part]]
+            name = "R1"
+            x = 10000.0
+            y = -10000.0
+            z = 4.0
+            [[net]]
+            name = "VCC"
+            waypoints = [{ name = "w1", x = 4.0, y = 9223372036854775807, z = 4.0 }]
+        "#;
+        std::fs::write(&path, text).ok();
+        let msg = err_text(Placement::load(&path));
+        for want in [
+            "far.toml: ",
+            "part \"BAT1\": y = -1e9 mm is beyond the limit of ±10000 mm",
+            "part \"BAT1\": z = 1e39 mm",
+            "part \"BAT1\": rotation = 1e300 °",
+            "part \"BAT1\": body_size = 1e9 mm is beyond the limit of ±1000 mm",
+            "net VCC waypoint \"w1\": y = 9.223372036854776e18 mm",
+        ] {
+            assert!(msg.contains(want), "{want:?} not in {msg:?}");
+        }
+        assert!(!msg.contains("R1"), "{msg}");
+        assert!(!msg.contains('\n'), "{msg}");
+        assert!(sample_placement().check_numbers().is_ok());
     }
 
     #[test]

@@ -115,7 +115,7 @@ pub struct PartReport {
 #[derive(Debug, thiserror::Error)]
 pub enum ElectronicsError {
     /// The placement does not fit the circuit or the scene.
-    #[error("{0}")]
+    #[error(transparent)]
     Placement(#[from] crate::circuit::PlacementError),
     /// `route.conductive_tool` names a tool the config does not define.
     ///

@@ -374,7 +374,10 @@ pub fn route_scene(
         for pad in &part.pads {
             // The layer whose top the pad sits on, within float noise.
             let key = scaled(pad.centre.z);
-            if let Some((_, layer)) = by_z.range_mut(key - 1..=key + 1).next() {
+            if let Some((_, layer)) = by_z
+                .range_mut(key.saturating_sub(1)..=key.saturating_add(1))
+                .next()
+            {
                 layer
                     .pads
                     .push((format!("{}.{}", part.name, pad.name), pad.outline.clone()));

@@ -517,9 +517,18 @@ struct Insert {
     point: Point2,
 }
 
+/// Most samples on one ring or one straight section: a longer one is sampled more sparsely,
+/// so a far pad or a huge island cannot make a loop or a list without bound.
+const MAX_SAMPLES: f64 = (1 << 18) as f64;
+
 /// Ring points: corners, inserted points and samples every `spacing` of arc length from the
-/// ring's start, in order along the ring, without repeats.
+/// ring's start (sparser on a ring longer than [`MAX_SAMPLES`] samples), in order along the
+/// ring, without repeats.
 fn sample_ring(ring: &[Point2], inserts: &[Insert], spacing: f64) -> Vec<Point2> {
+    let perimeter: f64 = (0..ring.len())
+        .map(|k| dist(ring[k], ring[(k + 1) % ring.len()]))
+        .sum();
+    let spacing = spacing.max(perimeter / MAX_SAMPLES);
     let mut out: Vec<Point2> = Vec::new();
     let mut arc = 0.0;
     for k in 0..ring.len() {
@@ -558,9 +567,10 @@ fn sample_ring(ring: &[Point2], inserts: &[Insert], spacing: f64) -> Vec<Point2>
     out
 }
 
-/// Points of the straight section `a`–`b` so no two consecutive are more than `spacing` apart.
+/// Points of the straight section `a`–`b` so no two consecutive are more than `spacing` apart
+/// (at most [`MAX_SAMPLES`] sections: a longer one gets longer sections).
 pub(crate) fn supersample(a: Point2, b: Point2, spacing: f64) -> Vec<Point2> {
-    let n = (dist(a, b) / spacing).ceil().max(1.0) as usize;
+    let n = (dist(a, b) / spacing).ceil().clamp(1.0, MAX_SAMPLES) as usize;
     (0..=n).map(|i| lerp(a, b, i as f64 / n as f64)).collect()
 }
 
@@ -864,5 +874,20 @@ mod tests {
         };
         assert_eq!(flat.piece(3), Some((flat.from, flat.to)));
         assert_eq!(flat.piece(4), None);
+    }
+
+    #[test]
+    fn sections_and_rings_a_billion_millimetres_long_are_sampled_boundedly() {
+        let (a, b) = (Point2::from_mm(0.0, 0.0), Point2::from_mm(0.0, -1e9));
+        let pts = supersample(a, b, 500_000.0);
+        assert_eq!(pts.len(), MAX_SAMPLES as usize + 1);
+        assert_eq!((pts[0], pts[pts.len() - 1]), (a, b));
+        assert_eq!(
+            supersample(a, Point2::from_mm(0.0, 2.0), 500_000.0).len(),
+            5
+        );
+        let ring = [a, Point2::from_mm(1.0, 0.0), Point2::from_mm(1.0, -1e9), b];
+        let n = sample_ring(&ring, &[], 500_000.0).len();
+        assert!(n as f64 <= MAX_SAMPLES + 8.0, "{n}");
     }
 }

@@ -21,6 +21,10 @@ const BAND: i64 = 1_000_000;
 /// more than [`MAX_CELLS`].
 const CELL: i64 = 500_000;
 
+/// Most bands in one index: a region taller than `MAX_BANDS` mm gets taller bands, so the
+/// band table stays bounded however far apart the rings lie.
+const MAX_BANDS: i64 = 1 << 16;
+
 /// Most cells in one cell map.
 const MAX_CELLS: i64 = 1 << 22;
 
@@ -60,7 +64,10 @@ impl CellMap {
             return Self::default();
         };
         let mut size = CELL;
-        while ((x1 - x0) / size + 1) * ((y1 - y0) / size + 1) > MAX_CELLS {
+        // In i128: for a region billions of millimetres wide the product overflows i64.
+        while (((x1 - x0) / size + 1) as i128) * (((y1 - y0) / size + 1) as i128)
+            > MAX_CELLS as i128
+        {
             size *= 2;
         }
         let (nx, ny) = ((x1 - x0) / size + 1, (y1 - y0) / size + 1);
@@ -162,6 +169,9 @@ pub(crate) struct RegionIndex {
     /// Band of the lowest point of each edge.
     first_band: Vec<u32>,
     y0: i64,
+    /// Height of one band, scaled units: [`BAND`], or more for a region of more than
+    /// [`MAX_BANDS`] bands.
+    band: i64,
     bands: Vec<Vec<u32>>,
     cells: CellMap,
 }
@@ -234,12 +244,17 @@ impl RegionIndex {
             return Self::default();
         };
         let y1 = edges.iter().map(|e| e.a.y.max(e.b.y)).max().unwrap_or(y0);
-        let count = ((y1 - y0) / BAND + 1) as usize;
+        let band = if (y1 - y0) / BAND < MAX_BANDS {
+            BAND
+        } else {
+            (y1 - y0) / MAX_BANDS + 1
+        };
+        let count = ((y1 - y0) / band + 1) as usize;
         let mut bands = vec![Vec::new(); count];
         let mut first_band = Vec::with_capacity(edges.len());
         for (i, e) in edges.iter().enumerate() {
-            let lo = ((e.a.y.min(e.b.y) - y0) / BAND) as usize;
-            let hi = ((e.a.y.max(e.b.y) - y0) / BAND) as usize;
+            let lo = ((e.a.y.min(e.b.y) - y0) / band) as usize;
+            let hi = ((e.a.y.max(e.b.y) - y0) / band) as usize;
             for band in &mut bands[lo..=hi.min(count - 1)] {
                 band.push(i as u32);
             }
@@ -250,6 +265,7 @@ impl RegionIndex {
             edges,
             first_band,
             y0,
+            band,
             bands,
             cells,
         }
@@ -269,7 +285,7 @@ impl RegionIndex {
     /// lies in).
     fn edges_between(&self, y_lo: i64, y_hi: i64) -> impl Iterator<Item = Edge> + '_ {
         let last = self.bands.len() as i64 - 1;
-        let band = |y: i64| (y - self.y0).div_euclid(BAND);
+        let band = |y: i64| (y - self.y0).div_euclid(self.band.max(1));
         let range = (!self.bands.is_empty() && band(y_hi) >= 0 && band(y_lo) <= last)
             .then(|| (band(y_lo).max(0) as usize, band(y_hi).min(last) as usize));
         range.into_iter().flat_map(move |(lo, hi)| {
@@ -287,7 +303,7 @@ impl RegionIndex {
         if self.bands.is_empty() || y < self.y0 {
             return &[];
         }
-        let k = ((y - self.y0) / BAND) as usize;
+        let k = ((y - self.y0) / self.band.max(1)) as usize;
         self.bands.get(k).map_or(&[], Vec::as_slice)
     }
 
@@ -491,5 +507,33 @@ mod tests {
         assert_eq!(idx.count_crossings(a, b), 4);
         assert!(idx.crosses(a, b));
         assert!(!idx.crosses(Point2::from_mm(1.0, 1.0), Point2::from_mm(10.0, 2.0)));
+    }
+
+    #[test]
+    fn rings_a_billion_millimetres_apart_get_a_bounded_index() {
+        // The pads of a part at y = -1e9 mm beside a 60 mm object: before, one 1 mm band per
+        // millimetre between them (24 GB).
+        let far = square(0.0, -1e9, 2.0);
+        let regions = [
+            annulus(),
+            ExPolygon {
+                contour: far,
+                holes: Vec::new(),
+            },
+        ];
+        let idx = RegionIndex::of_regions(&regions);
+        assert!(
+            idx.bands.len() as i64 <= MAX_BANDS + 1,
+            "{}",
+            idx.bands.len()
+        );
+        assert!(idx.cells.marked.len() as i64 <= MAX_CELLS);
+        assert!(idx.contains(Point2::from_mm(5.0, 30.0)));
+        assert!(!idx.contains(Point2::from_mm(30.0, 30.0)));
+        assert!(idx.contains(Point2::from_mm(1.0, -1e9 + 1.0)));
+        assert_eq!(
+            idx.count_crossings(Point2::from_mm(-5.0, 30.0), Point2::from_mm(65.0, 30.0)),
+            4
+        );
     }
 }
