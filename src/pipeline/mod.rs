@@ -114,6 +114,12 @@ pub enum PipelineError {
     /// A curved-layer (clfff) print cannot be planned.
     #[error(transparent)]
     Clfff(#[from] crate::curved::clfff::ClfffError),
+    /// Slicing left nothing to print: no layer has an extrusion (a mesh without volume, such
+    /// as loose or duplicated triangles, or objects thinner than a line).
+    ///
+    /// How to fix: give a closed solid; `conduit info` shows whether the mesh is closed.
+    #[error("nothing to print: no layer has an extrusion (the model has no printable volume)")]
+    NothingToPrint,
 }
 
 /// What slicing one object found.
@@ -457,6 +463,9 @@ pub fn slice_scene_with(
     progress(Stage::Program);
     let program = build_program_with(&objects, &extras, &cfg.program_params());
     drop(objects);
+    if program.layers.iter().all(|l| l.paths().next().is_none()) {
+        return Err(PipelineError::NothingToPrint);
+    }
     laps.lap(Stage::Program);
 
     progress(Stage::Emit);
