@@ -6,21 +6,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::support::{root, sample, temp_dir};
+use crate::support::{regressions, root, sample, temp_dir};
 
 /// A hang guard, not a benchmark: every run takes well under a second once refused.
 const DEADLINE: Duration = Duration::from_secs(20);
-
-/// The regressions folder, or `None` (after printing a skip line) when it is absent.
-fn regressions() -> Option<PathBuf> {
-    let dir = root().join("../shared/regressions");
-    if dir.join("README.md").is_file() {
-        Some(dir)
-    } else {
-        println!("skipped: regressions not found at {}", dir.display());
-        None
-    }
-}
 
 /// The arguments that ran `file` (by its name's prefix, as in the README), writing into `out`;
 /// `None` for a file of another command.

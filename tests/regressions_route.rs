@@ -6,19 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::support::{root, sample, temp_dir};
-
-/// The regression folder, or `None` (after printing a skip line) when it is not beside the
-/// checkout.
-fn regressions() -> Option<PathBuf> {
-    let dir = root().join("../shared/regressions");
-    if dir.join("README.md").is_file() {
-        Some(dir)
-    } else {
-        println!("skipped: regressions not found at {}", dir.display());
-        None
-    }
-}
+use crate::support::{regressions, sample, temp_dir};
 
 /// The files of this share: route placements and schematics, in every folder.
 fn route_files(dir: &Path) -> Vec<PathBuf> {

@@ -7,22 +7,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use super::support::{root, temp_dir};
+use super::support::{regressions, root, temp_dir};
 
 /// A hang guard, not a benchmark: every file finishes in well under a second.
 const DEADLINE: Duration = Duration::from_secs(20);
-
-/// The regression corpus, or `None` (after printing a skip line) when it is not beside the
-/// checkout.
-fn regressions() -> Option<PathBuf> {
-    let dir = root().join("../shared/regressions");
-    if dir.join("README.md").is_file() {
-        Some(dir)
-    } else {
-        println!("skipped: regressions not found at {}", dir.display());
-        None
-    }
-}
 
 /// Runs conduit with `args` from the project root under [`DEADLINE`]; returns the exit code
 /// (`None` when killed by a signal) and stderr. Panics if the deadline passes.

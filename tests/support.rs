@@ -20,6 +20,18 @@ pub fn corpus() -> Option<PathBuf> {
     }
 }
 
+/// The fuzzing regression folder beside the checkout (`../shared/regressions`), or `None`
+/// (after printing a skip line) when it is absent.
+pub fn regressions() -> Option<PathBuf> {
+    let dir = root().join("../shared/regressions");
+    if dir.join("README.md").is_file() {
+        Some(dir)
+    } else {
+        println!("skipped: regressions not found at {}", dir.display());
+        None
+    }
+}
+
 /// A file of the project's own samples.
 pub fn sample(name: &str) -> PathBuf {
     root().join("samples").join(name)
