@@ -2,7 +2,6 @@
 //! shared loading of `-c CONFIG --set KEY=VALUE` for the other commands.
 
 use super::{Failure, args::ConfigArgs, args::ConfigSource};
-use anyhow::Context;
 use conduit::config::{self, Config};
 
 /// Loads the config a command asked for (defaults when none), applies `--set` overrides and
@@ -24,7 +23,7 @@ pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
         cfg.apply_set(kv)
             .map_err(|e| Failure::Usage(e.to_string()))?;
     }
-    warnings.extend(cfg.validate().context("invalid configuration")?);
+    warnings.extend(cfg.validate().map_err(anyhow::Error::from)?);
     for w in warnings {
         eprintln!("warning: {w}");
     }

@@ -121,7 +121,7 @@ fn settings_config(src: &ConfigSource, settings: &HostSettings) -> Result<Config
         cfg.apply_set(kv)
             .map_err(|e| Failure::Usage(e.to_string()))?;
     }
-    let warnings = cfg.validate().context("invalid configuration")?;
+    let warnings = cfg.validate().map_err(anyhow::Error::from)?;
     if !src.set.is_empty() {
         for w in warnings {
             eprintln!("warning: {w}");
