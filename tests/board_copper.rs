@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use conduit::circuit::{Circuit, Placement, place};
-use conduit::geom::Point2;
+use conduit::geom::{Point2, Polygon, segment_distance};
 use conduit_eagle::{Board, SignalWire};
 
 use crate::support::corpus;
@@ -41,37 +41,13 @@ fn boards(corpus: &Path) -> Vec<PathBuf> {
     found
 }
 
-/// Whether `p` lies inside the polygon `ring` (even-odd rule) or within `reach` of its edges.
-fn touches(ring: &[Point2], p: [f64; 2], reach: f64) -> bool {
-    let pts: Vec<[f64; 2]> = ring
-        .iter()
-        .map(|q| {
-            let (x, y) = q.to_mm();
-            [x, y]
-        })
-        .collect();
-    let n = pts.len();
-    let mut inside = false;
-    let mut near = false;
-    for i in 0..n {
-        let (a, b) = (pts[i], pts[(i + 1) % n]);
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-            if x > p[0] {
-                inside = !inside;
-            }
-        }
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let len2 = dx * dx + dy * dy;
-        let t = if len2 > 0.0 {
-            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let (cx, cy) = (a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
-        near |= cx.hypot(cy) <= reach;
-    }
-    inside || near
+/// Whether `p` (mm) lies inside the pad `outline` or within `reach` (mm) of its edges.
+fn touches(outline: &Polygon, p: [f64; 2], reach: f64) -> bool {
+    let p = Point2::from_mm(p[0], p[1]);
+    let pts = &outline.points;
+    let reach_nm = reach * 1e6;
+    outline.contains(p)
+        || (0..pts.len()).any(|i| segment_distance(p, pts[i], pts[(i + 1) % pts.len()]) <= reach_nm)
 }
 
 /// Per board: (pads on copper, checkable pads) for top-side and for mirrored elements.
@@ -137,7 +113,7 @@ fn tally(board: &Board) -> Tally {
             }
             let on = ends
                 .iter()
-                .any(|(w, e)| touches(&pad.outline.points, *e, w.width / 2.0 + TOLERANCE_MM));
+                .any(|(w, e)| touches(&pad.outline, *e, w.width / 2.0 + TOLERANCE_MM));
             if !on && std::env::var_os("BOARD_COPPER_DEBUG").is_some() {
                 let c = pad.centre;
                 let d = ends

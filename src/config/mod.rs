@@ -569,26 +569,15 @@ impl Config {
         let s = &self.slice;
         let p = &self.printer;
         problems.extend(self.range_problems());
-        for (key, v) in [
-            ("slice.first_layer_height", s.first_layer_height),
-            ("slice.perimeter_speed", s.perimeter_speed),
-            ("slice.external_perimeter_speed", s.external_perimeter_speed),
-            ("slice.infill_speed", s.infill_speed),
-            ("slice.solid_infill_speed", s.solid_infill_speed),
-            ("slice.top_solid_infill_speed", s.top_solid_infill_speed),
-            ("slice.bridge_speed", s.bridge_speed),
-            ("slice.gap_fill_speed", s.gap_fill_speed),
-            ("slice.first_layer_speed", s.first_layer_speed),
-            ("slice.skirt_speed", s.skirt_speed),
-            ("slice.conductive_speed", s.conductive_speed),
-            ("printer.travel_speed", p.travel_speed),
-            ("printer.retract_speed", p.retract_speed),
+        let first = [("slice.first_layer_height", s.first_layer_height)];
+        let rest = [
             ("printer.max_acceleration", p.max_acceleration),
             ("printer.max_print_speed", p.max_print_speed),
             ("printer.max_height", p.max_height),
             ("printer.bed_size[0]", p.bed_size[0]),
             ("printer.bed_size[1]", p.bed_size[1]),
-        ] {
+        ];
+        for (key, v) in first.into_iter().chain(self.speed_keys()).chain(rest) {
             if !(v.is_finite() && v > 0.0) {
                 problems.push(format!("{key} must be > 0, got {v}"));
             }
@@ -620,6 +609,27 @@ impl Config {
         }
     }
 
+    /// The speeds every print move or travel uses, with their keys: each must be positive
+    /// and at most [`MAX_SPEED`].
+    fn speed_keys(&self) -> [(&'static str, f64); 12] {
+        let s = &self.slice;
+        let p = &self.printer;
+        [
+            ("slice.perimeter_speed", s.perimeter_speed),
+            ("slice.external_perimeter_speed", s.external_perimeter_speed),
+            ("slice.infill_speed", s.infill_speed),
+            ("slice.solid_infill_speed", s.solid_infill_speed),
+            ("slice.top_solid_infill_speed", s.top_solid_infill_speed),
+            ("slice.bridge_speed", s.bridge_speed),
+            ("slice.gap_fill_speed", s.gap_fill_speed),
+            ("slice.first_layer_speed", s.first_layer_speed),
+            ("slice.skirt_speed", s.skirt_speed),
+            ("slice.conductive_speed", s.conductive_speed),
+            ("printer.travel_speed", p.travel_speed),
+            ("printer.retract_speed", p.retract_speed),
+        ]
+    }
+
     /// The upper (and lower) bounds of the keys that size work, beyond the positivity checks
     /// of [`Config::validate`]: a number a real printer never uses (10¹⁸ perimeters, 10⁻⁹ mm
     /// layers, 10⁸ skirt loops) would otherwise turn into billions of loops or layers.
@@ -643,22 +653,11 @@ impl Config {
                  2 × slice.nozzle_diameter ({max_first} mm), got {h}"
             ));
         }
-        for (key, v) in [
-            ("slice.perimeter_speed", s.perimeter_speed),
-            ("slice.external_perimeter_speed", s.external_perimeter_speed),
-            ("slice.infill_speed", s.infill_speed),
-            ("slice.solid_infill_speed", s.solid_infill_speed),
-            ("slice.top_solid_infill_speed", s.top_solid_infill_speed),
-            ("slice.bridge_speed", s.bridge_speed),
-            ("slice.gap_fill_speed", s.gap_fill_speed),
-            ("slice.first_layer_speed", s.first_layer_speed),
-            ("slice.skirt_speed", s.skirt_speed),
-            ("slice.conductive_speed", s.conductive_speed),
-            ("printer.travel_speed", p.travel_speed),
-            ("printer.retract_speed", p.retract_speed),
+        let more = [
             ("printer.deretract_speed", p.deretract_speed),
             ("printer.max_print_speed", p.max_print_speed),
-        ] {
+        ];
+        for (key, v) in self.speed_keys().into_iter().chain(more) {
             if v > MAX_SPEED {
                 problems.push(format!("{key} must be at most {MAX_SPEED} mm/s, got {v}"));
             }
