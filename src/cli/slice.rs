@@ -82,6 +82,12 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         total,
         summary.gcode.estimated_time_s / 60.0
     );
+    for w in summary.warnings() {
+        match args.models.as_slice() {
+            [one] => eprintln!("warning: {}: {w}", one.display()),
+            _ => eprintln!("warning: {w}"),
+        }
+    }
     if let Some(r) = &summary.electronics {
         print_routing(r, "");
     }
