@@ -172,22 +172,54 @@ fn demo_circuit_slices_with_cavities_traces_events_and_placement_files() {
         );
     }
 
-    // The pick-and-place files list the three parts where the report puts them.
+    // The pick-and-place files list the parts where the report puts them. BAT1 is inserted by
+    // hand: the OpenPnP board has it disabled, the KiCad files (which cannot mark a row
+    // disabled) leave it out. The `.pos` rows are read with OpenPnP's importer pattern.
+    let report_part = |name: &str| {
+        parts
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap_or_else(|| panic!("{name} in the report"))
+    };
+    let at = |part: &Value, k: usize| part["position"][k].as_f64().expect("coordinate");
     let pos = std::fs::read_to_string(dir.path().join("demo.pos")).expect(".pos written");
-    let records = conduit_pnp::read_kicad_pos(&pos).expect(".pos parses");
-    assert_eq!(records.len(), 3);
-    for (rec, part) in records.iter().zip(parts) {
-        assert_eq!(rec.reference, part["name"].as_str().expect("name"));
-        for (k, v) in [rec.x, rec.y, rec.z].into_iter().enumerate() {
-            let want = part["position"][k].as_f64().expect("coordinate");
-            assert!((v - want).abs() < 1e-4, "{}: {v} vs {want}", rec.reference);
+    assert!(pos.starts_with("### Footprint positions") && pos.ends_with("## End\n"));
+    let ascii = conduit_pnp::read_kicad_ascii(&pos).expect("every .pos row matches the importer");
+    let csv = std::fs::read_to_string(dir.path().join("demo-pos.csv")).expect("CSV written");
+    let csv = conduit_pnp::read_kicad_csv(&csv).expect("CSV parses");
+    for records in [&ascii, &csv] {
+        let names: Vec<&str> = records.iter().map(|r| r.reference.as_str()).collect();
+        assert_eq!(
+            names,
+            ["LED1", "R1"],
+            "machine-placed parts in KiCad's order"
+        );
+        for rec in records.iter() {
+            let part = report_part(&rec.reference);
+            for (k, v) in [rec.x, rec.y].into_iter().enumerate() {
+                assert!((v - at(part, k)).abs() < 1e-4, "{}: {v}", rec.reference);
+            }
         }
     }
-    let xml =
-        std::fs::read_to_string(dir.path().join("demo.openpnp.xml")).expect("OpenPnP written");
+    let xml = std::fs::read_to_string(dir.path().join("demo.board.xml")).expect("board written");
     let board = conduit_pnp::read_openpnp_board(&xml).expect("OpenPnP parses");
     assert_eq!(board.len(), 3);
-    assert_eq!(board[2].rotation_deg, 90.0);
+    for rec in &board {
+        let part = report_part(&rec.reference);
+        for (k, v) in [rec.x, rec.y, rec.z].into_iter().enumerate() {
+            assert!((v - at(part, k)).abs() < 1e-4, "{}: {v}", rec.reference);
+        }
+        assert_eq!(rec.enabled, part["method"] == "auto", "{}", rec.reference);
+    }
+    assert_eq!(
+        board
+            .iter()
+            .filter(|r| !r.enabled)
+            .map(|r| r.reference.as_str())
+            .collect::<Vec<_>>(),
+        ["BAT1"]
+    );
+    assert!(xml.contains("<!-- R1: height 0.6000 mm -->"), "{xml}");
 }
 
 #[test]

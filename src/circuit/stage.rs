@@ -663,7 +663,8 @@ fn part_event(id: usize, part: &PlacedPart) -> Event {
     }
 }
 
-/// Pick-and-place records of the placed parts (bed coordinates), for `.pos` and OpenPnP files.
+/// Pick-and-place records of the placed parts (bed coordinates), for the KiCad position files
+/// and the OpenPnP board: enabled for the parts the machine places (`method = "auto"`).
 pub fn pnp_records(circuit: &Circuit, parts: &[PlacedPart]) -> Vec<conduit_pnp::PlacementRecord> {
     parts
         .iter()
@@ -682,6 +683,10 @@ pub fn pnp_records(circuit: &Circuit, parts: &[PlacedPart]) -> Vec<conduit_pnp::
                 } else {
                     conduit_pnp::Side::Top
                 },
+                // Only parts the vacuum nozzle places are enabled: a machine must not try to
+                // pick a part inserted by hand or one that only gets pads.
+                enabled: p.method == PlacingMethod::Auto,
+                height: p.body_height,
             }
         })
         .collect()

@@ -111,7 +111,8 @@ pub struct SliceArgs {
     #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
     /// Circuit to build into the object: an EAGLE schematic or board (.sch, .brd). Needs
-    /// `--placement`. Also writes OUT.pos (KiCad position CSV with PosZ) and OUT.openpnp.xml.
+    /// `--placement`. Also writes the pick-and-place files OUT.pos (KiCad's ASCII table, as
+    /// OpenPnP imports it), OUT-pos.csv (KiCad's CSV) and OUT.board.xml (an OpenPnP board).
     #[arg(long, value_name = "X.sch|X.brd", requires = "placement")]
     pub circuit: Option<PathBuf>,
     /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.

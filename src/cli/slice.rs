@@ -54,20 +54,9 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     outputs.add(&args.output, &gcode)?;
     if let Some(e) = &electronics {
         let records = pnp_records(&e.circuit, &summary.parts);
-        let pos = args.output.with_extension("pos");
-        let mut bytes = Vec::new();
-        conduit_pnp::write_kicad_pos(&records, &mut bytes)
-            .with_context(|| format!("{}: cannot write positions", pos.display()))?;
-        outputs.add(&pos, &bytes)?;
-        let xml = args.output.with_extension("openpnp.xml");
-        let name = args
-            .output
-            .file_stem()
-            .map_or_else(|| "board".to_owned(), |s| s.to_string_lossy().into_owned());
-        let mut bytes = Vec::new();
-        conduit_pnp::write_openpnp_board(&name, &records, &mut bytes)
-            .with_context(|| format!("{}: cannot write OpenPnP board", xml.display()))?;
-        outputs.add(&xml, &bytes)?;
+        for (path, bytes) in pick_and_place_files(&args.output, &records)? {
+            outputs.add(&path, &bytes)?;
+        }
     }
     if let Some(report) = &args.report {
         let json = serde_json::to_vec_pretty(&summary).context("serialising the report")?;
@@ -185,6 +174,36 @@ fn run_clfff(
         eprintln!("warning: {w}");
     }
     Ok(())
+}
+
+/// The pick-and-place files beside `output` (`OUT.gcode`): `OUT.pos` (KiCad's ASCII table,
+/// what OpenPnP's KiCad importer reads), `OUT-pos.csv` (KiCad's CSV) and `OUT.board.xml`
+/// (an OpenPnP board), with their bytes.
+pub(crate) fn pick_and_place_files(
+    output: &std::path::Path,
+    records: &[conduit_pnp::PlacementRecord],
+) -> anyhow::Result<Vec<(std::path::PathBuf, Vec<u8>)>> {
+    let stem = output
+        .file_stem()
+        .map_or_else(|| "board".to_owned(), |s| s.to_string_lossy().into_owned());
+    let beside = |name: String| output.with_file_name(name);
+    let mut files = Vec::new();
+    let pos = output.with_extension("pos");
+    let mut bytes = Vec::new();
+    conduit_pnp::write_kicad_ascii(records, &mut bytes)
+        .with_context(|| format!("{}: cannot write positions", pos.display()))?;
+    files.push((pos, bytes));
+    let csv = beside(format!("{stem}-pos.csv"));
+    let mut bytes = Vec::new();
+    conduit_pnp::write_kicad_csv(records, &mut bytes)
+        .with_context(|| format!("{}: cannot write positions", csv.display()))?;
+    files.push((csv, bytes));
+    let xml = beside(format!("{stem}.board.xml"));
+    let mut bytes = Vec::new();
+    conduit_pnp::write_openpnp_board(&stem, records, &mut bytes)
+        .with_context(|| format!("{}: cannot write OpenPnP board", xml.display()))?;
+    files.push((xml, bytes));
+    Ok(files)
 }
 
 /// The routing summary line (after `lead`), the report's warnings and one line per wire that
