@@ -4,6 +4,7 @@ use conduit_gcode::{Firmware, Machine};
 
 use crate::support::{conduit, sample, stderr, temp_dir, xyz};
 use serde_json::Value;
+use std::path::{Path, PathBuf};
 
 /// One extruding move of the replayed G-code.
 struct Extrusion {
@@ -362,7 +363,18 @@ fn wires_between_two_objects_are_reported_with_a_warning_and_not_routed() {
         "--report".as_ref(),
         report.as_os_str(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    // Two wires are not routed: the job fails, and still leaves the drawings and the report
+    // that show where.
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    for net in ["GND", "N1"] {
+        assert!(
+            stderr(&o)
+                .lines()
+                .any(|l| l.starts_with(&format!("error: net {net} could not be routed"))),
+            "{}",
+            stderr(&o)
+        );
+    }
     let v: Value =
         serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
     let wires = v["wires"].as_array().expect("wires");
@@ -394,4 +406,126 @@ fn wires_between_two_objects_are_reported_with_a_warning_and_not_routed() {
         "{}",
         stderr(&o)
     );
+}
+
+/// The demo placement with `edit` applied to its text, written to `dir/name`.
+fn demo_placement_with(
+    dir: &std::path::Path,
+    name: &str,
+    edit: impl Fn(&str) -> String,
+) -> PathBuf {
+    let text = std::fs::read_to_string(sample("circuit_demo/placement.toml")).expect("sample");
+    let path = dir.join(name);
+    std::fs::write(&path, edit(&text)).expect("placement written");
+    path
+}
+
+/// Slices the demo block with `placement` and `extra` arguments: exit code, stderr, whether
+/// the G-code exists.
+fn slice_demo_with(
+    dir: &std::path::Path,
+    placement: &Path,
+    extra: &[&str],
+) -> (Option<i32>, String, bool) {
+    let out = dir.join("job.gcode");
+    let _ = std::fs::remove_file(&out);
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "slice".into(),
+        sample("circuit_demo/block.stl").into(),
+        "--circuit".into(),
+        sample("circuit_demo/led_coin.sch").into(),
+        "--placement".into(),
+        placement.into(),
+        "-o".into(),
+        out.clone().into(),
+    ];
+    args.extend(extra.iter().map(Into::into));
+    let o = conduit(&args);
+    (o.status.code(), stderr(&o), out.exists())
+}
+
+/// The part section of `name` in the demo placement, for edits.
+fn edit_part(text: &str, name: &str, from: &str, to: &str) -> String {
+    let at = text
+        .find(&format!("name = \"{name}\""))
+        .expect("part in the sample");
+    let (head, tail) = text.split_at(at);
+    format!("{head}{}", tail.replacen(from, to, 1))
+}
+
+#[test]
+fn a_circuit_not_built_as_asked_fails_with_each_problem_named_and_writes_nothing() {
+    let dir = temp_dir();
+    let d = dir.path();
+    // (placement edit, expected error lines).
+    let outside = demo_placement_with(d, "outside.toml", |t| {
+        edit_part(t, "R1", "x = 32.0", "x = 132.0")
+    });
+    let above = demo_placement_with(d, "above.toml", |t| {
+        edit_part(t, "LED1", "z = 4.0", "z = 40.0")
+    });
+    let collide = demo_placement_with(d, "collide.toml", |t| {
+        edit_part(t, "LED1", "y = 22.0", "y = 8.0")
+    });
+    let empty = d.join("empty.toml");
+    std::fs::write(&empty, "origin = \"model\"\n").expect("written");
+    let cases: [(&Path, &[&str]); 4] = [
+        (
+            &outside,
+            &[
+                "error: part R1 is not inside the object: 3.8 of its 3.8 mm² footprint lies \
+                 outside the solid at z 4.000 mm",
+                "error: net N1 could not be routed (LED1.A to R1.2)",
+            ],
+        ),
+        (
+            &above,
+            &[
+                "error: part LED1 is above the object: its seating plane z 40.000 mm is 32.000 mm \
+               over the object's top (8.000 mm)",
+            ],
+        ),
+        (
+            &collide,
+            &["error: parts R1 and LED1 collide: their footprints share"],
+        ),
+        (
+            &empty,
+            &["error: the placement places no part of the circuit"],
+        ),
+    ];
+    for (placement, expected) in cases {
+        let (code, err, written) = slice_demo_with(d, placement, &[]);
+        assert_eq!(code, Some(1), "{}: {err}", placement.display());
+        assert!(
+            !written,
+            "{}: no G-code for a failed job",
+            placement.display()
+        );
+        for line in expected {
+            assert!(
+                err.lines().any(|l| l.starts_with(line)),
+                "{}: missing {line:?} in\n{err}",
+                placement.display()
+            );
+        }
+        let last = err.lines().last().unwrap_or_default();
+        assert!(
+            last.contains("job.gcode: the circuit was not built as asked")
+                && last.contains("nothing was written (--allow-unrouted accepts it)"),
+            "{last}"
+        );
+        // With --allow-unrouted the same problems are warnings and the files are written.
+        let (code, err, written) = slice_demo_with(d, placement, &["--allow-unrouted"]);
+        assert_eq!(code, Some(0), "{err}");
+        assert!(written);
+        for line in expected {
+            let warning = line.replacen("error: ", "warning: ", 1);
+            assert!(err.lines().any(|l| l.starts_with(&warning)), "{err}");
+        }
+    }
+    // The demo itself is built as asked: no problem at all.
+    let (code, err, _) = slice_demo_with(d, &sample("circuit_demo/placement.toml"), &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("error") && !err.contains("warning"), "{err}");
 }

@@ -129,6 +129,11 @@ pub struct SliceArgs {
     /// one file with a tool per section. Sets `curved.split_sections`.
     #[arg(long)]
     pub split_sections: bool,
+    /// Write the outputs even when the circuit is not built as asked (a wire not routed, a
+    /// part outside the solid or colliding with another, a placement that places nothing):
+    /// the problems become warnings and the exit code 0.
+    #[arg(long)]
+    pub allow_unrouted: bool,
 }
 
 /// Arguments of `conduit route`.
@@ -153,6 +158,11 @@ pub struct RouteArgs {
     /// perimeter crossings; totals).
     #[arg(long, value_name = "REPORT.json")]
     pub report: Option<PathBuf>,
+    /// Exit 0 even when the circuit is not built as asked (a wire not routed, a
+    /// part outside the solid or colliding with another, a placement that places nothing):
+    /// the problems become warnings. The drawings and report are written either way.
+    #[arg(long)]
+    pub allow_unrouted: bool,
 }
 
 /// Arguments of `conduit postprocess`.
@@ -185,6 +195,11 @@ pub struct PostprocessArgs {
     /// stays in the output folder).
     #[arg(long, value_name = "NAME")]
     pub output_name: Option<String>,
+    /// Rewrite the host's file even when the circuit is not built as asked (a wire not routed, a
+    /// part outside the solid or colliding with another, a placement that places nothing):
+    /// the problems become warnings and the exit code 0.
+    #[arg(long)]
+    pub allow_unrouted: bool,
 }
 
 /// Arguments of `conduit conform`.

@@ -48,5 +48,10 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
         view.layers.len()
     );
     super::slice::print_routing(&view.report, &lead);
-    Ok(())
+    super::slice::refuse_unbuilt_circuit(
+        &view.report,
+        args.allow_unrouted,
+        &args.out_dir,
+        "the drawings show where",
+    )
 }

@@ -62,6 +62,9 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         let json = serde_json::to_vec_pretty(&summary).context("serialising the report")?;
         outputs.add(report, &json)?;
     }
+    if let Some(r) = &summary.electronics {
+        refuse_unbuilt_circuit(r, args.allow_unrouted, &args.output, "nothing was written")?;
+    }
     outputs.commit()?;
     let total: f64 = summary.gcode.tools.iter().map(|t| t.filament_mm).sum();
     eprintln!(
@@ -206,8 +209,8 @@ pub(crate) fn pick_and_place_files(
     Ok(files)
 }
 
-/// The routing summary line (after `lead`), the report's warnings and one line per wire that
-/// could not be routed, on stderr.
+/// The routing summary line (after `lead`) and the report's warnings, on stderr. What was not
+/// built as asked is [`refuse_unbuilt_circuit`]'s to say.
 pub(crate) fn print_routing(r: &conduit::circuit::ElectronicsReport, lead: &str) {
     eprintln!(
         "{lead}{} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
@@ -220,12 +223,36 @@ pub(crate) fn print_routing(r: &conduit::circuit::ElectronicsReport, lead: &str)
     for w in &r.warnings {
         eprintln!("warning: {w}");
     }
-    for w in r.wires.iter().filter(|w| !w.routed) {
-        eprintln!(
-            "warning: net {} could not be routed ({} to {})",
-            w.net, w.from, w.to
-        );
+}
+
+/// A circuit job that did not build the circuit as asked (a wire not routed, a part outside
+/// the solid or colliding, a placement that places nothing) fails: each problem is printed as
+/// an `error:` line and the run exits 1 with `consequence` said about `output`. With
+/// `allow` (`--allow-unrouted`) the problems are warnings and the run goes on.
+pub(crate) fn refuse_unbuilt_circuit(
+    r: &conduit::circuit::ElectronicsReport,
+    allow: bool,
+    output: &std::path::Path,
+    consequence: &str,
+) -> Result<(), Failure> {
+    let failures = r.failures();
+    if failures.is_empty() {
+        return Ok(());
     }
+    let level = if allow { "warning" } else { "error" };
+    for f in &failures {
+        eprintln!("{level}: {f}");
+    }
+    if allow {
+        return Ok(());
+    }
+    eprintln!(
+        "error: {}: the circuit was not built as asked ({} problem(s) above); {consequence} \
+         (--allow-unrouted accepts it)",
+        output.display(),
+        failures.len()
+    );
+    Err(Failure::Reported)
 }
 
 /// The output set of a slice: none of its outputs may be one of the run's input files.
