@@ -220,7 +220,10 @@ fn sh_blocks_are_found_and_cargo_lines_mapped() {
     assert!(!blocks[1].no_run && blocks[2].no_run);
     assert!(blocks[1].needs().is_empty());
     assert_eq!(blocks[3].needs(), ["prusa-slicer"]);
-    assert_eq!(script(&blocks[3]), "# needs: prusa-slicer\nprusa-slicer --help");
+    assert_eq!(
+        script(&blocks[3]),
+        "# needs: prusa-slicer\nprusa-slicer --help"
+    );
 }
 
 #[test]
