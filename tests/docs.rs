@@ -121,9 +121,14 @@ struct Ran {
 
 /// Runs every `sh` block of `doc` (relative to the repository root) in one fresh folder.
 fn run_blocks_of(doc: &str) -> Ran {
+    let text = std::fs::read_to_string(root().join(doc)).expect("the document is readable");
+    run_blocks(doc, &text)
+}
+
+/// Runs every `sh` block of the Markdown `text` (named `doc` in messages) in one fresh folder.
+fn run_blocks(doc: &str, text: &str) -> Ran {
     let root = root();
-    let text = std::fs::read_to_string(root.join(doc)).expect("the document is readable");
-    let blocks = sh_blocks(&text);
+    let blocks = sh_blocks(text);
     assert!(!blocks.is_empty(), "{doc} has sh blocks");
     let tmp = temp_dir();
     let dir = tmp.path();
@@ -224,6 +229,15 @@ fn sh_blocks_are_found_and_cargo_lines_mapped() {
         script(&blocks[3]),
         "# needs: prusa-slicer\nprusa-slicer --help"
     );
+}
+
+#[test]
+fn marked_blocks_are_skipped_and_the_others_run() {
+    let md = "```sh\nmkdir -p out\nconduit info samples/cube_20mm.stl > out/info.txt\n```\n\
+              ```sh\n# needs: conduit-no-such-program\nexit 3\n```\n\
+              ```sh,no-run\nexit 4\n```\n```sh\n# needs: conduit bash\ntest -s out/info.txt\n```\n";
+    let ran = run_blocks("marks.md", md);
+    assert_eq!((ran.run, ran.skipped), (2, 2));
 }
 
 #[test]
