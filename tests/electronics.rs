@@ -7,17 +7,17 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 /// One extruding move of the replayed G-code.
-struct Extrusion {
-    tool: usize,
-    role: String,
-    z: f64,
-    from: [f64; 2],
-    to: [f64; 2],
+pub(crate) struct Extrusion {
+    pub(crate) tool: usize,
+    pub(crate) role: String,
+    pub(crate) z: f64,
+    pub(crate) from: [f64; 2],
+    pub(crate) to: [f64; 2],
 }
 
 impl Extrusion {
     /// Points along the move: both ends and three between.
-    fn samples(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
+    pub(crate) fn samples(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
         (0..=4).map(|k| {
             let t = f64::from(k) / 4.0;
             [
@@ -29,12 +29,14 @@ impl Extrusion {
 }
 
 /// What the demo's G-code holds: extrusions, and (part, z of the layer it was placed in).
-struct Replayed {
-    extrusions: Vec<Extrusion>,
-    events: Vec<(String, f64)>,
+pub(crate) struct Replayed {
+    pub(crate) extrusions: Vec<Extrusion>,
+    pub(crate) events: Vec<(String, f64)>,
 }
 
-fn replay(text: &str) -> Replayed {
+/// Replays conduit's G-code: the extruding moves (paste moves with the valve open), and the
+/// part events.
+pub(crate) fn replay(text: &str) -> Replayed {
     let mut out = Replayed {
         extrusions: Vec::new(),
         events: Vec::new(),

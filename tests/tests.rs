@@ -28,3 +28,4 @@ mod robot;
 mod roundtrip;
 mod slice;
 mod support;
+mod three_de;

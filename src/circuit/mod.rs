@@ -260,7 +260,7 @@ impl std::fmt::Display for PinRef {
 pub struct Net {
     /// Net name (`VCC`, `N$3`).
     pub name: String,
-    /// The pads, sorted by part then pad, at least two.
+    /// The pads, sorted by part then pad, at least one.
     pub pins: Vec<PinRef>,
 }
 
@@ -269,7 +269,9 @@ pub struct Net {
 pub struct Circuit {
     /// Parts with a package, in file order.
     pub parts: Vec<Part>,
-    /// Nets with at least two pins, sorted by name.
+    /// Nets with at least one pin, sorted by name. A net with a single pin has nothing to join
+    /// inside the circuit; a placement's wires may take it to waypoints (a terminal where a
+    /// battery, a connector or a wire is attached), as Electronic Slic3r's `.3de` files do.
     pub nets: Vec<Net>,
 }
 
@@ -447,7 +449,7 @@ impl Circuit {
     }
 }
 
-/// Nets with at least two pads, merged by name and sorted by name.
+/// Nets with at least one pad, merged by name and sorted by name.
 fn nets(src: &[conduit_eagle::Net]) -> Vec<Net> {
     let mut by_name: BTreeMap<&str, std::collections::BTreeSet<PinRef>> = BTreeMap::new();
     for n in src {
@@ -458,7 +460,7 @@ fn nets(src: &[conduit_eagle::Net]) -> Vec<Net> {
     }
     by_name
         .into_iter()
-        .filter(|(_, pins)| pins.len() >= 2)
+        .filter(|(_, pins)| !pins.is_empty())
         .map(|(name, pins)| Net {
             name: name.to_owned(),
             pins: pins.into_iter().collect(),

@@ -369,12 +369,21 @@ mod tests {
     }
 
     #[test]
-    fn tilt_turns_pads_out_of_the_seating_plane() {
+    fn a_tilted_part_is_refused_by_name_and_whole_turns_are_upright() {
         let mut p = sample_placement();
-        p.parts[1].tilt = [0.0, 90.0]; // R1 about y: package +x points down (-z).
+        p.parts[1].tilt = [0.0, 90.0]; // R1 about y: its pads would leave the seating plane.
+        let err = match place(&sample(), &p, &[]) {
+            Ok(_) => panic!("a tilted part is placed"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            err.contains("part \"R1\" is turned 0° about x and 90° about y"),
+            "{err}"
+        );
+        p.parts[1].tilt = [360.0, -720.0];
         let parts = placed(&sample(), &p, &[]);
         let (x, y, z) = centre(&parts, "R1", "2").unwrap_or_default();
-        assert!((x - 32.0).abs() < 1e-12 && y == 8.0 && (z - 3.05).abs() < 1e-12);
+        assert!((x - 32.95).abs() < 1e-9 && (y - 8.0).abs() < 1e-9 && (z - 4.0).abs() < 1e-9);
     }
 
     #[test]

@@ -207,6 +207,10 @@ pub struct Placement {
     /// Net routing hints, `[[net]]` in TOML.
     #[serde(default, rename = "net")]
     pub nets: Vec<NetRouting>,
+    /// Parts the file lists but does not place, with the reason, one line each (a `.3de`
+    /// part with `placed="false"`): the route stage reports them as warnings.
+    #[serde(skip)]
+    pub skipped: Vec<String>,
 }
 
 /// One thing wrong in a placement, found by [`Placement::validate`].
@@ -281,6 +285,14 @@ pub enum Problem {
         /// The unit of both, `mm` or `°`.
         unit: &'static str,
     },
+    /// A part turned about x or y: conduit cuts upright cavities and prints the traces to pads
+    /// in the seating plane, so it seats parts upright (turned about z only).
+    Tilted {
+        /// Part name.
+        part: String,
+        /// The tilt about x and y, degrees.
+        tilt: [f64; 2],
+    },
 }
 
 impl std::fmt::Display for Problem {
@@ -323,6 +335,13 @@ impl std::fmt::Display for Problem {
                 f,
                 "placement: {item}: {key} = {} {unit} is beyond the limit of ±{limit} {unit}",
                 super::short_number(*value)
+            ),
+            Problem::Tilted { part, tilt } => write!(
+                f,
+                "placement: part \"{part}\" is turned {}° about x and {}° about y: conduit seats \
+                 parts upright (turned about z only), so its cavity and pads cannot be built",
+                super::short_number(tilt[0]),
+                super::short_number(tilt[1])
             ),
         }
     }
@@ -551,6 +570,19 @@ impl Placement {
                 for (key, v) in [("x", w.x), ("y", w.y), ("z", w.z)] {
                     check(&item, key, v, MAX_POSITION_MM, "mm", false);
                 }
+            }
+        }
+        // Whole turns about x or y leave a part upright.
+        let upright = |a: f64| {
+            let r = a.rem_euclid(360.0);
+            r.min(360.0 - r) < 1e-6
+        };
+        for p in &self.parts {
+            if p.tilt.iter().all(|a| a.is_finite()) && !p.tilt.iter().all(|&a| upright(a)) {
+                problems.push(Problem::Tilted {
+                    part: p.name.clone(),
+                    tilt: p.tilt,
+                });
             }
         }
         problems
@@ -868,11 +900,13 @@ pub(crate) mod tests {
         assert_eq!(pose("R1"), Some((5.0, 23.0, 2.5, 90.0, false)));
         assert_eq!(pose("R2"), Some((25.0, 23.0, 2.5, 0.0, true)));
         let c = Circuit::from_board(&b);
-        assert_eq!(c.nets.len(), 1); // B has one pad
+        // B has one pad: kept, so a placement may wire it to a terminal.
+        assert_eq!(c.nets.len(), 2);
         assert_eq!(
             c.nets[0].pins,
             [PinRef::new("R1", "2"), PinRef::new("R2", "1")]
         );
+        assert_eq!((c.nets[1].name.as_str(), c.nets[1].pins.len()), ("B", 1));
         assert!(p.validate(&c).is_ok());
     }
 }

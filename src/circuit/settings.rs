@@ -62,6 +62,11 @@ pub struct RouteSettings {
     /// Put a conductive drop (a small disc of trace) on every pad, also on pins no net uses,
     /// so a part's leads sit in paste. Default false.
     pub pad_drops: bool,
+    /// Diameter of the contact pad printed at a terminal: a waypoint only one wire of its net
+    /// reaches, where a battery, a connector or a wire is attached (the `.3de` files of
+    /// Electronic Slic3r wire single-pin nets to such waypoints). 0 prints none. From 0 to
+    /// 50 mm. Default 2.
+    pub terminal_pad: f64,
 }
 
 impl Default for RouteSettings {
@@ -86,6 +91,7 @@ impl Default for RouteSettings {
             max_detour: r.max_detour,
             detour_slack: r.detour_slack,
             pad_drops: false,
+            terminal_pad: 2.0,
         }
     }
 }
@@ -141,6 +147,12 @@ impl RouteSettings {
             if !(v.is_finite() && v >= 0.0) {
                 out.push(format!("route.{key} must be ≥ 0, got {v}"));
             }
+        }
+        if !(0.0..=50.0).contains(&self.terminal_pad) {
+            out.push(format!(
+                "route.terminal_pad must be from 0 to 50 mm, got {}",
+                self.terminal_pad
+            ));
         }
         if self.perimeter_weights.len() < self.perimeters {
             out.push(format!(

@@ -37,6 +37,9 @@ pub struct ElectronicsParams {
     pub cavity_offset: f64,
     /// Whether every pad gets a conductive drop (`route.pad_drops`).
     pub pad_drops: bool,
+    /// Diameter of the contact pad at a terminal waypoint, mm; 0 for none
+    /// (`route.terminal_pad`).
+    pub terminal_pad: f64,
 }
 
 /// A circuit and where its parts go: what `--circuit` and `--placement` give.
@@ -98,6 +101,22 @@ pub struct ElectronicsReport {
     /// the solid at its seating plane, a part above the object, two parts' footprints
     /// overlapping. Each makes the job fail (see [`ElectronicsReport::failures`]).
     pub part_problems: Vec<String>,
+    /// The terminals: waypoints only one wire of their net reaches, each with a contact pad.
+    pub terminals: Vec<TerminalReport>,
+}
+
+/// A terminal in the report: where a battery, a connector or a wire is attached.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TerminalReport {
+    /// Net name.
+    pub net: String,
+    /// The waypoint's name.
+    pub name: String,
+    /// Where it is on the bed, mm: the centre of its contact pad, on the layer top nearest
+    /// the waypoint's z.
+    pub position: [f64; 3],
+    /// Diameter of its contact pad, mm (0: none printed).
+    pub pad_diameter: f64,
 }
 
 impl ElectronicsReport {
@@ -164,6 +183,23 @@ pub struct PlacedCircuit {
     pub wires: Vec<CircuitWire>,
     /// Net pins on parts the placement does not list (`net`, `part.pad`).
     pub unplaced: Vec<(String, String)>,
+    /// Waypoints only one wire of their net reaches, bed coordinates.
+    pub terminals: Vec<Terminal>,
+    /// Parts the placement lists but does not place ([`Placement::skipped`]).
+    pub skipped: Vec<String>,
+}
+
+/// A waypoint only one wire of its net reaches: the trace ends there, in a contact pad.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Terminal {
+    /// Net name.
+    pub net: String,
+    /// The waypoint's name.
+    pub name: String,
+    /// Its position, bed coordinates.
+    pub at: Point3,
+    /// The scene object it is in.
+    pub object: usize,
 }
 
 /// One wire to route, with the object it runs in and what it joins.
@@ -240,11 +276,40 @@ pub fn place_circuit(
         .iter()
         .map(|(net, pin)| (net.clone(), pin.to_string()))
         .collect();
+    let terminals = terminals(&placement, &offset);
     Ok(PlacedCircuit {
         parts,
         wires,
         unplaced,
+        terminals,
+        skipped: e.placement.skipped.clone(),
     })
+}
+
+/// The waypoints of `placement` (model coordinates) that exactly one wire end names, moved by
+/// their object's bed offset.
+fn terminals(placement: &Placement, offset: &impl Fn(usize) -> [f64; 3]) -> Vec<Terminal> {
+    let mut out = Vec::new();
+    for net in &placement.nets {
+        for w in &net.waypoints {
+            let ends = net
+                .wires
+                .iter()
+                .flatten()
+                .filter(|e| matches!(e, crate::circuit::placement::Endpoint::Waypoint(n) if *n == w.name))
+                .count();
+            if ends == 1 {
+                let d = offset(w.object);
+                out.push(Terminal {
+                    net: net.name.clone(),
+                    name: w.name.clone(),
+                    at: Point3::new(w.x + d[0], w.y + d[1], w.z + d[2]),
+                    object: w.object,
+                });
+            }
+        }
+    }
+    out
 }
 
 fn translate_part(part: &mut PlacedPart, d: [f64; 3]) {
@@ -308,13 +373,40 @@ pub fn object_stage(
         report
             .unplaced_pins
             .extend(circuit.unplaced.iter().cloned());
+        report.warnings.extend(circuit.skipped.iter().cloned());
     }
-    let result = route_object(&mine, &mine_wires, islands, zs, &params.route, report);
+    let terminals: Vec<&Terminal> = circuit
+        .terminals
+        .iter()
+        .filter(|t| t.object == object)
+        .collect();
+    let terminal_copper: Vec<PadCopper> = terminals
+        .iter()
+        .filter(|_| params.terminal_pad > 0.0)
+        .map(|t| PadCopper::round(Some(&t.net), t.at, params.terminal_pad))
+        .collect();
+    let result = route_object(
+        &mine,
+        &mine_wires,
+        &terminal_copper,
+        islands,
+        zs,
+        &params.route,
+        report,
+    );
     let style = TraceStyle::of(params);
     let mut per_layer = trace_paths(&result, &mine_wires, zs, style, report);
     if params.pad_drops {
         add_pad_drops(&mine, zs, style, &mut per_layer);
     }
+    add_terminal_pads(
+        &terminals,
+        zs,
+        style,
+        params.terminal_pad,
+        &mut per_layer,
+        report,
+    );
     add_traces(per_layer, zs, extras);
     add_part_events(&mine, zs, extras, report);
     total_up(report);
@@ -502,6 +594,7 @@ fn report_between_objects(between: &[&CircuitWire], object: usize, report: &mut 
 fn route_object(
     mine: &[(usize, &PlacedPart)],
     mine_wires: &[&CircuitWire],
+    terminal_copper: &[PadCopper],
     islands: &mut [Vec<ExPolygon>],
     zs: &[LayerZ],
     params: &RouteParams,
@@ -525,6 +618,7 @@ fn route_object(
             z: pad.centre.z,
             outline: pad.outline.clone(),
         })
+        .chain(terminal_copper.iter().cloned())
         .collect();
     report
         .warnings
@@ -613,6 +707,61 @@ fn add_pad_drops(
                 style.speed,
             ));
         }
+    }
+}
+
+/// The contact pads of the object's terminals (a disc of `diameter` filled with concentric
+/// rings of trace, on the layer whose top is nearest the waypoint), and their report entries.
+fn add_terminal_pads(
+    terminals: &[&Terminal],
+    zs: &[LayerZ],
+    style: TraceStyle,
+    diameter: f64,
+    per_layer: &mut BTreeMap<usize, Vec<Toolpath>>,
+    report: &mut ElectronicsReport,
+) {
+    for t in terminals {
+        let layer = floor_layer(zs, t.at.z).or_else(|| {
+            zs.iter()
+                .enumerate()
+                .min_by(|a, b| {
+                    (a.1.top - t.at.z)
+                        .abs()
+                        .total_cmp(&(b.1.top - t.at.z).abs())
+                })
+                .map(|(i, _)| i)
+        });
+        let Some(layer) = layer else { continue };
+        let z = zs[layer].top;
+        report.terminals.push(TerminalReport {
+            net: t.net.clone(),
+            name: t.name.clone(),
+            position: [t.at.x, t.at.y, z],
+            pad_diameter: diameter,
+        });
+        if diameter <= 0.0 {
+            continue;
+        }
+        // Rings one trace width apart, from the outermost (its outer edge on the pad's edge)
+        // inward, then a drop in the middle (a circle of one trace width, covering a disc of
+        // two).
+        let w = style.width;
+        let paths = per_layer.entry(layer).or_default();
+        let mut radius = diameter / 2.0 - w / 2.0;
+        while radius > w + 1e-9 {
+            let mut ring = drop_path(t.at, z, w, zs[layer].height(), style.tool, style.speed);
+            ring.points = circle(t.at, z, radius, 24);
+            paths.push(ring);
+            radius -= w;
+        }
+        paths.push(drop_path(
+            t.at,
+            z,
+            w,
+            zs[layer].height(),
+            style.tool,
+            style.speed,
+        ));
     }
 }
 
@@ -743,15 +892,9 @@ fn floor_layer(zs: &[LayerZ], z: f64) -> Option<usize> {
 
 /// A drop: a closed circle of one trace width around `centre` at height `z`.
 fn drop_path(centre: Point3, z: f64, width: f64, height: f64, tool: usize, speed: f64) -> Toolpath {
-    let r = width / 2.0;
-    let points = (0..12)
-        .map(|k| {
-            let a = f64::from(k) * std::f64::consts::TAU / 12.0;
-            Point3::new(centre.x + r * a.cos(), centre.y + r * a.sin(), z)
-        })
-        .collect();
     Toolpath {
-        points,
+        points: circle(centre, z, width / 2.0, 12),
+
         closed: true,
         role: Role::ConductiveDrop,
         tool,
@@ -761,6 +904,16 @@ fn drop_path(centre: Point3, z: f64, width: f64, height: f64, tool: usize, speed
         segments: None,
         tool_axis: None,
     }
+}
+
+/// `n` points on the circle of `radius` about `centre`, at height `z`, counter-clockwise.
+fn circle(centre: Point3, z: f64, radius: f64, n: u32) -> Vec<Point3> {
+    (0..n)
+        .map(|k| {
+            let a = f64::from(k) * std::f64::consts::TAU / f64::from(n);
+            Point3::new(centre.x + radius * a.cos(), centre.y + radius * a.sin(), z)
+        })
+        .collect()
 }
 
 fn method_name(m: PlacingMethod) -> &'static str {

@@ -34,7 +34,7 @@ impl Placement {
     /// `position` `Z` is the bottom of the part, `partHeight` its full height. `rotation` `Z`
     /// becomes `rotation`, `X` and `Y` the `tilt`. `placingMethod` is `Automatic`, `Manual` or
     /// `None`, `connectionMethod` `None`, `Layer` or `Part`. Parts with `placed` false (`0`,
-    /// `false`) are not in the object and are left out; a missing `attributes` element means
+    /// `false`) are not in the object: they are left out and named in [`Placement::skipped`]; a missing `attributes` element means
     /// placed, zero heights. Waypoints are named by their `key`; a part endpoint's `pin` may be a
     /// pad or schematic pin name.
     pub fn from_3de(xml: &str) -> Result<Self, PlacementError> {
@@ -62,6 +62,10 @@ impl Placement {
             let attrs = part.child("attributes");
             let attr = |key| attrs.and_then(|a| a.attr(key));
             if attr("placed").is_some_and(|v| !xml_bool(v)) {
+                out.skipped.push(format!(
+                    "part {name} is not placed in the object (placed=\"false\" in the .3de \
+                     file): it gets no cavity, and its pins no traces"
+                ));
                 continue;
             }
             let pos = part

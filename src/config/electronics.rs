@@ -12,7 +12,7 @@ use crate::circuit::stage::ElectronicsParams;
 impl Config {
     /// The electronics stage's parameters: the router's from `[route]` with the perimeter width
     /// of `[slice]` ([`RouteSettings::router_params`](super::RouteSettings::router_params)), the conductive tool, trace height,
-    /// cavity offset and pad drops of `[route]`, the conductive speed of `[slice]`, and how many
+    /// cavity offset, pad drops and terminal pads of `[route]`, the conductive speed of `[slice]`, and how many
     /// tools there are.
     pub fn electronics_params(&self) -> ElectronicsParams {
         let r = &self.route;
@@ -24,6 +24,7 @@ impl Config {
             conductive_speed: self.slice.conductive_speed,
             cavity_offset: r.cavity_offset,
             pad_drops: r.pad_drops,
+            terminal_pad: r.terminal_pad,
         }
     }
 }
