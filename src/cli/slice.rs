@@ -37,10 +37,7 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     }
     let scene = load_models(&args.models)?;
     let electronics = match (&args.circuit, &args.placement) {
-        (Some(c), Some(p)) => Some(Electronics {
-            circuit: Circuit::load(c).map_err(anyhow::Error::from)?,
-            placement: Placement::load(p).map_err(anyhow::Error::from)?,
-        }),
+        (Some(c), Some(p)) => Some(load_electronics(c, p)?),
         _ => None,
     };
     let bar = stage_bar();
@@ -52,6 +49,7 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         .with_context(|| format!("slicing {}", args.models[0].display()))?;
     bar.finish_and_clear();
     outputs.add(&args.output, &gcode)?;
+    let mut written = vec![args.output.clone()];
     if let Some(e) = &electronics {
         let records = pnp_records(&e.circuit, &summary.parts);
         let pos = args.output.with_extension("pos");
@@ -59,6 +57,7 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         conduit_pnp::write_kicad_pos(&records, &mut bytes)
             .with_context(|| format!("{}: cannot write positions", pos.display()))?;
         outputs.add(&pos, &bytes)?;
+        written.push(pos);
         let xml = args.output.with_extension("openpnp.xml");
         let name = args
             .output
@@ -68,14 +67,32 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         conduit_pnp::write_openpnp_board(&name, &records, &mut bytes)
             .with_context(|| format!("{}: cannot write OpenPnP board", xml.display()))?;
         outputs.add(&xml, &bytes)?;
+        written.push(xml);
     }
     if let Some(report) = &args.report {
         let json = serde_json::to_vec_pretty(&summary).context("serialising the report")?;
         outputs.add(report, &json)?;
     }
     outputs.commit()?;
+    written.extend(args.report.clone());
     let total: f64 = summary.gcode.tools.iter().map(|t| t.filament_mm).sum();
-    eprintln!(
+    if args.json {
+        super::print_json(&serde_json::json!({
+            "outputs": super::paths(written.iter().map(|p| p.as_path())),
+            "layers": summary.layers,
+            "filament_mm": total,
+            "estimated_time_s": summary.gcode.estimated_time_s,
+            "report": summary,
+        }))?;
+        if let Some(r) = &summary.electronics {
+            routing_warnings(r);
+        }
+        for r in summary.curved.iter().flat_map(|c| &c.rejections) {
+            warnln!("{r}");
+        }
+        return Ok(());
+    }
+    infoln!(
         "{}: {} layers, {:.0} mm filament, estimated {:.0} min",
         args.output.display(),
         summary.layers,
@@ -94,13 +111,13 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         } else {
             String::new()
         };
-        eprintln!(
+        infoln!(
             "curved tops: {} region(s) curved, {} kept planar{slowed}",
             c.regions.len(),
             c.rejections.len()
         );
         for r in &c.rejections {
-            eprintln!("warning: {r}");
+            warnln!("{r}");
         }
     }
     Ok(())
@@ -142,10 +159,45 @@ fn run_clfff(
         outputs.add(report, &json)?;
     }
     outputs.commit()?;
+    let r = &summary.clfff;
+    let model_layers = r
+        .layers
+        .iter()
+        .filter(|l| l.section == conduit::curved::clfff::Section::Model)
+        .count();
+    if args.json {
+        let files: Vec<serde_json::Value> = written
+            .iter()
+            .map(|(path, file)| {
+                serde_json::json!({
+                    "file": path.display().to_string(),
+                    "sections": file.sections.iter().map(|s| s.name()).collect::<Vec<_>>(),
+                    "program_layers": file.program.layers.len(),
+                    "filament_mm": file.stats.tools.iter().map(|t| t.filament_mm).sum::<f64>(),
+                    "estimated_time_s": file.stats.estimated_time_s,
+                })
+            })
+            .collect();
+        super::print_json(&serde_json::json!({
+            "outputs": super::paths(
+                written.iter().map(|(p, _)| p.as_path()).chain(args.report.as_deref())
+            ),
+            "files": files,
+            "scaffold_layers": r.scaffold.layers,
+            "buffer_layers": r.layers.len() - model_layers,
+            "curved_layers": model_layers,
+            "collisions": r.collisions.count,
+            "report": summary,
+        }))?;
+        for w in r.warnings() {
+            warnln!("{w}");
+        }
+        return Ok(());
+    }
     for (path, file) in written {
         let total: f64 = file.stats.tools.iter().map(|t| t.filament_mm).sum();
         let names: Vec<&str> = file.sections.iter().map(|s| s.name()).collect();
-        eprintln!(
+        infoln!(
             "{}: {} ({} program layers), {:.0} mm filament, estimated {:.0} min",
             path.display(),
             names.join(" + "),
@@ -154,12 +206,6 @@ fn run_clfff(
             file.stats.estimated_time_s / 60.0
         );
     }
-    let r = &summary.clfff;
-    let model_layers = r
-        .layers
-        .iter()
-        .filter(|l| l.section == conduit::curved::clfff::Section::Model)
-        .count();
     let slowed = if r.z_speed_limited > 0 {
         format!(
             ", {} moves slowed for curved.max_z_speed",
@@ -168,7 +214,7 @@ fn run_clfff(
     } else {
         String::new()
     };
-    eprintln!(
+    infoln!(
         "clfff: {} scaffold layers, {} buffer layer(s), {} curved layers, {} collision(s){slowed}",
         r.scaffold.layers,
         r.layers.len() - model_layers,
@@ -176,7 +222,7 @@ fn run_clfff(
         r.collisions.count
     );
     for w in r.warnings() {
-        eprintln!("warning: {w}");
+        warnln!("{w}");
     }
     Ok(())
 }
@@ -184,7 +230,7 @@ fn run_clfff(
 /// The routing summary line (after `lead`), the report's warnings and one line per wire that
 /// could not be routed, on stderr.
 pub(crate) fn print_routing(r: &conduit::circuit::ElectronicsReport, lead: &str) {
-    eprintln!(
+    infoln!(
         "{lead}{} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
         r.parts.len(),
         r.routed,
@@ -192,14 +238,16 @@ pub(crate) fn print_routing(r: &conduit::circuit::ElectronicsReport, lead: &str)
         r.total_length,
         r.total_lower_bound
     );
+    routing_warnings(r);
+}
+
+/// The routing report's warnings and one line per wire that could not be routed, on stderr.
+pub(crate) fn routing_warnings(r: &conduit::circuit::ElectronicsReport) {
     for w in &r.warnings {
-        eprintln!("warning: {w}");
+        warnln!("{w}");
     }
     for w in r.wires.iter().filter(|w| !w.routed) {
-        eprintln!(
-            "warning: net {} could not be routed ({} to {})",
-            w.net, w.from, w.to
-        );
+        warnln!("net {} could not be routed ({} to {})", w.net, w.from, w.to);
     }
 }
 
@@ -215,6 +263,22 @@ fn inputs(args: &SliceArgs) -> OutputSet {
     set
 }
 
+/// The circuit and its placement, checked against each other here so that a placement naming
+/// parts, nets or pins the circuit lacks is reported against the placement file.
+pub(crate) fn load_electronics(
+    circuit: &std::path::Path,
+    placement: &std::path::Path,
+) -> Result<Electronics, Failure> {
+    let c = Circuit::load(circuit).map_err(anyhow::Error::from)?;
+    let p = Placement::load(placement).map_err(anyhow::Error::from)?;
+    p.validate(&c)
+        .with_context(|| placement.display().to_string())?;
+    Ok(Electronics {
+        circuit: c,
+        placement: p,
+    })
+}
+
 /// One scene of every object of `models`, in order; reader warnings go to stderr.
 pub(crate) fn load_models(models: &[std::path::PathBuf]) -> Result<Scene, Failure> {
     let mut scene = Scene::default();
@@ -222,16 +286,16 @@ pub(crate) fn load_models(models: &[std::path::PathBuf]) -> Result<Scene, Failur
         let (s, warnings) =
             load_scene(path, &LoadOptions::default()).map_err(anyhow::Error::from)?;
         for w in warnings {
-            eprintln!("warning: {}: {w}", path.display());
+            warnln!("{}: {w}", path.display());
         }
         scene.objects.extend(s.objects);
     }
     Ok(scene)
 }
 
-/// A bar over the pipeline's stages, hidden when stderr is not a terminal.
+/// A bar over the pipeline's stages, hidden when stderr is not a terminal or with `--quiet`.
 fn stage_bar() -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
+    if super::quiet() || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(Stage::ALL.len() as u64);
