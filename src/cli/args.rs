@@ -114,7 +114,7 @@ pub struct SliceArgs {
     pub output: PathBuf,
     /// Also write a JSON report (objects, layers, filament, time, stage timings; with a circuit
     /// also parts and, per wire, routed/length/lower bound/layer changes/perimeter crossings).
-    #[arg(long, value_name = "REPORT.json")]
+    #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
     /// Circuit to build into the object: an EAGLE schematic or board (.sch, .brd). Needs
     /// `--placement`. Also writes OUT.pos (KiCad position CSV with PosZ) and OUT.openpnp.xml.
@@ -160,7 +160,7 @@ pub struct RouteArgs {
     pub out_dir: PathBuf,
     /// Also write the JSON report (parts; per wire routed, length, lower bound, layer changes,
     /// perimeter crossings; totals).
-    #[arg(long, value_name = "REPORT.json")]
+    #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
     /// Print one JSON document on stdout summarising what was done (outputs written, counts,
     /// key figures) instead of the text summary on stderr.
