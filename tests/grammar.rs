@@ -415,6 +415,34 @@ fn config_errors_say_what_a_value_must_be_in_words() {
 }
 
 #[test]
+fn a_config_refused_by_the_command_is_named() {
+    let dir = temp_dir();
+    let cfg = dir.path().join("conform.toml");
+    std::fs::write(&cfg, "[conform]\nfeed = -5\n").expect("config written");
+    let o = run(&[
+        &"conform",
+        &"--surface",
+        &sample("conform/wrinkled_film.xyz"),
+        &"--design",
+        &sample("conform/monopole.svg"),
+        &"-c",
+        &cfg,
+        &"-o",
+        &dir.path().join("m.gcode"),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with(&format!(
+            "error: {}: invalid config: conform.feed",
+            cfg.display()
+        )),
+        "{err}"
+    );
+}
+
+#[test]
 fn a_placement_naming_unknown_parts_or_pins_suggests_the_closest_and_names_its_file() {
     let dir = temp_dir();
     let demo = |f: &str| sample(&format!("circuit_demo/{f}"));

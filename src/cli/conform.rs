@@ -27,7 +27,13 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         Some(_) => cfg.conform.mapping = Mapping::Projection,
         None => {}
     }
-    let params = ConformParams::from_settings(&cfg.conform).context("invalid configuration")?;
+    // The `[conform]` settings are checked here rather than by the config's own validation:
+    // the error names the config file when there is one.
+    let params =
+        ConformParams::from_settings(&cfg.conform).with_context(|| match &args.config.config {
+            Some(path) => format!("{}: invalid config", path.display()),
+            None => "invalid config".to_owned(),
+        })?;
     let dialect = Dialect::from_name(&dialect_name);
     let orient = orientation(&args, &cfg, dialect)?;
     let place = args.place.as_deref().map(parse_place).transpose()?;
