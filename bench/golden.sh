@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs every sample command of the README and samples/ into a temporary folder and prints one
-# sha256 per output file, sorted by name: the byte-level fingerprint of conduit's behaviour.
+# Runs the documented sample commands (README, the guide in docs/, samples/) into a temporary
+# folder and prints one sha256 per output file, sorted by name: the byte-level fingerprint of
+# conduit's behaviour.
 #
 #   bench/golden.sh                 # uses target/release/conduit (build it first)
 #   CONDUIT=path/to/conduit bench/golden.sh

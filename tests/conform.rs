@@ -835,7 +835,7 @@ fn bad_inputs_fail_with_the_file_named() {
 
 #[test]
 fn the_readme_example_prints_the_monopole_on_the_sample_film() {
-    // The README's command on the bundled samples: exit 0, a report with the whole monopole
+    // The guide's command (docs/src/conformal.md) on the bundled samples: exit 0, a report with the whole monopole
     // (two strokes: feed line and triangle), no contact left, and `conduit check` clean.
     let dir = temp_dir();
     let (out, report) = (dir.path().join("monopole.gcode"), dir.path().join("m.json"));

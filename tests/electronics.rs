@@ -4,6 +4,7 @@ use conduit_gcode::{Firmware, Machine};
 
 use crate::support::{conduit, sample, stderr, temp_dir, xyz};
 use serde_json::Value;
+use std::path::{Path, PathBuf};
 
 /// One extruding move of the replayed G-code.
 struct Extrusion {
@@ -172,22 +173,54 @@ fn demo_circuit_slices_with_cavities_traces_events_and_placement_files() {
         );
     }
 
-    // The pick-and-place files list the three parts where the report puts them.
+    // The pick-and-place files list the parts where the report puts them. BAT1 is inserted by
+    // hand: the OpenPnP board has it disabled, the KiCad files (which cannot mark a row
+    // disabled) leave it out. The `.pos` rows are read with OpenPnP's importer pattern.
+    let report_part = |name: &str| {
+        parts
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap_or_else(|| panic!("{name} in the report"))
+    };
+    let at = |part: &Value, k: usize| part["position"][k].as_f64().expect("coordinate");
     let pos = std::fs::read_to_string(dir.path().join("demo.pos")).expect(".pos written");
-    let records = conduit_pnp::read_kicad_pos(&pos).expect(".pos parses");
-    assert_eq!(records.len(), 3);
-    for (rec, part) in records.iter().zip(parts) {
-        assert_eq!(rec.reference, part["name"].as_str().expect("name"));
-        for (k, v) in [rec.x, rec.y, rec.z].into_iter().enumerate() {
-            let want = part["position"][k].as_f64().expect("coordinate");
-            assert!((v - want).abs() < 1e-4, "{}: {v} vs {want}", rec.reference);
+    assert!(pos.starts_with("### Footprint positions") && pos.ends_with("## End\n"));
+    let ascii = conduit_pnp::read_kicad_ascii(&pos).expect("every .pos row matches the importer");
+    let csv = std::fs::read_to_string(dir.path().join("demo-pos.csv")).expect("CSV written");
+    let csv = conduit_pnp::read_kicad_csv(&csv).expect("CSV parses");
+    for records in [&ascii, &csv] {
+        let names: Vec<&str> = records.iter().map(|r| r.reference.as_str()).collect();
+        assert_eq!(
+            names,
+            ["LED1", "R1"],
+            "machine-placed parts in KiCad's order"
+        );
+        for rec in records.iter() {
+            let part = report_part(&rec.reference);
+            for (k, v) in [rec.x, rec.y].into_iter().enumerate() {
+                assert!((v - at(part, k)).abs() < 1e-4, "{}: {v}", rec.reference);
+            }
         }
     }
-    let xml =
-        std::fs::read_to_string(dir.path().join("demo.openpnp.xml")).expect("OpenPnP written");
+    let xml = std::fs::read_to_string(dir.path().join("demo.board.xml")).expect("board written");
     let board = conduit_pnp::read_openpnp_board(&xml).expect("OpenPnP parses");
     assert_eq!(board.len(), 3);
-    assert_eq!(board[2].rotation_deg, 90.0);
+    for rec in &board {
+        let part = report_part(&rec.reference);
+        for (k, v) in [rec.x, rec.y, rec.z].into_iter().enumerate() {
+            assert!((v - at(part, k)).abs() < 1e-4, "{}: {v}", rec.reference);
+        }
+        assert_eq!(rec.enabled, part["method"] == "auto", "{}", rec.reference);
+    }
+    assert_eq!(
+        board
+            .iter()
+            .filter(|r| !r.enabled)
+            .map(|r| r.reference.as_str())
+            .collect::<Vec<_>>(),
+        ["BAT1"]
+    );
+    assert!(xml.contains("<!-- R1: height 0.6000 mm -->"), "{xml}");
 }
 
 #[test]
@@ -330,7 +363,18 @@ fn wires_between_two_objects_are_reported_with_a_warning_and_not_routed() {
         "--report".as_ref(),
         report.as_os_str(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    // Two wires are not routed: the job fails, and still leaves the drawings and the report
+    // that show where.
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    for net in ["GND", "N1"] {
+        assert!(
+            stderr(&o)
+                .lines()
+                .any(|l| l.starts_with(&format!("error: net {net} could not be routed"))),
+            "{}",
+            stderr(&o)
+        );
+    }
     let v: Value =
         serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
     let wires = v["wires"].as_array().expect("wires");
@@ -362,4 +406,126 @@ fn wires_between_two_objects_are_reported_with_a_warning_and_not_routed() {
         "{}",
         stderr(&o)
     );
+}
+
+/// The demo placement with `edit` applied to its text, written to `dir/name`.
+fn demo_placement_with(
+    dir: &std::path::Path,
+    name: &str,
+    edit: impl Fn(&str) -> String,
+) -> PathBuf {
+    let text = std::fs::read_to_string(sample("circuit_demo/placement.toml")).expect("sample");
+    let path = dir.join(name);
+    std::fs::write(&path, edit(&text)).expect("placement written");
+    path
+}
+
+/// Slices the demo block with `placement` and `extra` arguments: exit code, stderr, whether
+/// the G-code exists.
+fn slice_demo_with(
+    dir: &std::path::Path,
+    placement: &Path,
+    extra: &[&str],
+) -> (Option<i32>, String, bool) {
+    let out = dir.join("job.gcode");
+    let _ = std::fs::remove_file(&out);
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "slice".into(),
+        sample("circuit_demo/block.stl").into(),
+        "--circuit".into(),
+        sample("circuit_demo/led_coin.sch").into(),
+        "--placement".into(),
+        placement.into(),
+        "-o".into(),
+        out.clone().into(),
+    ];
+    args.extend(extra.iter().map(Into::into));
+    let o = conduit(&args);
+    (o.status.code(), stderr(&o), out.exists())
+}
+
+/// The part section of `name` in the demo placement, for edits.
+fn edit_part(text: &str, name: &str, from: &str, to: &str) -> String {
+    let at = text
+        .find(&format!("name = \"{name}\""))
+        .expect("part in the sample");
+    let (head, tail) = text.split_at(at);
+    format!("{head}{}", tail.replacen(from, to, 1))
+}
+
+#[test]
+fn a_circuit_not_built_as_asked_fails_with_each_problem_named_and_writes_nothing() {
+    let dir = temp_dir();
+    let d = dir.path();
+    // (placement edit, expected error lines).
+    let outside = demo_placement_with(d, "outside.toml", |t| {
+        edit_part(t, "R1", "x = 32.0", "x = 132.0")
+    });
+    let above = demo_placement_with(d, "above.toml", |t| {
+        edit_part(t, "LED1", "z = 4.0", "z = 40.0")
+    });
+    let collide = demo_placement_with(d, "collide.toml", |t| {
+        edit_part(t, "LED1", "y = 22.0", "y = 8.0")
+    });
+    let empty = d.join("empty.toml");
+    std::fs::write(&empty, "origin = \"model\"\n").expect("written");
+    let cases: [(&Path, &[&str]); 4] = [
+        (
+            &outside,
+            &[
+                "error: part R1 is not inside the object: 3.8 of its 3.8 mm² footprint lies \
+                 outside the solid at z 4.000 mm",
+                "error: net N1 could not be routed (LED1.A to R1.2)",
+            ],
+        ),
+        (
+            &above,
+            &[
+                "error: part LED1 is above the object: its seating plane z 40.000 mm is 32.000 mm \
+               over the object's top (8.000 mm)",
+            ],
+        ),
+        (
+            &collide,
+            &["error: parts R1 and LED1 collide: their footprints share"],
+        ),
+        (
+            &empty,
+            &["error: the placement places no part of the circuit"],
+        ),
+    ];
+    for (placement, expected) in cases {
+        let (code, err, written) = slice_demo_with(d, placement, &[]);
+        assert_eq!(code, Some(1), "{}: {err}", placement.display());
+        assert!(
+            !written,
+            "{}: no G-code for a failed job",
+            placement.display()
+        );
+        for line in expected {
+            assert!(
+                err.lines().any(|l| l.starts_with(line)),
+                "{}: missing {line:?} in\n{err}",
+                placement.display()
+            );
+        }
+        let last = err.lines().last().unwrap_or_default();
+        assert!(
+            last.contains("job.gcode: the circuit was not built as asked")
+                && last.contains("nothing was written (--allow-unrouted accepts it)"),
+            "{last}"
+        );
+        // With --allow-unrouted the same problems are warnings and the files are written.
+        let (code, err, written) = slice_demo_with(d, placement, &["--allow-unrouted"]);
+        assert_eq!(code, Some(0), "{err}");
+        assert!(written);
+        for line in expected {
+            let warning = line.replacen("error: ", "warning: ", 1);
+            assert!(err.lines().any(|l| l.starts_with(&warning)), "{err}");
+        }
+    }
+    // The demo itself is built as asked: no problem at all.
+    let (code, err, _) = slice_demo_with(d, &sample("circuit_demo/placement.toml"), &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("error") && !err.contains("warning"), "{err}");
 }

@@ -1,7 +1,7 @@
-//! Byte-level behaviour: `bench/golden.sh` runs every sample command of the README and
-//! `samples/` and hashes each output; the hashes must equal `bench/golden.txt`. A change that
-//! alters an output on purpose re-records the file and names the changed outputs and the reason
-//! in its commit.
+//! Byte-level behaviour: `bench/golden.sh` runs the documented sample commands (README, the
+//! guide in `docs/`, `samples/`) and hashes each output; the hashes must equal
+//! `bench/golden.txt`. A change that alters an output on purpose re-records the file and names
+//! the changed outputs and the reason in its commit.
 
 use std::collections::BTreeMap;
 use std::process::Command;

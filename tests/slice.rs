@@ -17,7 +17,9 @@ use serde_json::Value;
 
 use conduit_gcode::{Firmware, Machine};
 
-use crate::support::{conduit, corpus, root, sample, stderr, stdout, temp_dir, xyz};
+use crate::support::{
+    conduit, corpus, root, sample, stderr, stdout, stl_triangles, temp_dir, write_stl, xyz,
+};
 
 /// Tolerance for "the same point" in G-code coordinates, mm (1 µm; XYZ are written to 3
 /// decimals, so equal points are written identically).
@@ -1324,5 +1326,70 @@ fn built_program_round_trips_through_the_writer() {
             .iter()
             .filter(|(_, _, _, de)| *de > 0.0)
             .all(|(_, _, to, _)| (99.9..=120.1).contains(&to[0]))
+    );
+}
+
+#[test]
+fn contours_dropped_from_an_open_mesh_are_a_warning_on_the_terminal() {
+    let tmp = temp_dir();
+    let dir = tmp.path();
+    // The closed 20 mm cube, and beside it a copy without its two x = max triangles: each of
+    // the copy's layers is an open chain whose ends are 20 mm apart, too far to close, so it is
+    // dropped while the closed cube prints.
+    let cube: Vec<[conduit::geom::Point3; 3]> = stl_triangles(&sample("cube_20mm.stl"))
+        .iter()
+        .map(|t| t.map(|p| conduit::geom::Point3::new(p[0] as f64, p[1] as f64, p[2] as f64)))
+        .collect();
+    let max_x = cube
+        .iter()
+        .flat_map(|t| t.iter().map(|p| p.x))
+        .fold(f64::MIN, f64::max);
+    let shift = conduit::geom::Vector3::new(30.0, 0.0, 0.0);
+    let open: Vec<_> = cube
+        .iter()
+        .filter(|t| !t.iter().all(|p| (p.x - max_x).abs() < 1e-9))
+        .map(|t| t.map(|p| p + shift))
+        .collect();
+    assert_eq!(open.len(), 10, "two facets removed");
+    let model = dir.join("open_cube.stl");
+    write_stl(&model, &[cube.clone(), open.clone()].concat());
+    let out = conduit_env(
+        &slice_args(dir, "open", std::slice::from_ref(&model), &[]),
+        &[],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("open.json")).expect("report written"),
+    )
+    .expect("report is JSON");
+    let dropped = report["objects"][0]["slice"]["open_chains_dropped"]
+        .as_u64()
+        .expect("dropped count in the report");
+    assert_eq!(
+        dropped, 100,
+        "one open chain per 0.2 mm layer of the 20 mm box"
+    );
+    let err = stderr(&out);
+    let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning: ")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].contains(&model.display().to_string())
+            && warnings[0].contains("100 open contour(s) could not be closed"),
+        "{}",
+        warnings[0]
+    );
+
+    // The open box alone leaves nothing to print: the error says why.
+    write_stl(&model, &open);
+    let out = conduit_env(
+        &slice_args(dir, "open", std::slice::from_ref(&model), &[]),
+        &[],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("nothing to print") && err.contains("100 open contour(s) could not be closed"),
+        "{err}"
     );
 }

@@ -94,6 +94,30 @@ pub struct ElectronicsReport {
     /// Design problems found before routing, one line each (pads of different nets closer
     /// than two traces can pass).
     pub warnings: Vec<String>,
+    /// Parts that cannot be built in as placed, one line each: a footprint reaching beyond
+    /// the solid at its seating plane, a part above the object, two parts' footprints
+    /// overlapping. Each makes the job fail (see [`ElectronicsReport::failures`]).
+    pub part_problems: Vec<String>,
+}
+
+impl ElectronicsReport {
+    /// Why the circuit was not built as asked, one line each: the placement places no part,
+    /// a part problem, a wire not routed. Empty when every part sits inside the solid and
+    /// every wire is routed.
+    pub fn failures(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.parts.is_empty() {
+            out.push("the placement places no part of the circuit".to_owned());
+        }
+        out.extend(self.part_problems.iter().cloned());
+        out.extend(
+            self.wires
+                .iter()
+                .filter(|w| !w.routed)
+                .map(|w| format!("net {} could not be routed ({} to {})", w.net, w.from, w.to)),
+        );
+        out
+    }
 }
 
 /// One placed part in the report.
@@ -270,6 +294,9 @@ pub fn object_stage(
         .enumerate()
         .filter(|(_, p)| p.object == object)
         .collect();
+    report
+        .part_problems
+        .extend(part_problems(&mine, islands, zs));
     let cavities = carve_part_cavities(&mine, islands, zs, params.cavity_offset);
     let (mine_wires, between): (Vec<&CircuitWire>, Vec<&CircuitWire>) = circuit
         .wires
@@ -320,6 +347,109 @@ impl TraceStyle {
             height: params.conductive_height,
         }
     }
+}
+
+/// Footprint area beyond the solid (or overlap between two footprints) that is still taken as
+/// none, mm²: polygon rounding at the nanometre grid, and pads flush with a wall.
+const PROBLEM_AREA_MM2: f64 = 0.05;
+
+/// What is wrong with where the object's parts sit, before their cavities are cut: a part
+/// above the object, a footprint reaching beyond the solid at its seating plane (the layer
+/// under it, or the first layer for a part on the bed), two parts whose footprints overlap at
+/// heights both bodies take up (cavities merely touching are one pocket, which is fine).
+fn part_problems(
+    mine: &[(usize, &PlacedPart)],
+    islands: &[Vec<ExPolygon>],
+    zs: &[LayerZ],
+) -> Vec<String> {
+    let mut problems = Vec::new();
+    let Some(last) = zs.last() else {
+        return problems;
+    };
+    for (_, part) in mine {
+        let z = part.position.z;
+        if z > last.top + 1e-6 {
+            problems.push(format!(
+                "part {} is above the object: its seating plane z {z:.3} mm is {:.3} mm over \
+                 the object's top ({:.3} mm)",
+                part.name,
+                z - last.top,
+                last.top
+            ));
+            continue;
+        }
+        let layer = zs.iter().rposition(|l| l.top <= z + 1e-6).unwrap_or(0);
+        let footprint = [ExPolygon {
+            contour: part.footprint.clone(),
+            holes: Vec::new(),
+        }];
+        let beyond: f64 = crate::geom::difference(&footprint, &islands[layer])
+            .iter()
+            .map(ExPolygon::area_mm2)
+            .sum();
+        if beyond > PROBLEM_AREA_MM2 {
+            let reach = part
+                .footprint
+                .points
+                .iter()
+                .map(|&p| distance_outside(p, &islands[layer]))
+                .fold(0.0, f64::max);
+            problems.push(format!(
+                "part {} is not inside the object: {beyond:.1} of its {:.1} mm² footprint lies \
+                 outside the solid at z {:.3} mm, up to {reach:.2} mm beyond its edge",
+                part.name,
+                part.footprint.area_mm2().abs(),
+                zs[layer].top
+            ));
+        }
+    }
+    for (i, (_, a)) in mine.iter().enumerate() {
+        for (_, b) in &mine[i + 1..] {
+            let (a_top, b_top) = (a.position.z + a.body_height, b.position.z + b.body_height);
+            if a.position.z.max(b.position.z) >= a_top.min(b_top) - 1e-6 {
+                continue;
+            }
+            let body = |p: &PlacedPart| {
+                [ExPolygon {
+                    contour: p.footprint.clone(),
+                    holes: Vec::new(),
+                }]
+            };
+            let shared: f64 = crate::geom::intersection(&body(a), &body(b))
+                .iter()
+                .map(ExPolygon::area_mm2)
+                .sum();
+            if shared > PROBLEM_AREA_MM2 {
+                problems.push(format!(
+                    "parts {} and {} collide: their footprints share {shared:.1} mm² between z \
+                     {:.3} and {:.3} mm",
+                    a.name,
+                    b.name,
+                    a.position.z.max(b.position.z),
+                    a_top.min(b_top)
+                ));
+            }
+        }
+    }
+    problems
+}
+
+/// How far `p` lies outside `islands`, mm: 0 inside, else the distance to the nearest edge.
+fn distance_outside(p: Point2, islands: &[ExPolygon]) -> f64 {
+    if islands.iter().any(|i| i.contains(p)) {
+        return 0.0;
+    }
+    islands
+        .iter()
+        .flat_map(|i| std::iter::once(&i.contour).chain(&i.holes))
+        .flat_map(|ring| {
+            let n = ring.points.len();
+            (0..n).map(move |k| {
+                crate::geom::segment_distance(p, ring.points[k], ring.points[(k + 1) % n])
+                    / scaled(1.0) as f64
+            })
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The cavities of the object's parts (`mine`, with their placement indices), carved from its
@@ -663,7 +793,8 @@ fn part_event(id: usize, part: &PlacedPart) -> Event {
     }
 }
 
-/// Pick-and-place records of the placed parts (bed coordinates), for `.pos` and OpenPnP files.
+/// Pick-and-place records of the placed parts (bed coordinates), for the KiCad position files
+/// and the OpenPnP board: enabled for the parts the machine places (`method = "auto"`).
 pub fn pnp_records(circuit: &Circuit, parts: &[PlacedPart]) -> Vec<conduit_pnp::PlacementRecord> {
     parts
         .iter()
@@ -682,6 +813,10 @@ pub fn pnp_records(circuit: &Circuit, parts: &[PlacedPart]) -> Vec<conduit_pnp::
                 } else {
                     conduit_pnp::Side::Top
                 },
+                // Only parts the vacuum nozzle places are enabled: a machine must not try to
+                // pick a part inserted by hand or one that only gets pads.
+                enabled: p.method == PlacingMethod::Auto,
+                height: p.body_height,
             }
         })
         .collect()

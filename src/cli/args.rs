@@ -117,7 +117,8 @@ pub struct SliceArgs {
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
     /// Circuit to build into the object: an EAGLE schematic or board (.sch, .brd). Needs
-    /// `--placement`. Also writes OUT.pos (KiCad position CSV with PosZ) and OUT.openpnp.xml.
+    /// `--placement`. Also writes the pick-and-place files OUT.pos (KiCad's ASCII table, as
+    /// OpenPnP imports it), OUT-pos.csv (KiCad's CSV) and OUT.board.xml (an OpenPnP board).
     #[arg(long, value_name = "X.sch|X.brd", requires = "placement")]
     pub circuit: Option<PathBuf>,
     /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.
@@ -138,6 +139,11 @@ pub struct SliceArgs {
     /// key figures) instead of the text summary on stderr.
     #[arg(long)]
     pub json: bool,
+    /// Write the outputs even when the circuit is not built as asked (a wire not routed, a
+    /// part outside the solid or colliding with another, a placement that places nothing):
+    /// the problems become warnings and the exit code 0.
+    #[arg(long)]
+    pub allow_unrouted: bool,
 }
 
 /// Arguments of `conduit route`.
@@ -166,6 +172,11 @@ pub struct RouteArgs {
     /// key figures) instead of the text summary on stderr.
     #[arg(long)]
     pub json: bool,
+    /// Exit 0 even when the circuit is not built as asked (a wire not routed, a
+    /// part outside the solid or colliding with another, a placement that places nothing):
+    /// the problems become warnings. The drawings and report are written either way.
+    #[arg(long)]
+    pub allow_unrouted: bool,
 }
 
 /// Arguments of `conduit postprocess`.
@@ -202,6 +213,11 @@ pub struct PostprocessArgs {
     /// key figures) instead of the text summary on stderr.
     #[arg(long)]
     pub json: bool,
+    /// Rewrite the host's file even when the circuit is not built as asked (a wire not routed, a
+    /// part outside the solid or colliding with another, a placement that places nothing):
+    /// the problems become warnings and the exit code 0.
+    #[arg(long)]
+    pub allow_unrouted: bool,
 }
 
 /// Arguments of `conduit conform`.

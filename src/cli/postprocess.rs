@@ -47,6 +47,12 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
         Some(e) => {
             let done = edit_circuit(&gcode, &print, e, &config)
                 .with_context(|| path.display().to_string())?;
+            super::slice::refuse_unbuilt_circuit(
+                &done.plan.report,
+                args.allow_unrouted,
+                path,
+                "the host's file was left as it was",
+            )?;
             add_edited(&mut outputs, path, &done.gcode)?;
             (true, Some(done))
         }

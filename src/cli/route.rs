@@ -52,7 +52,12 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
             "report": r,
         }))?;
         super::slice::routing_warnings(r);
-        return Ok(());
+        return super::slice::refuse_unbuilt_circuit(
+            r,
+            args.allow_unrouted,
+            &args.out_dir,
+            "the drawings show where",
+        );
     }
     let lead = format!(
         "{}: {} layers drawn; ",
@@ -60,5 +65,10 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
         view.layers.len()
     );
     super::slice::print_routing(&view.report, &lead);
-    Ok(())
+    super::slice::refuse_unbuilt_circuit(
+        &view.report,
+        args.allow_unrouted,
+        &args.out_dir,
+        "the drawings show where",
+    )
 }

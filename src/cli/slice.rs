@@ -52,26 +52,17 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     let mut written = vec![args.output.clone()];
     if let Some(e) = &electronics {
         let records = pnp_records(&e.circuit, &summary.parts);
-        let pos = args.output.with_extension("pos");
-        let mut bytes = Vec::new();
-        conduit_pnp::write_kicad_pos(&records, &mut bytes)
-            .with_context(|| format!("{}: cannot write positions", pos.display()))?;
-        outputs.add(&pos, &bytes)?;
-        written.push(pos);
-        let xml = args.output.with_extension("openpnp.xml");
-        let name = args
-            .output
-            .file_stem()
-            .map_or_else(|| "board".to_owned(), |s| s.to_string_lossy().into_owned());
-        let mut bytes = Vec::new();
-        conduit_pnp::write_openpnp_board(&name, &records, &mut bytes)
-            .with_context(|| format!("{}: cannot write OpenPnP board", xml.display()))?;
-        outputs.add(&xml, &bytes)?;
-        written.push(xml);
+        for (path, bytes) in pick_and_place_files(&args.output, &records)? {
+            outputs.add(&path, &bytes)?;
+            written.push(path);
+        }
     }
     if let Some(report) = &args.report {
         let json = serde_json::to_vec_pretty(&summary).context("serialising the report")?;
         outputs.add(report, &json)?;
+    }
+    if let Some(r) = &summary.electronics {
+        refuse_unbuilt_circuit(r, args.allow_unrouted, &args.output, "nothing was written")?;
     }
     outputs.commit()?;
     written.extend(args.report.clone());
@@ -84,6 +75,7 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
             "estimated_time_s": summary.gcode.estimated_time_s,
             "report": summary,
         }))?;
+        model_warnings(&args, &summary);
         if let Some(r) = &summary.electronics {
             routing_warnings(r);
         }
@@ -99,6 +91,7 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         total,
         summary.gcode.estimated_time_s / 60.0
     );
+    model_warnings(&args, &summary);
     if let Some(r) = &summary.electronics {
         print_routing(r, "");
     }
@@ -121,6 +114,16 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// The slice's warnings about the models, naming the model when there is one.
+fn model_warnings(args: &SliceArgs, summary: &conduit::pipeline::SliceSummary) {
+    for w in summary.warnings() {
+        match args.models.as_slice() {
+            [one] => warnln!("{}: {w}", one.display()),
+            _ => warnln!("{w}"),
+        }
+    }
 }
 
 /// `conduit slice --curved clfff`: one G-code file, or one per section with
@@ -227,8 +230,38 @@ fn run_clfff(
     Ok(())
 }
 
-/// The routing summary line (after `lead`), the report's warnings and one line per wire that
-/// could not be routed, on stderr.
+/// The pick-and-place files beside `output` (`OUT.gcode`): `OUT.pos` (KiCad's ASCII table,
+/// what OpenPnP's KiCad importer reads), `OUT-pos.csv` (KiCad's CSV) and `OUT.board.xml`
+/// (an OpenPnP board), with their bytes.
+pub(crate) fn pick_and_place_files(
+    output: &std::path::Path,
+    records: &[conduit_pnp::PlacementRecord],
+) -> anyhow::Result<Vec<(std::path::PathBuf, Vec<u8>)>> {
+    let stem = output
+        .file_stem()
+        .map_or_else(|| "board".to_owned(), |s| s.to_string_lossy().into_owned());
+    let beside = |name: String| output.with_file_name(name);
+    let mut files = Vec::new();
+    let pos = output.with_extension("pos");
+    let mut bytes = Vec::new();
+    conduit_pnp::write_kicad_ascii(records, &mut bytes)
+        .with_context(|| format!("{}: cannot write positions", pos.display()))?;
+    files.push((pos, bytes));
+    let csv = beside(format!("{stem}-pos.csv"));
+    let mut bytes = Vec::new();
+    conduit_pnp::write_kicad_csv(records, &mut bytes)
+        .with_context(|| format!("{}: cannot write positions", csv.display()))?;
+    files.push((csv, bytes));
+    let xml = beside(format!("{stem}.board.xml"));
+    let mut bytes = Vec::new();
+    conduit_pnp::write_openpnp_board(&stem, records, &mut bytes)
+        .with_context(|| format!("{}: cannot write OpenPnP board", xml.display()))?;
+    files.push((xml, bytes));
+    Ok(files)
+}
+
+/// The routing summary line (after `lead`) and the report's warnings, on stderr. What was not
+/// built as asked is [`refuse_unbuilt_circuit`]'s to say.
 pub(crate) fn print_routing(r: &conduit::circuit::ElectronicsReport, lead: &str) {
     infoln!(
         "{lead}{} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
@@ -246,9 +279,39 @@ pub(crate) fn routing_warnings(r: &conduit::circuit::ElectronicsReport) {
     for w in &r.warnings {
         warnln!("{w}");
     }
-    for w in r.wires.iter().filter(|w| !w.routed) {
-        warnln!("net {} could not be routed ({} to {})", w.net, w.from, w.to);
+}
+
+/// A circuit job that did not build the circuit as asked (a wire not routed, a part outside
+/// the solid or colliding, a placement that places nothing) fails: each problem is printed as
+/// an `error:` line and the run exits 1 with `consequence` said about `output`. With
+/// `allow` (`--allow-unrouted`) the problems are warnings and the run goes on.
+pub(crate) fn refuse_unbuilt_circuit(
+    r: &conduit::circuit::ElectronicsReport,
+    allow: bool,
+    output: &std::path::Path,
+    consequence: &str,
+) -> Result<(), Failure> {
+    let failures = r.failures();
+    if failures.is_empty() {
+        return Ok(());
     }
+    for f in &failures {
+        if allow {
+            warnln!("{f}");
+        } else {
+            errorln!("{f}");
+        }
+    }
+    if allow {
+        return Ok(());
+    }
+    errorln!(
+        "{}: the circuit was not built as asked ({} problem(s) above); {consequence} \
+         (--allow-unrouted accepts it)",
+        output.display(),
+        failures.len()
+    );
+    Err(Failure::Reported)
 }
 
 /// The output set of a slice: none of its outputs may be one of the run's input files.

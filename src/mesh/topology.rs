@@ -257,13 +257,15 @@ pub(crate) fn shell_facing(mesh: &Mesh, shells: &Shells) -> Vec<Facing> {
             .map(|&s| shell_box(mesh, &members[s]))
             .collect();
         let grid = BoxGrid::new(&boxes);
+        let mut candidates = Vec::new();
         for &a in &closed {
             let probes = probe_points(mesh, &members[a]);
             let Some(first) = probes.first() else {
                 continue;
             };
             // Only a shell whose box holds the first probe can contain `a` (see `inside`).
-            for j in grid.candidates(first) {
+            grid.candidates(first, &mut candidates);
+            for &j in &candidates {
                 let b = closed[j];
                 if a != b && inside(mesh, &probes, &members[b], &boxes[j]) {
                     depth[a] += 1;
@@ -293,11 +295,13 @@ pub(crate) fn shell_facing(mesh: &Mesh, shells: &Shells) -> Vec<Facing> {
 /// point are found without testing every box: testing every shell against every other is
 /// quadratic, minutes for a file of 2¹⁸ component instances. Cells are as large as the median
 /// box; a box spanning more than [`BoxGrid::MAX_CELLS`] cells is kept in a list tried for every
-/// point.
+/// point. The registrations are one sorted list searched by cell, not a map of lists: millions
+/// of small per-cell allocations cost more than the search.
 struct BoxGrid {
     /// Side of a cell, or `None` when the boxes give no usable size (every box is then tried).
     cell: Option<f64>,
-    cells: std::collections::HashMap<[i64; 3], Vec<usize>>,
+    /// (cell, box) for every cell a box overlaps, sorted.
+    cells: Vec<([i64; 3], u32)>,
     /// Boxes tried for every point.
     big: Vec<usize>,
 }
@@ -319,28 +323,30 @@ impl BoxGrid {
             .filter(|c| c.is_finite() && *c > 0.0);
         let mut grid = BoxGrid {
             cell,
-            cells: std::collections::HashMap::new(),
+            cells: Vec::new(),
             big: Vec::new(),
         };
         for (j, (lo, hi)) in boxes.iter().enumerate() {
             let range = cell.map(|c| (Self::key(lo, c), Self::key(hi, c)));
-            let Some((from, to)) = range.filter(|(from, to)| {
+            let small = range.filter(|(from, to)| {
                 (0..3)
                     .map(|k| to[k].saturating_sub(from[k]).saturating_add(1))
                     .try_fold(1i64, |n, d| n.checked_mul(d))
                     .is_some_and(|n| n <= Self::MAX_CELLS)
-            }) else {
+            });
+            let (Some((from, to)), Ok(index)) = (small, u32::try_from(j)) else {
                 grid.big.push(j);
                 continue;
             };
             for x in from[0]..=to[0] {
                 for y in from[1]..=to[1] {
                     for z in from[2]..=to[2] {
-                        grid.cells.entry([x, y, z]).or_default().push(j);
+                        grid.cells.push(([x, y, z], index));
                     }
                 }
             }
         }
+        grid.cells.sort_unstable();
         grid
     }
 
@@ -348,17 +354,22 @@ impl BoxGrid {
         p.map(|c| (c / cell).floor() as i64)
     }
 
-    /// Indices of the boxes that may hold `p`, in increasing order.
-    fn candidates(&self, p: &Point3) -> Vec<usize> {
+    /// Indices of the boxes that may hold `p`, in increasing order, into `out` (cleared first).
+    fn candidates(&self, p: &Point3, out: &mut Vec<usize>) {
+        out.clear();
+        out.extend_from_slice(&self.big);
         let Some(cell) = self.cell else {
-            return self.big.clone();
+            return;
         };
-        let mut out = self.big.clone();
-        if let Some(v) = self.cells.get(&Self::key(&[p.x, p.y, p.z], cell)) {
-            out.extend_from_slice(v);
-        }
+        let key = Self::key(&[p.x, p.y, p.z], cell);
+        let from = self.cells.partition_point(|(k, _)| *k < key);
+        out.extend(
+            self.cells[from..]
+                .iter()
+                .take_while(|(k, _)| *k == key)
+                .map(|&(_, j)| j as usize),
+        );
         out.sort_unstable();
-        out
     }
 }
 

@@ -118,8 +118,25 @@ pub enum PipelineError {
     /// as loose or duplicated triangles, or objects thinner than a line).
     ///
     /// How to fix: give a closed solid; `conduit info` shows whether the mesh is closed.
-    #[error("nothing to print: no layer has an extrusion (the model has no printable volume)")]
-    NothingToPrint,
+    #[error(
+        "nothing to print: no layer has an extrusion (the model has no printable volume){}",
+        open_note(*dropped)
+    )]
+    NothingToPrint {
+        /// Open contours that could not be closed and were left out, over all objects.
+        dropped: usize,
+    },
+}
+
+/// The reason an empty print may have, when open contours were dropped.
+fn open_note(dropped: usize) -> String {
+    if dropped == 0 {
+        return String::new();
+    }
+    format!(
+        "; {dropped} open contour(s) could not be closed and were left out: the mesh has \
+         holes (`conduit info` shows them, `conduit convert --repair` fills them)"
+    )
 }
 
 /// What slicing one object found.
@@ -155,6 +172,25 @@ pub struct SliceSummary {
     /// files list.
     #[serde(skip)]
     pub parts: Vec<crate::circuit::PlacedPart>,
+}
+
+impl SliceSummary {
+    /// What the user should hear about on the terminal, one line each: objects whose open
+    /// contours could not be closed and were left out of the print (the mesh has holes).
+    pub fn warnings(&self) -> Vec<String> {
+        self.objects
+            .iter()
+            .filter(|o| o.slice.open_chains_dropped > 0)
+            .map(|o| {
+                format!(
+                    "object \"{}\": {} open contour(s) could not be closed and were left out \
+                     ({} closed across a gap); the mesh has holes: `conduit info` shows them, \
+                     `conduit convert --repair` fills them",
+                    o.name, o.slice.open_chains_dropped, o.slice.open_chains_closed
+                )
+            })
+            .collect()
+    }
 }
 
 /// Places every object of the scene on the bed: the scene's combined footprint is centred on the
@@ -464,7 +500,9 @@ pub fn slice_scene_with(
     let program = build_program_with(&objects, &extras, &cfg.program_params());
     drop(objects);
     if program.layers.iter().all(|l| l.paths().next().is_none()) {
-        return Err(PipelineError::NothingToPrint);
+        return Err(PipelineError::NothingToPrint {
+            dropped: summaries.iter().map(|o| o.slice.open_chains_dropped).sum(),
+        });
     }
     laps.lap(Stage::Program);
 

@@ -1,31 +1,35 @@
-//! Pick-and-place files: KiCad position CSV and OpenPnP board XML.
+//! Pick-and-place files: KiCad position files (ASCII and CSV) and OpenPnP board XML.
 //!
 //! Part of conduit's `formats/` layer, used by the emit stage: beside the G-code, the pipeline
 //! writes where each component goes, so that the vacuum nozzle (or an assembly house) can place
 //! it. The crate only describes the files and has no dependency on the pipeline.
 //!
-//! - [`write_kicad_pos`] / [`read_kicad_pos`]: KiCad's "Generate Placement Files" CSV
-//!   (`Ref,Val,Package,PosX,PosY,Rot,Side`) plus conduit's trailing `PosZ` column for parts
-//!   seated inside a printed object. The reader also takes KiCad's own files without `PosZ`.
-//! - [`write_openpnp_board`] / [`read_openpnp_board`]: an OpenPnP `*.board.xml`
-//!   (`<openpnp-board version="1.1">`, placements version 1.4).
+//! - [`write_kicad_ascii`] / [`read_kicad_ascii`]: KiCad's "Generate Placement Files" ASCII
+//!   table (`NAME.pos`), the file OpenPnP's KiCad importer reads; the reader follows that
+//!   importer's row pattern.
+//! - [`write_kicad_csv`] / [`read_kicad_csv`]: the same in KiCad's CSV layout
+//!   (`NAME-pos.csv`, `Ref,Val,Package,PosX,PosY,Rot,Side`).
+//! - [`write_openpnp_board`] / [`read_openpnp_board`]: an OpenPnP `NAME.board.xml`
+//!   (`<openpnp-board version="1.1">`, placements version 1.4), parts the machine does not
+//!   place marked `enabled="false"`, each part's height in a comment.
 //!
-//! Output is deterministic (same records, same bytes): `\n` line endings, every number with
-//! 4 decimals in millimetres or degrees, rotations normalised to `[0, 360)`. Writers refuse
-//! NaN and infinite numbers with [`std::io::ErrorKind::InvalidInput`]; readers never panic.
+//! Output is deterministic (same records, same bytes): `\n` line endings, numbers with fixed
+//! decimals in millimetres or degrees. Writers refuse NaN and infinite numbers with
+//! [`std::io::ErrorKind::InvalidInput`]; readers never panic.
 //!
 //! ```
 //! use conduit_pnp::{PlacementRecord, Side};
 //! let r = PlacementRecord {
 //!     reference: "R1".into(), value: "10k".into(), package: "R_0603".into(),
-//!     x: 12.5, y: -3.0, z: 1.2, rotation_deg: -90.0, side: Side::Top,
+//!     x: 12.5, y: -3.0, z: 1.2, rotation_deg: 270.0, side: Side::Top,
+//!     enabled: true, height: 0.6,
 //! };
 //! let mut csv = Vec::new();
-//! conduit_pnp::write_kicad_pos(&[r], &mut csv)?;
+//! conduit_pnp::write_kicad_csv(&[r], &mut csv)?;
 //! assert_eq!(
 //!     String::from_utf8_lossy(&csv),
-//!     "Ref,Val,Package,PosX,PosY,Rot,Side,PosZ\n\
-//!      \"R1\",\"10k\",\"R_0603\",12.5000,-3.0000,270.0000,top,1.2000\n"
+//!     "Ref,Val,Package,PosX,PosY,Rot,Side\n\
+//!      \"R1\",\"10k\",\"R_0603\",12.500000,-3.000000,-90.000000,top\n"
 //! );
 //! # Ok::<(), std::io::Error>(())
 //! ```
@@ -35,7 +39,7 @@ mod openpnp;
 #[cfg(test)]
 mod tests;
 
-pub use kicad::{read_kicad_pos, write_kicad_pos};
+pub use kicad::{read_kicad_ascii, read_kicad_csv, write_kicad_ascii, write_kicad_csv};
 pub use openpnp::{read_openpnp_board, write_openpnp_board};
 
 use std::io;
@@ -59,6 +63,11 @@ pub struct PlacementRecord {
     pub rotation_deg: f64,
     /// Board side the component sits on.
     pub side: Side,
+    /// Whether the machine places it: false for parts inserted by hand or not at all, which
+    /// the OpenPnP board marks `enabled="false"` and the KiCad files leave out.
+    pub enabled: bool,
+    /// Height of the part above its seating plane, mm (0 when unknown).
+    pub height: f64,
 }
 
 impl PlacementRecord {
@@ -122,6 +131,19 @@ pub enum PnpError {
         /// The field as found.
         value: String,
     },
+    /// A row of a KiCad ASCII position file does not match the importer's row pattern.
+    #[error(
+        "line {line}: not a position row (reference, value, package, x, y, rotation, side): `{found}`"
+    )]
+    PosRow {
+        /// Line of the row.
+        line: usize,
+        /// The row as found (its first 80 characters).
+        found: String,
+    },
+    /// The row pattern did not build (never expected: it is a constant).
+    #[error("internal row pattern: {0}")]
+    Pattern(String),
     /// The XML is not well formed.
     #[error("line {line}: XML error: {source}")]
     Xml {
@@ -169,13 +191,19 @@ pub enum PnpError {
 
 /// Formats a length or angle with the crate's fixed 4 decimals, refusing NaN and infinities.
 fn fixed4(v: f64) -> io::Result<String> {
+    fixed(v, 4)
+}
+
+/// Formats a number with `decimals` decimals, refusing NaN and infinities; a value that
+/// rounds to zero is written without a sign.
+fn fixed(v: f64, decimals: usize) -> io::Result<String> {
     if !v.is_finite() {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
             format!("cannot write non-finite number {v} to a placement file"),
         ));
     }
-    let s = format!("{v:.4}");
+    let s = format!("{v:.decimals$}");
     // Values in (-0.00005, 0] round to "-0.0000"; write them as "0.0000".
     Ok(match s.strip_prefix('-') {
         Some(abs) if abs.bytes().all(|b| b == b'0' || b == b'.') => abs.to_owned(),

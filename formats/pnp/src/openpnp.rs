@@ -15,7 +15,9 @@ use quick_xml::events::{BytesStart, Event};
 use crate::{PlacementRecord, PnpError, Side, fixed4, line_of, normalized_rotation, parse_finite};
 
 /// Writes an OpenPnP board named `name` holding `records` in the given order, all of type
-/// `Placement` and enabled, with locations in millimetres.
+/// `Placement`, with locations in millimetres: `enabled="false"` for records the machine does
+/// not place, and before each placement a comment with the part's height (OpenPnP keeps
+/// heights on its parts, not on the board, so the comment is for whoever sets those up).
 ///
 /// # Errors
 /// [`io::ErrorKind::InvalidInput`] if a number is NaN or infinite or a string holds a control
@@ -26,6 +28,11 @@ pub fn write_openpnp_board(
     out: &mut impl io::Write,
 ) -> io::Result<()> {
     let mut text = format!("<openpnp-board version=\"1.1\" name=\"{}\">\n", attr(name)?);
+    text.push_str(
+        "   <!-- Locations are in the printer's bed coordinates, mm: put the board at X 0, Y 0, \
+         Z 0, rotation 0 in the job. z is each part's seating plane (0 on a flat board, higher \
+         inside a printed object). -->\n",
+    );
     text.push_str("   <placements>\n");
     for r in records {
         let side = match r.side {
@@ -33,11 +40,17 @@ pub fn write_openpnp_board(
             Side::Bottom => "Bottom",
         };
         text += &format!(
+            "      <!-- {}: height {} mm -->\n",
+            comment(&r.reference),
+            fixed4(r.height)?
+        );
+        text += &format!(
             "      <placement version=\"1.4\" id=\"{}\" side=\"{side}\" part-id=\"{}\" \
-             type=\"Placement\" enabled=\"true\">\n         <location units=\"Millimeters\" \
+             type=\"Placement\" enabled=\"{}\">\n         <location units=\"Millimeters\" \
              x=\"{}\" y=\"{}\" z=\"{}\" rotation=\"{}\"/>\n      </placement>\n",
             attr(&r.reference)?,
             attr(&r.part_id())?,
+            r.enabled,
             fixed4(r.x)?,
             fixed4(r.y)?,
             fixed4(r.z)?,
@@ -71,6 +84,14 @@ fn attr(s: &str) -> io::Result<String> {
     Ok(out)
 }
 
+/// `s` made safe inside an XML comment (no `--`, no control characters).
+fn comment(s: &str) -> String {
+    s.chars()
+        .map(|c| if c.is_control() { '?' } else { c })
+        .collect::<String>()
+        .replace("--", "- -")
+}
+
 /// A `<placement>` whose end tag has not been read yet.
 struct Open {
     attrs: Vec<(String, String)>,
@@ -80,8 +101,9 @@ struct Open {
 
 /// Reads the placements of an OpenPnP board file, in file order, converting lengths to mm.
 ///
-/// Placements that OpenPnP would not place are skipped: `type="Fiducial"`, the pre-1.4
-/// `type="Ignore"`, and `enabled="false"`. Other children of the board are ignored.
+/// Fiducials (`type="Fiducial"`) are skipped; placements OpenPnP would not place (the pre-1.4
+/// `type="Ignore"`, or `enabled="false"`) are returned with `enabled` false. Heights are 0
+/// (the board has none). Other children of the board are ignored.
 ///
 /// # Errors
 /// [`PnpError::Xml`] with the line for malformed XML, [`PnpError::NotABoard`], or an error
@@ -164,7 +186,7 @@ fn get<'a>(attrs: &'a [(String, String)], key: &str) -> Option<&'a str> {
         .map(|(_, v)| v.as_str())
 }
 
-/// Turns a finished `<placement>` into a record, unless OpenPnP would not place it.
+/// Turns a finished `<placement>` into a record, unless it is a fiducial.
 fn finish(open: Option<Open>, records: &mut Vec<PlacementRecord>) -> Result<(), PnpError> {
     let Some(Open {
         attrs,
@@ -196,8 +218,9 @@ fn finish(open: Option<Open>, records: &mut Vec<PlacementRecord>) -> Result<(), 
         "Bottom" => Side::Bottom,
         other => return Err(invalid("side", other)),
     };
-    let skipped = matches!(get(&attrs, "type"), Some("Fiducial" | "Ignore"))
-        || get(&attrs, "enabled").is_some_and(|v| v.eq_ignore_ascii_case("false"));
+    let skipped = get(&attrs, "type") == Some("Fiducial");
+    let enabled = get(&attrs, "type") != Some("Ignore")
+        && !get(&attrs, "enabled").is_some_and(|v| v.eq_ignore_ascii_case("false"));
     let (loc, loc_line) = location.ok_or_else(|| missing("<location>"))?;
     if skipped {
         return Ok(());
@@ -244,6 +267,8 @@ fn finish(open: Option<Open>, records: &mut Vec<PlacementRecord>) -> Result<(), 
         z: num("z")? * mm,
         rotation_deg: num("rotation")?,
         side,
+        enabled,
+        height: 0.0,
     });
     Ok(())
 }
