@@ -769,7 +769,8 @@ fn bad_input_fails_with_a_clear_message_and_writes_nothing() {
     let (code, err) = run_fail(&short, &["--dialect", "urscript"]);
     assert_eq!(code, Some(1), "{err}");
     assert!(
-        err.contains("robot.toml:5") && err.contains("length 6"),
+        err.contains("robot.toml:5")
+            && err.contains("robot.workpiece_frame must be a list of 6 values"),
         "{err}"
     );
     let nan = config(dir.path(), "[robot]\ntool_frame = [0, 0, 100, 0, nan, 0]\n");

@@ -16,6 +16,7 @@ mod docs;
 mod electronics;
 mod electronics_corpus;
 mod golden;
+mod grammar;
 mod jet;
 mod outputs;
 mod postprocess;

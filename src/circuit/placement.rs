@@ -220,6 +220,8 @@ pub enum Problem {
     UnknownPart {
         /// Part name.
         part: String,
+        /// The circuit's part whose name is closest, when one is close enough to be a typo.
+        closest: Option<String>,
     },
     /// A part placed more than once.
     DuplicatePart {
@@ -230,6 +232,8 @@ pub enum Problem {
     UnknownNet {
         /// Net name.
         net: String,
+        /// The circuit's net whose name is closest, when one is close enough to be a typo.
+        closest: Option<String>,
     },
     /// A net listed more than once.
     DuplicateNet {
@@ -242,6 +246,8 @@ pub enum Problem {
         net: String,
         /// The endpoint as written.
         pin: String,
+        /// The closest existing pin (`PART.PAD`), when one is close enough to be a typo.
+        closest: Option<String>,
     },
     /// A wire end on a pad of another net.
     PinNotOnNet {
@@ -295,22 +301,67 @@ pub enum Problem {
     },
 }
 
+/// `; did you mean "X"?` after a name that is not in the circuit, when a close one is.
+fn did_you_mean(f: &mut std::fmt::Formatter<'_>, closest: &Option<String>) -> std::fmt::Result {
+    match closest {
+        Some(c) => write!(f, "; did you mean \"{c}\"?"),
+        None => Ok(()),
+    }
+}
+
+/// The name of `candidates` closest to `name` (ASCII case ignored, as EAGLE compares names),
+/// when it is close enough to be a typo: a few letters changed, not two thirds of the name.
+fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<String> {
+    let wanted = name.to_ascii_lowercase();
+    candidates
+        .into_iter()
+        .map(|c| {
+            (
+                strsim::damerau_levenshtein(&wanted, &c.to_ascii_lowercase()),
+                c,
+            )
+        })
+        .filter(|(d, _)| *d <= 2.max(name.chars().count() / 3))
+        .min()
+        .map(|(_, c)| c.to_owned())
+}
+
+/// The existing pin closest to `pin`: the closest pad of its part, or, when the part is not in
+/// the circuit, the same pad of the closest part.
+fn closest_pin(circuit: &Circuit, pin: &PinRef) -> Option<String> {
+    match circuit.part(&pin.part) {
+        Some(part) => closest(&pin.pad, part.pads.iter().map(|p| p.name.as_str()))
+            .map(|pad| PinRef::new(&pin.part, &pad).to_string()),
+        None => {
+            let name = closest(&pin.part, circuit.parts.iter().map(|p| p.name.as_str()))?;
+            let part = circuit.part(&name)?;
+            let pad = part.pad(&pin.pad)?;
+            Some(PinRef::new(&name, &pad.name).to_string())
+        }
+    }
+}
+
 impl std::fmt::Display for Problem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Problem::UnknownPart { part } => {
-                write!(f, "placement: part \"{part}\" is not in the circuit")
+            Problem::UnknownPart { part, closest } => {
+                write!(f, "placement: part \"{part}\" is not in the circuit")?;
+                did_you_mean(f, closest)
             }
             Problem::DuplicatePart { part } => {
                 write!(f, "placement: part \"{part}\" is placed more than once")
             }
-            Problem::UnknownNet { net } => {
-                write!(f, "placement: net \"{net}\" is not in the circuit")
+            Problem::UnknownNet { net, closest } => {
+                write!(f, "placement: net \"{net}\" is not in the circuit")?;
+                did_you_mean(f, closest)
             }
             Problem::DuplicateNet { net } => {
                 write!(f, "placement: net \"{net}\" is listed more than once")
             }
-            Problem::UnknownPin { net, pin } => write!(f, "net {net}: pin {pin} does not exist"),
+            Problem::UnknownPin { net, pin, closest } => {
+                write!(f, "net {net}: pin {pin} does not exist")?;
+                did_you_mean(f, closest)
+            }
             Problem::PinNotOnNet { net, pin } => {
                 write!(f, "net {net}: pin {pin} is not on this net")
             }
@@ -457,16 +508,28 @@ impl Placement {
     /// # Errors
     /// [`PlacementError::Toml`] for invalid TOML or keys.
     pub fn from_toml(text: &str) -> Result<Self, PlacementError> {
-        let placement: Self = toml::from_str(text).map_err(|e: toml::de::Error| {
+        let located = |e: toml::de::Error, key: Option<String>| {
             let before = |at: usize| &text.as_bytes()[..at.min(text.len())];
+            let message = e.message().trim();
+            // A value of the wrong type in words, after its key: `part[0].x must be a number
+            // in mm, got "a"`.
+            let message = match (key, crate::scene::words::must_be(message, None)) {
+                (Some(k), Some(words)) => format!("{k} {words}"),
+                (None, Some(words)) => words,
+                (_, None) => message.to_owned(),
+            };
             PlacementError::Toml {
                 line: e.span().map_or(0, |s| {
                     before(s.start).iter().filter(|&&c| c == b'\n').count() + 1
                 }),
-                message: e.message().trim().to_owned(),
+                message,
             }
-        })?;
-        Ok(placement)
+        };
+        let deserializer = toml::Deserializer::parse(text).map_err(|e| located(e, None))?;
+        serde_path_to_error::deserialize(deserializer).map_err(|e| {
+            let key = e.path().to_string();
+            located(e.into_inner(), (key != ".").then_some(key))
+        })
     }
 
     /// The elements of an EAGLE board as parts lying on the plane `z`, shifted by `offset`
@@ -597,6 +660,7 @@ impl Placement {
             if circuit.part(&p.name).is_none() {
                 problems.push(Problem::UnknownPart {
                     part: p.name.clone(),
+                    closest: closest(&p.name, circuit.parts.iter().map(|q| q.name.as_str())),
                 });
             } else if self.parts[..i].iter().any(|q| q.name == p.name) {
                 problems.push(Problem::DuplicatePart {
@@ -608,6 +672,7 @@ impl Placement {
             let Some(net) = circuit.net(&n.name) else {
                 problems.push(Problem::UnknownNet {
                     net: n.name.clone(),
+                    closest: closest(&n.name, circuit.nets.iter().map(|m| m.name.as_str())),
                 });
                 continue;
             };
@@ -639,6 +704,7 @@ impl Placement {
                             None => problems.push(Problem::UnknownPin {
                                 net: n.name.clone(),
                                 pin: pin.to_string(),
+                                closest: closest_pin(circuit, pin),
                             }),
                             Some(pad) => {
                                 let resolved = PinRef::new(&pin.part, &pad.name);
@@ -797,7 +863,7 @@ pub(crate) mod tests {
         let Ok(p) = p else { panic!("{p:?}") };
         let msg = err_text(p.validate(&sample()));
         for want in [
-            "placement: part \"R9\" is not in the circuit",
+            "placement: part \"R9\" is not in the circuit; did you mean \"R1\"?",
             "placement: part \"R1\": z must be a finite number",
             "net VCC: pin LED1.X does not exist",
             "net VCC: waypoint \"w9\" is not defined",
@@ -868,6 +934,13 @@ pub(crate) mod tests {
         );
         let msg = err_text(Placement::from_toml("origin = \"centre\""));
         assert!(msg.contains("line 1") && msg.contains("centre"), "{msg}");
+        // Values of the wrong type in words, after their key.
+        let msg = err_text(Placement::from_toml("[[part]]\nname = 3\n"));
+        assert_eq!(msg, "line 2: part[0].name must be text in quotes, got 3");
+        let msg = err_text(Placement::from_toml(
+            "[[part]]\nname = \"R1\"\nx = \"a\"\ny = 0\nz = 0\n",
+        ));
+        assert_eq!(msg, "line 3: part[0].x must be a number, got \"a\"");
         let path = dir.path().join("p.json");
         assert!(err_text(Placement::load(&path)).contains("p.json"));
     }

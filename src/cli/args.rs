@@ -5,7 +5,7 @@ use conduit::scene::MeshFormat;
 use std::path::PathBuf;
 
 /// What `conduit conform --dialect` writes.
-const DIALECTS: [&str; 6] = [
+pub(crate) const DIALECTS: [&str; 6] = [
     "gcode",
     "urscript",
     "krl",
@@ -18,6 +18,12 @@ const DIALECTS: [&str; 6] = [
 #[derive(Debug, Parser)]
 #[command(name = "conduit", version, about, long_about = None, propagate_version = true)]
 pub struct Cli {
+    /// Print only errors on stderr: no progress bars, summaries or warnings.
+    #[arg(short, long, global = true, conflicts_with = "verbose")]
+    pub quiet: bool,
+    /// Print the details a warning sums up, such as every ignored PrusaSlicer setting.
+    #[arg(short, long, global = true)]
+    pub verbose: bool,
     /// The command to run.
     #[command(subcommand)]
     pub command: Command,
@@ -108,7 +114,7 @@ pub struct SliceArgs {
     pub output: PathBuf,
     /// Also write a JSON report (objects, layers, filament, time, stage timings; with a circuit
     /// also parts and, per wire, routed/length/lower bound/layer changes/perimeter crossings).
-    #[arg(long, value_name = "REPORT.json")]
+    #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
     /// Circuit to build into the object: an EAGLE schematic or board (.sch, .brd). Needs
     /// `--placement`. Also writes the pick-and-place files OUT.pos (KiCad's ASCII table, as
@@ -129,6 +135,10 @@ pub struct SliceArgs {
     /// one file with a tool per section. Sets `curved.split_sections`.
     #[arg(long)]
     pub split_sections: bool,
+    /// Print one JSON document on stdout summarising what was done (outputs written, counts,
+    /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
     /// Write the outputs even when the circuit is not built as asked (a wire not routed, a
     /// part outside the solid or colliding with another, a placement that places nothing):
     /// the problems become warnings and the exit code 0.
@@ -151,13 +161,17 @@ pub struct RouteArgs {
     /// Where the parts go: a placement TOML or an Electronic Slic3r .3de file.
     #[arg(long, value_name = "P.toml|P.3de")]
     pub placement: PathBuf,
-    /// Folder for `layer_0001.svg`... (created if missing).
-    #[arg(short, long = "out-dir", value_name = "DIR")]
+    /// Folder for `layer_0001.svg`... (made when missing). `-o` is taken as an older spelling.
+    #[arg(long = "out-dir", short_alias = 'o', value_name = "DIR")]
     pub out_dir: PathBuf,
     /// Also write the JSON report (parts; per wire routed, length, lower bound, layer changes,
     /// perimeter crossings; totals).
-    #[arg(long, value_name = "REPORT.json")]
+    #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
+    /// Print one JSON document on stdout summarising what was done (outputs written, counts,
+    /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
     /// Exit 0 even when the circuit is not built as asked (a wire not routed, a
     /// part outside the solid or colliding with another, a placement that places nothing):
     /// the problems become warnings. The drawings and report are written either way.
@@ -195,6 +209,10 @@ pub struct PostprocessArgs {
     /// stays in the output folder).
     #[arg(long, value_name = "NAME")]
     pub output_name: Option<String>,
+    /// Print one JSON document on stdout summarising what was done (outputs written, counts,
+    /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
     /// Rewrite the host's file even when the circuit is not built as asked (a wire not routed, a
     /// part outside the solid or colliding with another, a placement that places nothing):
     /// the problems become warnings and the exit code 0.
@@ -243,29 +261,27 @@ pub struct ConformArgs {
     /// Settings (`[conform]`, `[robot]`, tools, printer).
     #[command(flatten)]
     pub config: ConfigSource,
-    /// The file to write: G-code, or the program of `--dialect`.
-    #[arg(short = 'o', long = "out", value_name = "OUT")]
-    pub out: PathBuf,
-    /// What to write: `gcode` (3-axis, the printer's flavour), `urscript`, `krl` (KUKA .src),
-    /// `rapid` (ABB module), `poses-csv` (x,y,z,qw,qx,qy,qz,dispense) or `gcode-5axis`
-    /// (`robot.five_axis`: I J K tool vectors, or a head or table with rotary axes). The
-    /// `[robot]` section sets frames, clearance, speeds and the dispense output.
+    /// The file to write: G-code, or the program of `--dialect` (`--out` is the older
+    /// spelling).
+    // `--output` once named the dialect (`--output krl`): a value that is a dialect name, given
+    // beside the file and without `--dialect`, is still read as one with a warning. The values
+    // are collected (not refused as a repeated option) to tell the two apart; see
+    // `conform::output_and_dialect`.
     #[arg(
-        long,
-        value_name = "DIALECT",
-        default_value = "gcode",
-        value_parser = DIALECTS
-    )]
-    pub dialect: String,
-    /// The older spelling of `--dialect`: still taken, with a warning.
-    #[arg(
+        short = 'o',
         long = "output",
-        value_name = "DIALECT",
-        hide = true,
-        conflicts_with = "dialect",
-        value_parser = DIALECTS
+        alias = "out",
+        value_name = "OUT",
+        required = true,
+        action = clap::ArgAction::Append
     )]
-    pub output_dialect: Option<String>,
+    pub output: Vec<PathBuf>,
+    /// What to write: `gcode` (3-axis, the printer's flavour; the default), `urscript`, `krl`
+    /// (KUKA .src), `rapid` (ABB module), `poses-csv` (x,y,z,qw,qx,qy,qz,dispense) or
+    /// `gcode-5axis` (`robot.five_axis`: I J K tool vectors, or a head or table with rotary
+    /// axes). The `[robot]` section sets frames, clearance, speeds and the dispense output.
+    #[arg(long, value_name = "DIALECT", value_parser = DIALECTS)]
+    pub dialect: Option<String>,
     /// Tool axis per point: `vertical` (3-axis planning with its corrections, the default),
     /// `normal` (along the surface normal, smoothed along the path over
     /// `robot.axis_smoothing`, tilt limited by `--max-tilt`; standoff along the axis) or
@@ -285,6 +301,10 @@ pub struct ConformArgs {
     /// controls, contacts, replay, tool orientation).
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
+    /// Print one JSON document on stdout summarising what was done (outputs written, counts,
+    /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `conduit jet`.
@@ -317,6 +337,10 @@ pub struct JetArgs {
     /// layer plan, totals.
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
+    /// Print one JSON document on stdout summarising what was done (outputs written, counts,
+    /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Subcommands of `conduit jet`.
@@ -375,8 +399,9 @@ pub struct PreviewArgs {
     /// G-code file to draw.
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
-    /// Folder for `layer_0001.svg`... and `contact_sheet.png` (created if missing).
-    #[arg(short, long = "out-dir", value_name = "DIR")]
+    /// Folder for `layer_0001.svg`... and `contact_sheet.png` (made when missing). `-o` is
+    /// taken as an older spelling.
+    #[arg(long = "out-dir", short_alias = 'o', value_name = "DIR")]
     pub out_dir: PathBuf,
     /// Contact sheet: every Nth layer (default: the smallest N giving at most 36 tiles).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
@@ -384,6 +409,10 @@ pub struct PreviewArgs {
     /// Contact sheet tile size, pixels.
     #[arg(long, value_name = "PX", default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=4096))]
     pub tile: u32,
+    /// Print one JSON document on stdout summarising what was done (outputs written, counts,
+    /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `conduit config`.
@@ -425,7 +454,7 @@ pub struct ConvertArgs {
     /// Output format for batch conversion (with --out-dir).
     #[arg(long, value_enum, value_name = "FORMAT", requires = "out_dir")]
     pub to: Option<MeshFormat>,
-    /// Folder for batch outputs, named after each input's file stem.
+    /// Folder for batch outputs, named after each input's file stem (made when missing).
     #[arg(long, value_name = "DIR")]
     pub out_dir: Option<PathBuf>,
     /// Repair meshes before writing (merge near vertices, drop degenerate facets, fix winding, fill holes).
@@ -434,4 +463,8 @@ pub struct ConvertArgs {
     /// Write ASCII instead of binary STL.
     #[arg(long)]
     pub ascii: bool,
+    /// Print one JSON document on stdout summarising what was done (outputs written, counts,
+    /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -46,6 +46,10 @@ pub struct TcpArgs {
     /// Also write the result and the residuals as JSON.
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
+    /// Print the result as one JSON document on stdout (the report's content and the files
+    /// written) instead of text.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `conduit calibrate register`.
@@ -64,6 +68,10 @@ pub struct RegisterArgs {
     /// median residual, at least 0.01 mm.
     #[arg(long, value_name = "MM")]
     pub outlier: Option<f64>,
+    /// Print the result as one JSON document on stdout (the report's content and the files
+    /// written) instead of text.
+    #[arg(long)]
+    pub json: bool,
 }
 
 pub(crate) fn run(args: CalibrateArgs) -> Result<(), Failure> {
@@ -118,6 +126,16 @@ fn run_tcp(args: TcpArgs) -> Result<(), Failure> {
     let named = |e: tcp::TcpError| anyhow!("{file}: {e}");
     let flange = tcp::flange_poses(&text, &cfg.robot.dh).map_err(named)?;
     let p = tcp::pivot(&flange.poses, &flange.lines, flange.source).map_err(named)?;
+    if args.json {
+        let report = TcpReport { file, result: &p };
+        if let Some(path) = &args.report {
+            write_report(path, &report, &inputs(&args))?;
+        }
+        return super::print_json(&serde_json::json!({
+            "outputs": super::paths(args.report.as_deref()),
+            "report": report,
+        }));
+    }
 
     let source = match p.source {
         PoseSource::Quaternions => "positions and quaternions",
@@ -161,12 +179,16 @@ fn run_tcp(args: TcpArgs) -> Result<(), Failure> {
         list(&cfg.robot.tool_frame[3..], 4, ", ")
     )?;
     if let Some(path) = &args.report {
-        let inputs: Vec<&PathBuf> = std::iter::once(&args.poses)
-            .chain(&args.config.config)
-            .collect();
-        write_report(path, &TcpReport { file, result: &p }, &inputs)?;
+        write_report(path, &TcpReport { file, result: &p }, &inputs(&args))?;
     }
     Ok(())
+}
+
+/// The inputs of a `tcp` run, which its report may not overwrite.
+fn inputs(args: &TcpArgs) -> Vec<&PathBuf> {
+    std::iter::once(&args.poses)
+        .chain(&args.config.config)
+        .collect()
 }
 
 /// The JSON report of `conduit calibrate register`.
@@ -184,6 +206,21 @@ fn run_register(args: RegisterArgs) -> Result<(), Failure> {
     let a = frames::read_measured(&read(&args.a)?).map_err(|e| anyhow!("{fa}: {e}"))?;
     let b = frames::read_measured(&read(&args.b)?).map_err(|e| anyhow!("{fb}: {e}"))?;
     let f = frames::register_frames(&a, &b, rule).map_err(|e| anyhow!("{fa} and {fb}: {e}"))?;
+    if args.json {
+        let report = RegisterReport {
+            a: fa,
+            b: fb,
+            result: &f,
+        };
+        if let Some(path) = &args.report {
+            write_report(path, &report, &[&args.a, &args.b])?;
+        }
+        warn_outliers(&f);
+        return super::print_json(&serde_json::json!({
+            "outputs": super::paths(args.report.as_deref()),
+            "report": report,
+        }));
+    }
     print_transform(&fa, &fb, &f)?;
     print_residuals(&f)?;
     warn_outliers(&f);
@@ -316,8 +353,8 @@ fn warn_outliers(f: &FrameFit) {
     ] {
         let pairs = named(used);
         if !pairs.is_empty() {
-            eprintln!(
-                "warning: {} outlier(s) {what}: {}; measure them again or check the row order",
+            warnln!(
+                "{} outlier(s) {what}: {}; measure them again or check the row order",
                 pairs.len(),
                 pairs.join(", ")
             );

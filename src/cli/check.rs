@@ -40,8 +40,8 @@ pub(crate) fn run(args: CheckArgs) -> Result<(), Failure> {
         outln!("{}: {report}", args.file.display())?;
     }
     if report.has_errors() {
-        eprintln!(
-            "error: {}: {} error-level finding(s)",
+        errorln!(
+            "{}: {} error-level finding(s)",
             args.file.display(),
             report.errors
         );

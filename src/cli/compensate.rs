@@ -99,7 +99,7 @@ pub struct CompensateArgs {
     #[arg(long, value_name = "FILE", requires = "dialect")]
     pub program: Option<PathBuf>,
     /// The program's dialect: `urscript`, `krl`, `rapid` or `gcode-5axis` (as `conduit conform
-    /// --output`; frames, speeds and dispense outputs from `[robot]`).
+    /// --dialect`; frames, speeds and dispense outputs from `[robot]`).
     #[arg(long, value_name = "DIALECT", requires = "program",
           value_parser = ["urscript", "krl", "rapid", "gcode-5axis"])]
     pub dialect: Option<String>,
@@ -107,6 +107,10 @@ pub struct CompensateArgs {
     /// the real gaps after each pass.
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
+    /// Print one JSON document on stdout summarising what was done (outputs written, counts,
+    /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Subcommands of `conduit compensate`.
@@ -152,6 +156,10 @@ pub struct PatternArgs {
     /// The pose table to write.
     #[arg(short, long, value_name = "PATH.csv")]
     pub output: PathBuf,
+    /// Print one JSON document on stdout summarising what was done (outputs written, counts,
+    /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `A,B,C` as three numbers.
@@ -342,6 +350,14 @@ fn output_set(job: &Job) -> OutputSet {
     set
 }
 
+/// The files a compensation run writes besides `--readings-out`: the table, the program and
+/// the report.
+fn written<'a>(job: &'a Job) -> impl Iterator<Item = &'a Path> {
+    std::iter::once(job.output.as_path())
+        .chain(job.args.program.as_deref())
+        .chain(job.args.report.as_deref())
+}
+
 /// One pass over measured gaps.
 fn measured(job: &Job, gaps_path: &Path) -> Result<(), Failure> {
     let Job {
@@ -358,8 +374,8 @@ fn measured(job: &Job, gaps_path: &Path) -> Result<(), Failure> {
     let on =
         gaps::read(&text, &poses.arc_lengths()).with_context(|| gaps_path.display().to_string())?;
     if on.outside > 0 {
-        eprintln!(
-            "warning: {}: {} pose(s) lie outside the measured stretch and take the nearest reading",
+        warnln!(
+            "{}: {} pose(s) lie outside the measured stretch and take the nearest reading",
             gaps_path.display(),
             on.outside
         );
@@ -377,7 +393,14 @@ fn measured(job: &Job, gaps_path: &Path) -> Result<(), Failure> {
     }
     outputs.commit()?;
     let (b, c) = (done.report.before_mm, done.report.correction_mm);
-    eprintln!(
+    if args.json {
+        return super::print_json(&serde_json::json!({
+            "outputs": super::paths(written(job)),
+            "poses": done.poses.len(),
+            "report": done.report,
+        }));
+    }
+    infoln!(
         "{}: {} poses; gap before {:.4}..{:.4} mm (variation {:.1} µm, RMS {:.1} µm about {:.1} µm); \
          correction {:.4}..{:.4} mm",
         output.display(),
@@ -424,6 +447,14 @@ fn simulated(job: &Job, spec: &str) -> Result<(), Failure> {
         add_report(&mut outputs, r, &done.report)?;
     }
     outputs.commit()?;
+    if args.json {
+        return super::print_json(&serde_json::json!({
+            "outputs": super::paths(written(job).chain(args.readings_out.as_deref())),
+            "poses": poses.poses.len(),
+            "surface": spec,
+            "report": done.report,
+        }));
+    }
     let figures: Vec<String> = done
         .report
         .variation_um
@@ -437,7 +468,7 @@ fn simulated(job: &Job, spec: &str) -> Result<(), Failure> {
             }
         })
         .collect();
-    eprintln!(
+    infoln!(
         "{}: {} poses on {spec}; gap variation: {}",
         output.display(),
         poses.poses.len(),
@@ -456,7 +487,7 @@ fn load_substrate(spec: &str, cfg: &Config) -> Result<Substrate, Failure> {
     };
     let scan = load_scan(&file, false, cfg.conform.fold_gap).map_err(anyhow::Error::from)?;
     for w in &scan.warnings {
-        eprintln!("warning: {}: {w}", file.display());
+        warnln!("{}: {w}", file.display());
     }
     Ok(Substrate::Mesh(Box::new(scan.surface)))
 }
@@ -506,7 +537,15 @@ fn run_pattern(args: PatternArgs) -> Result<(), Failure> {
     outputs.input(Path::new(&args.surface));
     add_table(&mut outputs, &args.output, &comments, &poses)?;
     outputs.commit()?;
-    eprintln!(
+    if args.json {
+        return super::print_json(&serde_json::json!({
+            "outputs": super::paths([args.output.as_path()]),
+            "shape": shape,
+            "poses": poses.len(),
+            "surface": args.surface,
+        }));
+    }
+    infoln!(
         "{}: {shape}, {} poses on {}",
         args.output.display(),
         poses.len(),

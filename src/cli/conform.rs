@@ -16,21 +16,31 @@ use conduit::scene::{Content, LoadOptions, OutputSet, load};
 use serde::Serialize;
 
 pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
+    let (file, dialect_name) = output_and_dialect(&args)?;
+    let args = ConformArgs {
+        output: vec![file],
+        ..args
+    };
     let mut cfg = resolve(&args.config)?;
     match args.mapping.as_deref() {
         Some("geodesic") => cfg.conform.mapping = Mapping::Geodesic,
         Some(_) => cfg.conform.mapping = Mapping::Projection,
         None => {}
     }
-    let params = ConformParams::from_settings(&cfg.conform).context("invalid configuration")?;
-    let dialect_name = dialect_name(&args);
+    // The `[conform]` settings are checked here rather than by the config's own validation:
+    // the error names the config file when there is one.
+    let params =
+        ConformParams::from_settings(&cfg.conform).with_context(|| match &args.config.config {
+            Some(path) => format!("{}: invalid config", path.display()),
+            None => "invalid config".to_owned(),
+        })?;
     let dialect = Dialect::from_name(&dialect_name);
     let orient = orientation(&args, &cfg, dialect)?;
     let place = args.place.as_deref().map(parse_place).transpose()?;
     let scan = load_scan(&args.surface, args.as_cloud, cfg.conform.fold_gap)
         .map_err(anyhow::Error::from)?;
     for w in &scan.warnings {
-        eprintln!("warning: {}: {w}", args.surface.display());
+        warnln!("{}: {w}", args.surface.display());
     }
     let refs = refs(&args)?;
     let design = match load(&args.design, &LoadOptions::default())
@@ -50,14 +60,25 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
         params,
         orient,
         dialect,
-        program_name: args
-            .out
+        program_name: out_path(&args)
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default(),
     };
     let out = walk::run(job, &cfg, |_| {}).map_err(|e| located(e, &args))?;
     write_outputs(&args, &out)?;
+    if args.json {
+        super::print_json(&serde_json::json!({
+            "outputs": super::paths(std::iter::once(out_path(&args)).chain(args.report.as_deref())),
+            "dialect": dialect_name,
+            "moves": out.moves,
+            "report": FullReport {
+                conform: &out.report,
+                orientation: &out.orientation,
+            },
+        }))?;
+        return warnings(&args, &out.report);
+    }
     match out.moves {
         Some(moves) => print_program_summary(&args, &dialect_name, &out, moves),
         None => print_gcode_summary(&args, cfg.conform.corrections, &out.report),
@@ -65,14 +86,43 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
     warnings(&args, &out.report)
 }
 
-/// The output dialect's name: `--dialect`, or the old spelling `--output` (with a warning).
-fn dialect_name(args: &ConformArgs) -> String {
-    match &args.output_dialect {
-        Some(name) => {
-            eprintln!("warning: `--output {name}` is now spelled `--dialect {name}`");
-            name.clone()
+/// The one file to write (after [`output_and_dialect`] left one).
+fn out_path(args: &ConformArgs) -> &std::path::Path {
+    args.output
+        .first()
+        .map_or(std::path::Path::new(""), |p| p.as_path())
+}
+
+/// The file to write and the output dialect's name.
+///
+/// `-o/--output FILE` names the file (`--out` is its older spelling), `--dialect` the language.
+/// `--output` once named the language (`-o out.src --output krl`); that spelling is still read,
+/// with a warning, when one `--output` value is a dialect name, another is the file and
+/// `--dialect` is not given: a file literally named `krl` beside another output is not a
+/// likely wish, and refusing would break the old command lines for no gain. Any other mix is a
+/// usage error that says how to write it.
+fn output_and_dialect(args: &ConformArgs) -> Result<(std::path::PathBuf, String), Failure> {
+    let is_dialect = |p: &std::path::PathBuf| {
+        p.to_str()
+            .is_some_and(|s| super::args::DIALECTS.contains(&s))
+    };
+    match (args.output.as_slice(), &args.dialect) {
+        ([file], Some(d)) => Ok((file.clone(), d.clone())),
+        ([file], None) if is_dialect(file) => Err(Failure::Usage(format!(
+            "--output {0} names the file to write; give the file with -o FILE and the language \
+             with --dialect {0}",
+            file.display()
+        ))),
+        ([file], None) => Ok((file.clone(), "gcode".to_owned())),
+        ([a, b], None) if is_dialect(a) != is_dialect(b) => {
+            let (name, file) = if is_dialect(a) { (a, b) } else { (b, a) };
+            let name = name.display().to_string();
+            warnln!("`--output {name}` is now spelled `--dialect {name}`");
+            Ok((file.clone(), name))
         }
-        None => args.dialect.clone(),
+        _ => Err(Failure::Usage(
+            "give one output file with -o/--output FILE and the language with --dialect".to_owned(),
+        )),
     }
 }
 
@@ -136,7 +186,7 @@ fn write_outputs(args: &ConformArgs, out: &ConformOutput) -> Result<(), Failure>
             .into_iter()
             .chain(&args.config.config),
     );
-    outputs.add(&args.out, &out.program)?;
+    outputs.add(out_path(args), &out.program)?;
     if let Some(path) = &args.report {
         let full = FullReport {
             conform: &out.report,
@@ -157,11 +207,11 @@ fn print_program_summary(
     moves: usize,
 ) {
     let (report, o) = (&out.report, &out.orientation);
-    eprintln!(
+    infoln!(
         "{}: {} program, {} path(s), {} points, {moves} moves, {:.1} mm on the surface; tool \
          axis {}: largest tilt {:.1}°, largest angle to the surface normal {:.1}°{}; {} \
          nozzle contact(s)",
-        args.out.display(),
+        out_path(args).display(),
         dialect_name,
         report.paths,
         report.points,
@@ -191,10 +241,10 @@ fn print_gcode_summary(args: &ConformArgs, corrections: Corrections, report: &Co
         .filter(|&&m| m != corrections)
         .map(|&m| format!("{} {:.3}", m.name(), report.comparison.of(m).mean_abs_error))
         .collect();
-    eprintln!(
+    infoln!(
         "{}: {} path(s), {} points, {:.1} mm on the surface ({:.1} mm in the plane), Δz {:.2} mm; \
          deposit error {:.3} mm mean with {} corrections ({}); {} nozzle contact(s) in the replay",
-        args.out.display(),
+        out_path(args).display(),
         report.paths,
         report.points,
         report.geometry.length_3d,
@@ -233,8 +283,8 @@ fn warnings(args: &ConformArgs, report: &ConformReport) -> Result<(), Failure> {
     if let Some(r) = &report.replay
         && r.custom > 0
     {
-        eprintln!(
-            "warning: the printer's start or end G-code moves the nozzle into the surface ({} \
+        warnln!(
+            "the printer's start or end G-code moves the nozzle into the surface ({} \
              sample(s), first at {:?}): check printer.start_gcode (the default homes and primes a \
              line on the bed's front edge) and printer.end_gcode",
             r.custom,
@@ -242,16 +292,16 @@ fn warnings(args: &ConformArgs, report: &ConformReport) -> Result<(), Failure> {
         );
     }
     if report.off_surface > 0 {
-        eprintln!(
-            "warning: {} design point(s) have no surface under them and were left out",
+        warnln!(
+            "{} design point(s) have no surface under them and were left out",
             report.off_surface
         );
     }
     if let Some(c) = &report.surface.cloud
         && c.folds
     {
-        eprintln!(
-            "warning: {}: the point cloud folds over itself; a height field holds only its top \
+        warnln!(
+            "{}: the point cloud folds over itself; a height field holds only its top \
              ({} of {} points below a fold were left out)",
             args.surface.display(),
             c.below_fold,

@@ -1,8 +1,9 @@
 //! `conduit convert`: mesh files to STL, 3MF or OBJ, many in parallel.
 //!
 //! An input may be a folder: its mesh files (by extension, not recursive) in name order. Each
-//! conversion prints one line (`IN -> OUT: N objects, M triangles`); a failed one prints its
-//! error, and a batch with failures ends with the count.
+//! conversion prints one line (`IN -> OUT: N objects, M triangles`) and a failed one its error,
+//! one line each, so the error lines count the failures (no extra summary line; `--json` has
+//! the count).
 
 use super::{Failure, args::ConvertArgs, progress};
 use anyhow::Context;
@@ -39,9 +40,39 @@ pub(crate) fn run(args: ConvertArgs) -> Result<(), Failure> {
         })
         .collect();
     bar.finish_and_clear();
-    let mut failed = 0;
+    let failed = results.iter().filter(|r| r.is_err()).count();
+    if args.json {
+        let done: Vec<serde_json::Value> = jobs
+            .iter()
+            .zip(&results)
+            .map(|(job, r)| match r {
+                Ok(c) => serde_json::json!({
+                    "input": job.input.display().to_string(),
+                    "output": job.output.display().to_string(),
+                    "objects": c.objects,
+                    "triangles": c.triangles,
+                }),
+                Err(e) => serde_json::json!({
+                    "input": job.input.display().to_string(),
+                    "error": format!("{e:#}"),
+                }),
+            })
+            .collect();
+        super::print_json(&serde_json::json!({
+            "outputs": super::paths(
+                jobs.iter()
+                    .zip(&results)
+                    .filter(|(_, r)| r.is_ok())
+                    .map(|(j, _)| j.output.as_path())
+            ),
+            "converted": jobs.len() - failed,
+            "failed": failed,
+            "conversions": done,
+        }))?;
+    }
     for (job, r) in jobs.iter().zip(&results) {
         match r {
+            Ok(_) if args.json => {}
             Ok(c) => outln!(
                 "{} -> {}: {} object{}, {} triangles",
                 job.input.display(),
@@ -50,16 +81,10 @@ pub(crate) fn run(args: ConvertArgs) -> Result<(), Failure> {
                 if c.objects == 1 { "" } else { "s" },
                 c.triangles
             )?,
-            Err(e) => {
-                failed += 1;
-                eprintln!("error: {e:#}");
-            }
+            Err(e) => errorln!("{e:#}"),
         }
     }
     if failed > 0 {
-        if jobs.len() > 1 {
-            eprintln!("{failed} of {} conversions failed", jobs.len());
-        }
         return Err(Failure::Reported);
     }
     Ok(())

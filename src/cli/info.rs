@@ -65,7 +65,7 @@ pub(crate) fn run(args: InfoArgs) -> Result<(), Failure> {
     }
     out.flush().map_err(Failure::stdout)?;
     for e in reports.iter().filter_map(|r| r.as_ref().err()) {
-        eprintln!("error: {e}");
+        errorln!("{e}");
     }
     if failed > 0 {
         Err(Failure::Reported)

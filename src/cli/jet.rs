@@ -38,7 +38,7 @@ pub(crate) fn run(args: JetArgs) -> Result<(), Failure> {
     for path in &args.designs {
         let loaded = jet::design::load(path, cfg.jet.arc_tolerance).map_err(anyhow::Error::from)?;
         for w in &loaded.warnings {
-            eprintln!("warning: {w}");
+            warnln!("{w}");
         }
         outlines.extend(loaded.outlines);
     }
@@ -67,26 +67,41 @@ pub(crate) fn run(args: JetArgs) -> Result<(), Failure> {
             .filter(|c| c.action == a)
             .count()
     };
-    eprintln!(
-        "{}: {} structure(s), {} layers, {} paths, {:.3} mm jetted, {} corners ({} filleted, {} split), estimated {:.0} s",
-        output.display(),
-        report.structures.len(),
-        params.layers,
-        stats.paths,
-        stats.jetted_mm,
-        corners,
-        count(jet::fillet::CornerAction::Fillet),
-        count(jet::fillet::CornerAction::Split),
-        stats.estimated_time_s
-    );
+    if args.json {
+        super::print_json(&serde_json::json!({
+            "outputs": super::paths(std::iter::once(output.as_path()).chain(args.report.as_deref())),
+            "structures": report.structures.len(),
+            "layers": params.layers,
+            "paths": stats.paths,
+            "jetted_mm": stats.jetted_mm,
+            "corners": corners,
+            "filleted": count(jet::fillet::CornerAction::Fillet),
+            "split": count(jet::fillet::CornerAction::Split),
+            "estimated_time_s": stats.estimated_time_s,
+            "warnings": report.warnings.len(),
+        }))?;
+    } else {
+        infoln!(
+            "{}: {} structure(s), {} layers, {} paths, {:.3} mm jetted, {} corners ({} filleted, {} split), estimated {:.0} s",
+            output.display(),
+            report.structures.len(),
+            params.layers,
+            stats.paths,
+            stats.jetted_mm,
+            corners,
+            count(jet::fillet::CornerAction::Fillet),
+            count(jet::fillet::CornerAction::Split),
+            stats.estimated_time_s
+        );
+    }
     // Every corner is in the report; the terminal gets the first few.
     const SHOWN: usize = 10;
     for w in report.warnings.iter().take(SHOWN) {
-        eprintln!("warning: {w}");
+        warnln!("{w}");
     }
     if report.warnings.len() > SHOWN {
-        eprintln!(
-            "warning: ... and {} more (see --report)",
+        warnln!(
+            "... and {} more (see --report)",
             report.warnings.len() - SHOWN
         );
     }

@@ -4,6 +4,12 @@
 //! Standard output is written with [`outln!`] and [`out!`], which return write errors instead of
 //! panicking as `println!` does; standard error with `eprintln!`, shadowed below by a version
 //! that ignores write errors (there is nowhere left to report them).
+//!
+//! What reaches standard error goes through one switch, the global `-q/--quiet` and
+//! `-v/--verbose` flags ([`Verbosity`]): errors always print ([`errorln!`]), warnings
+//! ([`warnln!`]), summary and info lines ([`infoln!`]) and progress bars ([`progress`]) only
+//! when not quiet, details ([`verbose`]) only when verbose. Every error and warning is one line:
+//! control characters of quoted input are escaped ([`one_line`]).
 
 /// Writes a line to standard output; a write error becomes a [`Failure`] (a closed pipe a
 /// quiet end, anything else an error), never a panic. Use as `outln!("...")?`.
@@ -31,6 +37,33 @@ macro_rules! eprintln {
     }};
 }
 
+/// A warning on standard error, `warning: ` and the message on one line; nothing with
+/// `--quiet`.
+macro_rules! warnln {
+    ($($arg:tt)*) => {{
+        if !$crate::cli::quiet() {
+            eprintln!("warning: {}", $crate::cli::one_line(&format!($($arg)*)));
+        }
+    }};
+}
+
+/// An error on standard error, `error: ` and the message on one line; printed even with
+/// `--quiet`.
+macro_rules! errorln {
+    ($($arg:tt)*) => {{
+        eprintln!("error: {}", $crate::cli::one_line(&format!($($arg)*)));
+    }};
+}
+
+/// A summary or info line on standard error; nothing with `--quiet`.
+macro_rules! infoln {
+    ($($arg:tt)*) => {{
+        if !$crate::cli::quiet() {
+            eprintln!($($arg)*);
+        }
+    }};
+}
+
 mod args;
 mod calibrate;
 mod check;
@@ -50,6 +83,7 @@ mod slice;
 use clap::Parser;
 use std::io::Write;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Exit code for bad input or failed work.
 const EXIT_FAILURE: u8 = 1;
@@ -94,6 +128,61 @@ impl From<anyhow::Error> for Failure {
     }
 }
 
+/// How much a run says on standard error besides its errors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[repr(u8)]
+pub(crate) enum Verbosity {
+    /// `--quiet`: errors only.
+    Quiet = 0,
+    /// Progress, summaries and warnings.
+    Normal = 1,
+    /// `--verbose`: also the details a warning sums up (such as every ignored setting).
+    Verbose = 2,
+}
+
+/// The run's [`Verbosity`], set once from the global flags before the command runs.
+static VERBOSITY: AtomicU8 = AtomicU8::new(Verbosity::Normal as u8);
+
+/// True with `--quiet`: no progress, summaries or warnings on standard error.
+pub(crate) fn quiet() -> bool {
+    VERBOSITY.load(Ordering::Relaxed) == Verbosity::Quiet as u8
+}
+
+/// True with `--verbose`: warnings that sum up a list also print the list.
+pub(crate) fn verbose() -> bool {
+    VERBOSITY.load(Ordering::Relaxed) == Verbosity::Verbose as u8
+}
+
+/// `text` on one line: line ends, tabs and other control characters (C0, DEL, C1) written as
+/// escapes (`\n`, `\r`, `\t`, `\u{1b}`), so that a message quoting raw input (an SVG
+/// attribute, an EAGLE value) stays one line that tools can grep.
+pub(crate) fn one_line(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            c if c.is_control() => out.push_str(&format!("\\u{{{:x}}}", u32::from(c))),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Prints `value` as one pretty JSON document on standard output: the `--json` summary of a
+/// command.
+pub(crate) fn print_json(value: &impl serde::Serialize) -> Result<(), Failure> {
+    let text = serde_json::to_string_pretty(value)
+        .map_err(|e| Failure::Work(anyhow::Error::new(e).context("serialising the summary")))?;
+    outln!("{text}")
+}
+
+/// The paths of a `--json` summary's `outputs` list, as text.
+pub(crate) fn paths<'a>(paths: impl IntoIterator<Item = &'a std::path::Path>) -> Vec<String> {
+    paths.into_iter().map(|p| p.display().to_string()).collect()
+}
+
 /// Runs the command line and returns the process exit code.
 pub fn run() -> ExitCode {
     let cli = match args::Cli::try_parse() {
@@ -112,6 +201,14 @@ pub fn run() -> ExitCode {
             };
         }
     };
+    let verbosity = if cli.quiet {
+        Verbosity::Quiet
+    } else if cli.verbose {
+        Verbosity::Verbose
+    } else {
+        Verbosity::Normal
+    };
+    VERBOSITY.store(verbosity as u8, Ordering::Relaxed);
     let result = match cli.command {
         args::Command::Info(a) => info::run(a),
         args::Command::Convert(a) => convert::run(a),
@@ -133,12 +230,12 @@ pub fn run() -> ExitCode {
     match result {
         Ok(()) | Err(Failure::StdoutClosed) => ExitCode::SUCCESS,
         Err(Failure::Usage(msg)) => {
-            eprintln!("error: {msg}");
+            errorln!("{msg}");
             eprintln!("For more information, try '--help'.");
             ExitCode::from(EXIT_USAGE)
         }
         Err(Failure::Work(e)) => {
-            eprintln!("error: {e:#}");
+            errorln!("{e:#}");
             ExitCode::from(EXIT_FAILURE)
         }
         Err(Failure::Reported) => ExitCode::from(EXIT_FAILURE),

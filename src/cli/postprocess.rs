@@ -6,7 +6,6 @@
 use super::{Failure, args::ConfigSource, args::PostprocessArgs, config::resolve};
 use anyhow::Context;
 use conduit::circuit::Electronics;
-use conduit::circuit::{Circuit, Placement};
 use conduit::config::{Config, HostSettings};
 use conduit::pipeline::postprocess::{Edit, HostPrint, edit, edit_circuit};
 use conduit::postprocess::rewrite::SUMMARY_PREFIX;
@@ -68,16 +67,36 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
         outputs.add(report_path, &json)?;
     }
     outputs.commit()?;
-    for line in done.iter().flat_map(|d| &d.summary) {
-        let text = line.strip_prefix(SUMMARY_PREFIX).unwrap_or(line);
-        eprintln!("{}:{text}", path.display());
+    let summary: Vec<&str> = done
+        .iter()
+        .flat_map(|d| &d.summary)
+        .map(|line| line.strip_prefix(SUMMARY_PREFIX).unwrap_or(line).trim())
+        .collect();
+    if args.json {
+        let mut written = Vec::new();
+        if changed {
+            written.push(path.clone());
+        }
+        if args.output_name.is_some() {
+            written.push(output_name_file(path));
+        }
+        written.extend(args.report.clone());
+        return super::print_json(&serde_json::json!({
+            "outputs": super::paths(written.iter().map(|p| p.as_path())),
+            "changed": changed,
+            "summary": summary,
+            "report": report,
+        }));
+    }
+    for text in summary {
+        infoln!("{}: {text}", path.display());
     }
     let outcome = if changed {
         "rewritten"
     } else {
         "left unchanged"
     };
-    eprintln!("{}: {report}; {outcome}", path.display());
+    infoln!("{}: {report}; {outcome}", path.display());
     Ok(())
 }
 
@@ -119,7 +138,7 @@ fn settings_config(src: &ConfigSource, settings: &HostSettings) -> Result<Config
     let mut cfg = match from_host {
         Ok(cfg) => cfg,
         Err(e) => {
-            eprintln!("warning: the host's settings: {e}; using conduit's defaults");
+            warnln!("the host's settings: {e}; using conduit's defaults");
             Config::default()
         }
     };
@@ -130,7 +149,7 @@ fn settings_config(src: &ConfigSource, settings: &HostSettings) -> Result<Config
     let warnings = cfg.validate().map_err(anyhow::Error::from)?;
     if !src.set.is_empty() {
         for w in warnings {
-            eprintln!("warning: {w}");
+            warnln!("{w}");
         }
     }
     Ok(cfg)
@@ -141,10 +160,5 @@ fn load_electronics(args: &PostprocessArgs) -> Result<Option<Electronics>, Failu
     let (Some(circuit_path), Some(placement_path)) = (&args.circuit, &args.placement) else {
         return Ok(None);
     };
-    let circuit = Circuit::load(circuit_path).map_err(anyhow::Error::from)?;
-    let placement = Placement::load(placement_path).map_err(anyhow::Error::from)?;
-    placement
-        .validate(&circuit)
-        .with_context(|| format!("{}", placement_path.display()))?;
-    Ok(Some(Electronics { circuit, placement }))
+    super::slice::load_electronics(circuit_path, placement_path).map(Some)
 }

@@ -21,13 +21,22 @@ pub(crate) fn run(args: PreviewArgs) -> Result<(), Failure> {
     let moves = layered_by_markers(&gcode, moves(&gcode, Firmware::Marlin));
     let drawn = render(&moves, &params).with_context(|| format!("{file}"))?;
     let dir = &args.out_dir;
-    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot write", dir.display()))?;
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
     // All the files or none: a run that fails on the tenth layer leaves no mix of new and old.
     let mut outputs = OutputSet::new([&args.file]);
     for (name, bytes) in &drawn.files {
         outputs.add(&dir.join(name), bytes)?;
     }
     outputs.commit()?;
+    if args.json {
+        return super::print_json(&serde_json::json!({
+            "outputs": drawn.files.iter().map(|(name, _)| dir.join(name).display().to_string()).collect::<Vec<_>>(),
+            "layers": drawn.layers,
+            "every": drawn.every,
+            "tiles": drawn.tiles,
+        }));
+    }
     outln!(
         "{file}: {} layers: {} SVG files and {} (every {} layer(s), {} tiles), side views {} in {}",
         drawn.layers,

@@ -3,8 +3,6 @@
 
 use super::{Failure, args::RouteArgs, config::resolve};
 use anyhow::Context;
-use conduit::circuit::Electronics;
-use conduit::circuit::{Circuit, Placement};
 use conduit::emit::route_svg::{layer_svg, view_box};
 use conduit::pipeline::route_scene;
 use conduit::scene::OutputSet;
@@ -22,19 +20,18 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
     }
     let cfg = resolve(&args.config)?;
     let scene = super::slice::load_models(&args.models)?;
-    let electronics = Electronics {
-        circuit: Circuit::load(&args.circuit).map_err(anyhow::Error::from)?,
-        placement: Placement::load(&args.placement).map_err(anyhow::Error::from)?,
-    };
+    let electronics = super::slice::load_electronics(&args.circuit, &args.placement)?;
     let view = route_scene(&scene, &cfg, &electronics, |_| {})
         .with_context(|| format!("routing {}", args.circuit.display()))?;
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("{}: cannot create the folder", args.out_dir.display()))?;
+    let mut written = Vec::new();
     if let Some(bounds) = view_box(&view.layers) {
         for (i, layer) in view.layers.iter().enumerate() {
             let path = args.out_dir.join(format!("layer_{:04}.svg", i + 1));
             let svg = layer_svg(layer, bounds, cfg.route.conductive_width);
             outputs.add(&path, svg.as_bytes())?;
+            written.push(path);
         }
     }
     if let Some(report) = &args.report {
@@ -42,6 +39,26 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
         outputs.add(report, &json)?;
     }
     outputs.commit()?;
+    if args.json {
+        let r = &view.report;
+        super::print_json(&serde_json::json!({
+            "outputs": super::paths(written.iter().map(|p| p.as_path()).chain(args.report.as_deref())),
+            "layers": view.layers.len(),
+            "parts": r.parts.len(),
+            "wires": r.routed + r.unrouted,
+            "routed": r.routed,
+            "trace_mm": r.total_length,
+            "straight_mm": r.total_lower_bound,
+            "report": r,
+        }))?;
+        super::slice::routing_warnings(r);
+        return super::slice::refuse_unbuilt_circuit(
+            r,
+            args.allow_unrouted,
+            &args.out_dir,
+            "the drawings show where",
+        );
+    }
     let lead = format!(
         "{}: {} layers drawn; ",
         args.out_dir.display(),

@@ -37,10 +37,7 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
     }
     let scene = load_models(&args.models)?;
     let electronics = match (&args.circuit, &args.placement) {
-        (Some(c), Some(p)) => Some(Electronics {
-            circuit: Circuit::load(c).map_err(anyhow::Error::from)?,
-            placement: Placement::load(p).map_err(anyhow::Error::from)?,
-        }),
+        (Some(c), Some(p)) => Some(load_electronics(c, p)?),
         _ => None,
     };
     let bar = stage_bar();
@@ -52,10 +49,12 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         .with_context(|| format!("slicing {}", args.models[0].display()))?;
     bar.finish_and_clear();
     outputs.add(&args.output, &gcode)?;
+    let mut written = vec![args.output.clone()];
     if let Some(e) = &electronics {
         let records = pnp_records(&e.circuit, &summary.parts);
         for (path, bytes) in pick_and_place_files(&args.output, &records)? {
             outputs.add(&path, &bytes)?;
+            written.push(path);
         }
     }
     if let Some(report) = &args.report {
@@ -66,20 +65,33 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         refuse_unbuilt_circuit(r, args.allow_unrouted, &args.output, "nothing was written")?;
     }
     outputs.commit()?;
+    written.extend(args.report.clone());
     let total: f64 = summary.gcode.tools.iter().map(|t| t.filament_mm).sum();
-    eprintln!(
+    if args.json {
+        super::print_json(&serde_json::json!({
+            "outputs": super::paths(written.iter().map(|p| p.as_path())),
+            "layers": summary.layers,
+            "filament_mm": total,
+            "estimated_time_s": summary.gcode.estimated_time_s,
+            "report": summary,
+        }))?;
+        model_warnings(&args, &summary);
+        if let Some(r) = &summary.electronics {
+            routing_warnings(r);
+        }
+        for r in summary.curved.iter().flat_map(|c| &c.rejections) {
+            warnln!("{r}");
+        }
+        return Ok(());
+    }
+    infoln!(
         "{}: {} layers, {:.0} mm filament, estimated {:.0} min",
         args.output.display(),
         summary.layers,
         total,
         summary.gcode.estimated_time_s / 60.0
     );
-    for w in summary.warnings() {
-        match args.models.as_slice() {
-            [one] => eprintln!("warning: {}: {w}", one.display()),
-            _ => eprintln!("warning: {w}"),
-        }
-    }
+    model_warnings(&args, &summary);
     if let Some(r) = &summary.electronics {
         print_routing(r, "");
     }
@@ -92,16 +104,26 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         } else {
             String::new()
         };
-        eprintln!(
+        infoln!(
             "curved tops: {} region(s) curved, {} kept planar{slowed}",
             c.regions.len(),
             c.rejections.len()
         );
         for r in &c.rejections {
-            eprintln!("warning: {r}");
+            warnln!("{r}");
         }
     }
     Ok(())
+}
+
+/// The slice's warnings about the models, naming the model when there is one.
+fn model_warnings(args: &SliceArgs, summary: &conduit::pipeline::SliceSummary) {
+    for w in summary.warnings() {
+        match args.models.as_slice() {
+            [one] => warnln!("{}: {w}", one.display()),
+            _ => warnln!("{w}"),
+        }
+    }
 }
 
 /// `conduit slice --curved clfff`: one G-code file, or one per section with
@@ -140,10 +162,45 @@ fn run_clfff(
         outputs.add(report, &json)?;
     }
     outputs.commit()?;
+    let r = &summary.clfff;
+    let model_layers = r
+        .layers
+        .iter()
+        .filter(|l| l.section == conduit::curved::clfff::Section::Model)
+        .count();
+    if args.json {
+        let files: Vec<serde_json::Value> = written
+            .iter()
+            .map(|(path, file)| {
+                serde_json::json!({
+                    "file": path.display().to_string(),
+                    "sections": file.sections.iter().map(|s| s.name()).collect::<Vec<_>>(),
+                    "program_layers": file.program.layers.len(),
+                    "filament_mm": file.stats.tools.iter().map(|t| t.filament_mm).sum::<f64>(),
+                    "estimated_time_s": file.stats.estimated_time_s,
+                })
+            })
+            .collect();
+        super::print_json(&serde_json::json!({
+            "outputs": super::paths(
+                written.iter().map(|(p, _)| p.as_path()).chain(args.report.as_deref())
+            ),
+            "files": files,
+            "scaffold_layers": r.scaffold.layers,
+            "buffer_layers": r.layers.len() - model_layers,
+            "curved_layers": model_layers,
+            "collisions": r.collisions.count,
+            "report": summary,
+        }))?;
+        for w in r.warnings() {
+            warnln!("{w}");
+        }
+        return Ok(());
+    }
     for (path, file) in written {
         let total: f64 = file.stats.tools.iter().map(|t| t.filament_mm).sum();
         let names: Vec<&str> = file.sections.iter().map(|s| s.name()).collect();
-        eprintln!(
+        infoln!(
             "{}: {} ({} program layers), {:.0} mm filament, estimated {:.0} min",
             path.display(),
             names.join(" + "),
@@ -152,12 +209,6 @@ fn run_clfff(
             file.stats.estimated_time_s / 60.0
         );
     }
-    let r = &summary.clfff;
-    let model_layers = r
-        .layers
-        .iter()
-        .filter(|l| l.section == conduit::curved::clfff::Section::Model)
-        .count();
     let slowed = if r.z_speed_limited > 0 {
         format!(
             ", {} moves slowed for curved.max_z_speed",
@@ -166,7 +217,7 @@ fn run_clfff(
     } else {
         String::new()
     };
-    eprintln!(
+    infoln!(
         "clfff: {} scaffold layers, {} buffer layer(s), {} curved layers, {} collision(s){slowed}",
         r.scaffold.layers,
         r.layers.len() - model_layers,
@@ -174,7 +225,7 @@ fn run_clfff(
         r.collisions.count
     );
     for w in r.warnings() {
-        eprintln!("warning: {w}");
+        warnln!("{w}");
     }
     Ok(())
 }
@@ -212,7 +263,7 @@ pub(crate) fn pick_and_place_files(
 /// The routing summary line (after `lead`) and the report's warnings, on stderr. What was not
 /// built as asked is [`refuse_unbuilt_circuit`]'s to say.
 pub(crate) fn print_routing(r: &conduit::circuit::ElectronicsReport, lead: &str) {
-    eprintln!(
+    infoln!(
         "{lead}{} parts, {} of {} wires routed ({:.1} mm of trace, {:.1} mm straight)",
         r.parts.len(),
         r.routed,
@@ -220,8 +271,13 @@ pub(crate) fn print_routing(r: &conduit::circuit::ElectronicsReport, lead: &str)
         r.total_length,
         r.total_lower_bound
     );
+    routing_warnings(r);
+}
+
+/// The routing report's warnings and one line per wire that could not be routed, on stderr.
+pub(crate) fn routing_warnings(r: &conduit::circuit::ElectronicsReport) {
     for w in &r.warnings {
-        eprintln!("warning: {w}");
+        warnln!("{w}");
     }
 }
 
@@ -239,15 +295,18 @@ pub(crate) fn refuse_unbuilt_circuit(
     if failures.is_empty() {
         return Ok(());
     }
-    let level = if allow { "warning" } else { "error" };
     for f in &failures {
-        eprintln!("{level}: {f}");
+        if allow {
+            warnln!("{f}");
+        } else {
+            errorln!("{f}");
+        }
     }
     if allow {
         return Ok(());
     }
-    eprintln!(
-        "error: {}: the circuit was not built as asked ({} problem(s) above); {consequence} \
+    errorln!(
+        "{}: the circuit was not built as asked ({} problem(s) above); {consequence} \
          (--allow-unrouted accepts it)",
         output.display(),
         failures.len()
@@ -267,6 +326,22 @@ fn inputs(args: &SliceArgs) -> OutputSet {
     set
 }
 
+/// The circuit and its placement, checked against each other here so that a placement naming
+/// parts, nets or pins the circuit lacks is reported against the placement file.
+pub(crate) fn load_electronics(
+    circuit: &std::path::Path,
+    placement: &std::path::Path,
+) -> Result<Electronics, Failure> {
+    let c = Circuit::load(circuit).map_err(anyhow::Error::from)?;
+    let p = Placement::load(placement).map_err(anyhow::Error::from)?;
+    p.validate(&c)
+        .with_context(|| placement.display().to_string())?;
+    Ok(Electronics {
+        circuit: c,
+        placement: p,
+    })
+}
+
 /// One scene of every object of `models`, in order; reader warnings go to stderr.
 pub(crate) fn load_models(models: &[std::path::PathBuf]) -> Result<Scene, Failure> {
     let mut scene = Scene::default();
@@ -274,16 +349,16 @@ pub(crate) fn load_models(models: &[std::path::PathBuf]) -> Result<Scene, Failur
         let (s, warnings) =
             load_scene(path, &LoadOptions::default()).map_err(anyhow::Error::from)?;
         for w in warnings {
-            eprintln!("warning: {}: {w}", path.display());
+            warnln!("{}: {w}", path.display());
         }
         scene.objects.extend(s.objects);
     }
     Ok(scene)
 }
 
-/// A bar over the pipeline's stages, hidden when stderr is not a terminal.
+/// A bar over the pipeline's stages, hidden when stderr is not a terminal or with `--quiet`.
 fn stage_bar() -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
+    if super::quiet() || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(Stage::ALL.len() as u64);

@@ -62,7 +62,7 @@ const SECTION_DOCS: &[(&str, &str)] = &[
     ),
     (
         "robot",
-        "Robot arms and five-axis machines (conduit conform --output, conduit calibrate): arm \
+        "Robot arms and five-axis machines (conduit conform --dialect, conduit calibrate): arm \
          model, frames, tool orientation and the dispense commands of each program dialect.",
     ),
     (
@@ -131,6 +131,38 @@ pub fn defaults_toml() -> String {
         }
     }
     out
+}
+
+/// Units a field's documentation states after a comma (`Layer height, mm, …`), longest first
+/// where one starts another.
+const UNITS: &[&str] = &[
+    "mm/s²", "mm³/s", "mm/s", "mm", "µm", "°C", "degrees", "°", "percent", "g/cm³", "s",
+];
+
+/// The unit the documentation of the dotted config `key` states (`slice.layer_height` → `mm`,
+/// `tools.1.temperature` → `°C`), when it states one: for messages that say what a value must
+/// be.
+pub(super) fn unit_of(key: &str) -> Option<&'static str> {
+    let schema = config_schema();
+    // `printer.bed_size[0]` is documented as `printer.bed_size`.
+    let mut parts = key.split('.').map(|p| p.split('[').next().unwrap_or(p));
+    let mut node = schema.get("properties")?.get(parts.next()?)?;
+    if let Some(entry) = numbered_entry(node) {
+        parts.next()?;
+        node = entry;
+    }
+    let field = node.get("properties")?.get(parts.next()?)?;
+    if parts.next().is_some() {
+        return None;
+    }
+    let doc = field.get("description")?.as_str()?;
+    let first = doc.split("\n\n").next()?.replace('\n', " ");
+    UNITS.iter().copied().find(|u| {
+        first.match_indices(&format!(", {u}")).any(|(i, m)| {
+            let after = &first[i + m.len()..];
+            after.is_empty() || after.starts_with(['.', ',', ';']) || after.starts_with(" (")
+        })
+    })
 }
 
 /// The JSON schema of [`Config`] with every type inlined, so each section's keys are the

@@ -334,10 +334,10 @@ pub enum ConfigError {
     ///
     /// How to fix: compare with `conduit config --defaults`, which lists every key.
     #[error(
-        "{}{}: {}{message}",
+        "{}{}: {}",
         file_label(path),
         line.map(|l| format!(":{l}")).unwrap_or_default(),
-        key.as_ref().map(|k| format!("{k}: ")).unwrap_or_default()
+        keyed(key.as_deref(), message)
     )]
     Toml {
         /// The file, if the TOML came from one.
@@ -354,7 +354,7 @@ pub enum ConfigError {
     ///
     /// How to fix: use a dotted key of `conduit config --defaults`, such as
     /// `slice.layer_height=0.3` or `tools.1.temperature=25`.
-    #[error("--set {key}: {message}")]
+    #[error("--set {}", keyed(Some(key), message))]
     Set {
         /// The dotted key.
         key: String,
@@ -396,6 +396,16 @@ pub enum ConfigError {
     },
 }
 
+/// `message` about `key`: `slice.layer_height must be …` when the message says what the value
+/// must be, `key: message` otherwise.
+fn keyed(key: Option<&str>, message: &str) -> String {
+    match key {
+        Some(k) if message.starts_with("must ") => format!("{k} {message}"),
+        Some(k) => format!("{k}: {message}"),
+        None => message.to_owned(),
+    }
+}
+
 fn file_label(path: &Option<PathBuf>) -> String {
     match path {
         Some(p) => p.display().to_string(),
@@ -415,9 +425,21 @@ impl ConfigError {
             path: path.map(Path::to_path_buf),
             line,
             key: err.key.clone(),
-            message: explain_unknown_key(err.error.message().trim()),
+            message: explain(err.error.message().trim(), err.key.as_deref()),
         }
     }
+}
+
+/// serde's message about the value of `key` in words: an unknown key as [`explain_unknown_key`]
+/// does, a value of the wrong type or range as what it must be and what it is
+/// (`must be a number in mm, got "abc"` for serde's `invalid type: string "abc", expected f64`),
+/// with the unit the key's documentation gives; other messages as they are.
+fn explain(message: &str, key: Option<&str>) -> String {
+    if message.starts_with("unknown field `") {
+        return explain_unknown_key(message);
+    }
+    let unit = key.and_then(defaults::unit_of);
+    crate::scene::words::must_be(message, unit).unwrap_or_else(|| message.to_owned())
 }
 
 /// serde's "unknown field `x`, expected one of `a`, `b`, …" as "unknown key `x`", with the
@@ -963,7 +985,7 @@ impl Config {
         }
         let new: Config = tree
             .try_into()
-            .map_err(|e: toml::de::Error| set_err(explain_unknown_key(e.message().trim())))?;
+            .map_err(|e: toml::de::Error| set_err(explain(e.message().trim(), Some(key))))?;
         *self = new;
         Ok(())
     }

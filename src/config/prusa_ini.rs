@@ -42,7 +42,11 @@
 //!   own width; conduit has one first-layer width and takes the perimeter width.
 //!
 //! Every other key is listed, once, in a warning as ignored — among them `max_print_speed`,
-//! which in PrusaSlicer only limits automatic speeds while conduit's clamps every speed.
+//! which in PrusaSlicer only limits automatic speeds while conduit's clamps every speed. The
+//! warning counts them and names first those that change what is printed (a curated list:
+//! seam, ironing, supports, spiral vase…, each only when set to a value conduit does not
+//! print), then after [`IGNORED_LIST_MARK`] all of them, so a front end can show the summary
+//! alone.
 //!
 //! G-code written by PrusaSlicer or Slic3r carries its settings as `; key = value` comments;
 //! [`pairs_from_gcode`] collects them for [`from_prusa_pairs`].
@@ -817,24 +821,120 @@ fn extrusion_widths(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     Ok(())
 }
 
-/// Lists, in one warning, every key no step has read.
+/// Where the warning about ignored keys ([`warn_ignored`]) turns from its summary to the full
+/// list: a front end that shows only the summary cuts the warning here.
+pub const IGNORED_LIST_MARK: &str = "; all of them: ";
+
+/// PrusaSlicer settings that conduit does not honour and that change what is printed (the
+/// material laid down, its shape or place) when set to anything but the value given, which
+/// prints as conduit does; `None` when every value changes the print. Settings of cooling,
+/// accelerations, G-code comments, multi-material ramming and the like change at most how the
+/// same paths are run, and are not listed.
+const CHANGES_THE_PRINT: &[(&str, Option<&[&str]>)] = &[
+    ("bottom_solid_min_thickness", Some(&["0"])),
+    ("bridge_angle", Some(&["0"])),
+    ("bridge_flow_ratio", Some(&["1"])),
+    ("brim_separation", Some(&["0"])),
+    ("brim_type", Some(&["outer_only"])),
+    ("complete_objects", Some(&["0"])),
+    ("draft_shield", Some(&["disabled", "0"])),
+    ("elefant_foot_compensation", Some(&["0"])),
+    ("ensure_vertical_shell_thickness", Some(&["0"])),
+    ("extra_perimeters", Some(&["0"])),
+    ("extra_perimeters_on_overhangs", Some(&["0"])),
+    ("filament_max_volumetric_speed", Some(&["0"])),
+    ("fuzzy_skin", Some(&["none"])),
+    ("infill_anchor", Some(&["0"])),
+    ("infill_anchor_max", Some(&["0"])),
+    ("infill_every_layers", Some(&["1"])),
+    ("infill_first", Some(&["0"])),
+    ("infill_only_where_needed", Some(&["0"])),
+    ("interface_shells", Some(&["0"])),
+    ("ironing", Some(&["0"])),
+    ("max_volumetric_speed", Some(&["0"])),
+    ("overhangs", Some(&["0"])),
+    ("raft_layers", Some(&["0"])),
+    ("seam_position", None),
+    ("solid_infill_every_layers", Some(&["0"])),
+    ("spiral_vase", Some(&["0"])),
+    ("support_material_auto", None),
+    ("support_material_buildplate_only", None),
+    ("support_material_contact_distance", None),
+    ("support_material_interface_layers", None),
+    ("support_material_pattern", None),
+    ("support_material_spacing", None),
+    ("support_material_threshold", None),
+    ("thick_bridges", Some(&["0"])),
+    ("thin_walls", Some(&["0"])),
+    ("top_solid_min_thickness", Some(&["0"])),
+    ("wipe_tower", Some(&["0"])),
+    ("xy_size_compensation", Some(&["0"])),
+    ("z_offset", Some(&["0"])),
+];
+
+/// True when the ignored `key` with `value` changes what is printed ([`CHANGES_THE_PRINT`]);
+/// a per-extruder list changes it when any of its values does, a setting of the supports only
+/// when the profile prints supports (`support`).
+fn changes_the_print(key: &str, value: &str, support: bool) -> bool {
+    let Some((_, neutral)) = CHANGES_THE_PRINT.iter().find(|(k, _)| *k == key) else {
+        return false;
+    };
+    if key.starts_with("support_material_") && !support {
+        return false;
+    }
+    let Some(neutral) = neutral else {
+        return true;
+    };
+    value.split(',').map(str::trim).any(|v| {
+        !neutral.contains(&v)
+            && !v
+                .parse::<f64>()
+                .is_ok_and(|x| neutral.iter().any(|n| n.parse::<f64>() == Ok(x)))
+    })
+}
+
+/// Lists, in one warning, every key no step has read: their number, those that change the
+/// print ([`CHANGES_THE_PRINT`]) by name, then after [`IGNORED_LIST_MARK`] all of them, sorted.
 fn warn_ignored(imp: &mut Import) {
     let p = &mut imp.p;
     for key in ACCEPTED {
         p.used.insert((*key).to_owned());
     }
-    let ignored: Vec<&str> = p
+    let support = p
         .values
-        .keys()
-        .filter(|k| !p.used.contains(*k))
-        .map(String::as_str)
+        .get("support_material")
+        .is_some_and(|(v, _)| v.trim() == "1");
+    // `values` is a sorted map: both lists come out sorted.
+    let ignored: Vec<(&str, &str)> = p
+        .values
+        .iter()
+        .filter(|(k, _)| !p.used.contains(*k))
+        .map(|(k, (v, _))| (k.as_str(), v.as_str()))
         .collect();
-    if !ignored.is_empty() {
-        imp.warnings.push(format!(
-            "ignored PrusaSlicer settings (no conduit equivalent): {}",
-            ignored.join(", ")
-        ));
+    if ignored.is_empty() {
+        return;
     }
+    let changing: Vec<&str> = ignored
+        .iter()
+        .filter(|(k, v)| changes_the_print(k, v, support))
+        .map(|(k, _)| *k)
+        .collect();
+    let n = ignored.len();
+    let keys = if n == 1 { "key" } else { "keys" };
+    let which = if changing.is_empty() {
+        "none that change the print".to_owned()
+    } else {
+        format!(
+            "{} that change the print: {}",
+            changing.len(),
+            changing.join(", ")
+        )
+    };
+    let all: Vec<&str> = ignored.iter().map(|(k, _)| *k).collect();
+    imp.warnings.push(format!(
+        "{n} PrusaSlicer {keys} ignored ({which}){IGNORED_LIST_MARK}{}",
+        all.join(", ")
+    ));
 }
 
 /// `250x125` → [250, 125].
@@ -1000,7 +1100,8 @@ gcode_comments = 0
         assert!(all.contains("start_gcode uses PrusaSlicer macros"), "{all}");
         assert!(
             all.contains(
-                "ignored PrusaSlicer settings (no conduit equivalent): gcode_comments, wipe"
+                "2 PrusaSlicer keys ignored (none that change the print); all of them: \
+                 gcode_comments, wipe"
             ),
             "{all}"
         );
@@ -1038,11 +1139,21 @@ gcode_comments = 0
             assert_eq!(cfg.tools[0].temperature, 210.0);
             assert_eq!(cfg.tools[0].filament_density, 1.24);
             assert!(cfg.printer.start_gcode.starts_with("G28 ; home all axes\n"));
-            assert!(
-                warnings
-                    .iter()
-                    .any(|w| w.starts_with("ignored PrusaSlicer settings"))
-            );
+            let ignored = warnings
+                .iter()
+                .find(|w| w.contains(" PrusaSlicer keys ignored ("))
+                .expect("a warning lists the ignored keys");
+            let (summary, all) = ignored
+                .split_once(IGNORED_LIST_MARK)
+                .expect("the full list follows the summary");
+            // The summary names only what changes the print; the list has every key.
+            assert!(summary.contains("seam_position"), "{file}: {summary}");
+            assert!(!summary.contains("gcode_comments"), "{file}: {summary}");
+            assert!(all.contains("gcode_comments"), "{file}: {all}");
+            let keys: Vec<&str> = all.split(", ").collect();
+            let mut sorted = keys.clone();
+            sorted.sort_unstable();
+            assert_eq!(keys, sorted, "{file}");
         }
         Ok(())
     }

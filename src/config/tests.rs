@@ -182,7 +182,9 @@ fn load_picks_the_format_by_extension() -> Result<(), Box<dyn std::error::Error>
     assert_eq!(cfg.slice.layer_height, 0.15);
     assert_eq!(
         warnings,
-        vec!["ignored PrusaSlicer settings (no conduit equivalent): bogus".to_owned()]
+        vec![
+            "1 PrusaSlicer key ignored (none that change the print); all of them: bogus".to_owned()
+        ]
     );
     std::fs::write(&ini_path, "layer_height = 0.15\nperimeters = x\n")?;
     let err = load(&ini_path)
@@ -292,11 +294,53 @@ fn errors_name_the_key_and_suggest_the_closest() {
     let text = |src: &str| parse(src).err().map(|e| e.to_string()).unwrap_or_default();
     assert_eq!(
         text("[slice]\nlayer_height = \"x\"\n"),
-        "config:2: slice.layer_height: invalid type: string \"x\", expected f64"
+        "config:2: slice.layer_height must be a number in mm, got \"x\""
     );
     assert_eq!(
         text("[tools.1]\nnozzle_diameter = true\n"),
-        "config:2: tools.1.nozzle_diameter: invalid type: boolean `true`, expected f64"
+        "config:2: tools.1.nozzle_diameter must be a number in mm, got true"
+    );
+    assert_eq!(
+        text("[slice]\nperimeters = 2.5\n"),
+        "config:2: slice.perimeters must be a whole number ≥ 0, got 2.5"
+    );
+    assert_eq!(
+        text("[slice]\nperimeters = -1\n"),
+        "config:2: slice.perimeters must be a whole number ≥ 0, got -1"
+    );
+    assert_eq!(
+        text("[slice]\nobject_tools = 3\n"),
+        "config:2: slice.object_tools must be a list `[…]`, got 3"
+    );
+    assert_eq!(
+        text("[tools.0]\ntemperature = \"hot\"\n"),
+        "config:2: tools.0.temperature must be a number in °C, got \"hot\""
+    );
+    assert_eq!(
+        text("[printer]\nuse_relative_e_distances = 1\n"),
+        "config:2: printer.use_relative_e_distances must be true or false, got 1"
+    );
+    // No message names a Rust type.
+    for src in [
+        "[printer]\nbed_size = [1]\n",
+        "[printer]\nbed_size = \"x\"\n",
+        "[printer]\nflavor = \"sprinter\"\n",
+        "[slice]\nperimeters = true\n",
+        "[tools.0]\nname = 3\n",
+    ] {
+        let t = text(src);
+        assert!(t.contains(" must be "), "{src:?}: {t}");
+        for word in [
+            "f64", "u32", "usize", "Option", "Vec", "sequence", "expected",
+        ] {
+            assert!(!t.contains(word), "{src:?}: {t}");
+        }
+    }
+    let mut cfg = Config::default();
+    let err = cfg.apply_set("slice.layer_height=abc").err();
+    assert_eq!(
+        err.map(|e| e.to_string()).as_deref(),
+        Some("--set slice.layer_height must be a number in mm, got \"abc\"")
     );
     assert_eq!(
         text("[slice]\nlayerheight = 0.3\n"),

@@ -9,6 +9,7 @@ mod detect;
 mod load;
 mod output;
 mod save;
+pub mod words;
 
 pub use detect::FileKind;
 pub use load::{

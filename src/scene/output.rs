@@ -145,10 +145,19 @@ fn plain(e: io::Error) -> io::Error {
         .and_then(|x| x.source())
         .and_then(|s| s.downcast_ref::<io::Error>())
         .and_then(io::Error::raw_os_error);
-    match inner {
-        Some(code) => io::Error::from_raw_os_error(code),
-        None if e.get_ref().is_some_and(|x| x.source().is_some()) => io::Error::from(e.kind()),
-        None => e,
+    if let Some(code) = inner {
+        return io::Error::from_raw_os_error(code);
+    }
+    // tempfile's wrapper of an operating system error has no source to unwrap: its text is
+    // the error's, then ` at path "<temporary file>"`.
+    let text = e.get_ref().map(ToString::to_string).unwrap_or_default();
+    if let Some((cause, _)) = text.rsplit_once(" at path \"") {
+        return io::Error::new(e.kind(), cause.to_owned());
+    }
+    if e.get_ref().is_some_and(|x| x.source().is_some()) {
+        io::Error::from(e.kind())
+    } else {
+        e
     }
 }
 
@@ -454,5 +463,20 @@ mod tests {
         let text = err.to_string();
         assert!(text.contains("does not exist"), "{text}");
         assert!(!text.contains(".conduit-"), "{text}");
+    }
+
+    /// A folder that exists but takes no new file (`/proc`): the operating system's reason,
+    /// without tempfile's ` at path "<temporary file>"`.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_folder_refusing_files_names_no_temporary_file() {
+        let err = write_atomically(Path::new("/proc/conduit-out.stl"), |f| f.write_all(b"x"))
+            .expect_err("/proc takes no new file");
+        let text = err.to_string();
+        assert!(
+            !text.contains(".conduit-") && !text.contains("at path"),
+            "{text}"
+        );
+        assert!(text.contains("os error"), "{text}");
     }
 }
