@@ -18,6 +18,11 @@ const DIALECTS: [&str; 6] = [
 #[derive(Debug, Parser)]
 #[command(name = "conduit", version, about, long_about = None, propagate_version = true)]
 pub struct Cli {
+    /// Read 3MF files strictly: refuse the harmless defects that are otherwise read past with
+    /// a warning (a metadata name missing, duplicated or undefined, a relationship Id used
+    /// twice, a second StartPart, a duplicated resource id nothing references).
+    #[arg(long, global = true)]
+    pub strict: bool,
     /// The command to run.
     #[command(subcommand)]
     pub command: Command,
