@@ -174,7 +174,7 @@ fn check_extra_starts(
         };
         if !seen.contains_key(&opc::key(target)) {
             let mut scratch = Ctx::new(ctx.limits, false);
-            let clean = matches!(read_model_part(ar, target, true, &mut scratch), Ok(_))
+            let clean = read_model_part(ar, target, true, &mut scratch).is_ok()
                 && scratch.warnings.is_empty()
                 && scratch.suppressed == 0;
             if !clean {
