@@ -28,9 +28,9 @@
 //!   spaces (`schemas.microsoft.com/3dmanufacturing/`, `schemas.3mf.io/3dmanufacturing/`) that
 //!   are not declared `mc:Ignorable`, which are errors. Unknown elements in the core namespace
 //!   are skipped with a warning.
-//! - **Model rules**: unit, object types, metadata (name required, unique per scope, defined;
-//!   see the two modes below), one
-//!   `<resources>` and (root part) one `<build>`; resource ids unique across all resource kinds;
+//! - **Model rules**: unit, object types, metadata (name required, unique per scope,
+//!   well-known or namespace-qualified: see the two modes below), one `<resources>` and (root
+//!   part) one `<build>`; resource ids unique across all resource kinds;
 //!   build items reference existing objects not of type `other`; vertex indices in range and
 //!   distinct; `pid`/`pindex`/`p1..p3` resolve to property groups defined earlier and stay in
 //!   range; colour groups, textures (content type `image/png`/`image/jpeg`, part present),
@@ -38,10 +38,8 @@
 //!   multiproperties inside, at most one colour group and one base/composite group, blend
 //!   methods) are validated; component cycles are errors; slice stacks referenced by a
 //!   `sliceref` must not contain `sliceref`s themselves.
-//!
-//! - **Warnings, not errors** ([`Package::warnings`], at most 1000 per package): undeclared
-//!   metadata prefixes are part of the undefined-name defect below; unknown core elements, the
-//!   legacy namespace, extensions recognised but not interpreted, thumbnails and textures
+//! - **Warnings, not errors** ([`Package::warnings`], at most 1000 per package): unknown core
+//!   elements, the legacy namespace, extensions recognised but not interpreted, thumbnails and textures
 //!   without their relationship, beam-lattice attribute problems, and two defects found in the
 //!   3MF Consortium's own must-pass files (`<multi>` written in the core namespace,
 //!   multiproperties layers naming a `texture2d` or indexing out of range) are warnings in both
@@ -71,10 +69,10 @@
 //! language, metadata, base materials, colour groups, objects (mesh or components, ordered so
 //! components follow the objects they use) and the build. Bytes are deterministic. Numbers use
 //! the shortest `f32` spelling for f32-exact values, else the shortest `f64` one, never an
-//! exponent. The package is read back with [`read`] before anything reaches the sink, so an
-//! invalid model is refused with [`ThreeMfError::Unwritable`]; metadata names must be
-//! well-known or namespace-qualified (lib3mf's strict mode rejects others); `path`s to other
-//! parts are refused; only the materials extension can be required.
+//! exponent. The package is read back with [`read_with`] in strict mode before anything reaches
+//! the sink, so an invalid model is refused with [`ThreeMfError::Unwritable`]; metadata names
+//! must be well-known or namespace-qualified (lib3mf's strict mode rejects others); `path`s to
+//! other parts are refused; only the materials extension can be required.
 //!
 //! # Limits
 //! [`Limits`] bounds entries, inflated bytes (total, and compression ratio per part, counted
