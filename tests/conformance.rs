@@ -23,7 +23,7 @@
 //! both, as lib3mf's strict mode does. The 3MF reader's own corpus test
 //! (`formats/threemf/src/corpus_tests.rs`) applies the same rules to the library.
 
-use crate::support::{conduit, corpus, stderr, stdout};
+use crate::support::{conduit, corpus, stderr, stdout, temp_dir};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -316,5 +316,54 @@ fn strict_mode_refuses_every_defect_the_manifest_names() {
         "{} corpus files off their strict-mode outcome:\n{}",
         failures.len(),
         failures.join("\n")
+    );
+}
+
+/// `--strict` is global: `convert` and `slice` read 3MF the way `info` does. Run on the
+/// manifest's harmless-defect entries that the default mode loads.
+#[test]
+fn strict_applies_to_convert_and_slice() {
+    let Some(cases) = cases() else { return };
+    let dir = temp_dir();
+    let stl = dir.path().join("out.stl");
+    let gcode = dir.path().join("out.gcode");
+    let mut checked = 0;
+    for case in cases.iter().filter(|c| c.harmless && c.is_3mf) {
+        let name = case.path.display().to_string();
+        let file = case.path.as_os_str();
+        let convert = |strict: bool| {
+            let mut args = vec!["convert".as_ref(), file, "-o".as_ref(), stl.as_os_str()];
+            if strict {
+                args.push("--strict".as_ref());
+            }
+            conduit(args)
+        };
+        let default = convert(false);
+        if default.status.code() != Some(0) {
+            continue; // an `either` entry the default mode refuses
+        }
+        assert!(
+            stderr(&default).starts_with(&format!("warning: {name}: ")),
+            "{name}: convert: {}",
+            stderr(&default)
+        );
+        let strict = convert(true);
+        assert_eq!(strict.status.code(), Some(1), "{name}: convert --strict");
+        assert_eq!(refusal_problem(&strict, &name), None, "{name}");
+        let slice = conduit([
+            "slice".as_ref(),
+            "--strict".as_ref(),
+            file,
+            "-o".as_ref(),
+            gcode.as_os_str(),
+        ]);
+        assert_eq!(slice.status.code(), Some(1), "{name}: slice --strict");
+        assert_eq!(refusal_problem(&slice, &name), None, "{name}");
+        assert!(!gcode.exists(), "{name}: slice --strict wrote G-code");
+        checked += 1;
+    }
+    assert!(
+        checked > 0,
+        "no harmless-defect entry loads in the default mode"
     );
 }
