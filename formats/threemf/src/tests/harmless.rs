@@ -251,3 +251,23 @@ fn referenced_duplicate_resource_id_is_refused_in_both_modes() {
     );
     assert!(err_of(&pkg(&xml)).contains("resource id 1 is already used"));
 }
+
+#[test]
+fn repeated_start_part_relationship_is_ignored() {
+    let rels = RELS.replace(
+        "</Relationships>",
+        r#"<Relationship Target="/3D/3dmodel.model" Id="rel1" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>"#,
+    );
+    let root = model_with("", "");
+    let bytes = zip_of(&[
+        ("[Content_Types].xml", CT.as_bytes()),
+        ("_rels/.rels", rels.as_bytes()),
+        ("3D/3dmodel.model", root.as_bytes()),
+    ]);
+    let p = harmless(
+        &bytes,
+        r#"/3D/3dmodel.model is read and /3D/3dmodel.model (relationship "rel1") is ignored"#,
+        "2 StartPart relationships of type 3dmodel (exactly one is required)",
+    );
+    assert_eq!(p.models.len(), 1);
+}
