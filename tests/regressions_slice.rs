@@ -116,18 +116,23 @@ fn slice_meshes_of_duplicated_triangles_finish_quickly() {
     let out = temp_dir();
     let gcode = out.path().join("out.gcode");
     let report = out.path().join("out.json");
-    for mesh in &meshes {
-        let (code, stderr) = run_guarded(&[
-            "slice".as_ref(),
-            mesh.as_os_str(),
-            "-o".as_ref(),
-            gcode.as_os_str(),
-            "--report".as_ref(),
-            report.as_os_str(),
-        ]);
-        match code {
-            Some(0) => {}
-            _ => assert_refused(mesh, code, &stderr),
+    // In both 3MF reading modes.
+    for mode in [None, Some("--strict")] {
+        for mesh in &meshes {
+            let mut args = vec![
+                "slice".as_ref(),
+                mesh.as_os_str(),
+                "-o".as_ref(),
+                gcode.as_os_str(),
+                "--report".as_ref(),
+                report.as_os_str(),
+            ];
+            args.extend(mode.map(std::ffi::OsStr::new));
+            let (code, stderr) = run_guarded(&args);
+            match code {
+                Some(0) => {}
+                _ => assert_refused(mesh, code, &stderr),
+            }
         }
     }
 }
@@ -136,9 +141,16 @@ fn slice_meshes_of_duplicated_triangles_finish_quickly() {
 fn info_on_a_3mf_fanning_out_to_many_instances_finishes() {
     let Some(dir) = regressions() else { return };
     let file = dir.join("handmade/3mf_fanout_distinct_2pow18.3mf");
-    let (code, stderr) = run_guarded(&["info".as_ref(), file.as_os_str()]);
-    match code {
-        Some(0) => {}
-        _ => assert_refused(&file, code, &stderr),
+    // In both 3MF reading modes.
+    for strict in [false, true] {
+        let mut args = vec!["info".as_ref(), file.as_os_str()];
+        if strict {
+            args.push("--strict".as_ref());
+        }
+        let (code, stderr) = run_guarded(&args);
+        match code {
+            Some(0) => {}
+            _ => assert_refused(&file, code, &stderr),
+        }
     }
 }

@@ -24,6 +24,11 @@ pub struct Cli {
     /// Print the details a warning sums up, such as every ignored PrusaSlicer setting.
     #[arg(short, long, global = true)]
     pub verbose: bool,
+    /// Read 3MF files strictly: refuse the harmless defects that are otherwise read past with
+    /// a warning (a metadata name missing, duplicated or undefined, a relationship Id used
+    /// twice, a second StartPart, a duplicated resource id nothing references).
+    #[arg(long, global = true)]
+    pub strict: bool,
     /// The command to run.
     #[command(subcommand)]
     pub command: Command,

@@ -485,7 +485,8 @@ fn load_substrate(spec: &str, cfg: &Config) -> Result<Substrate, Failure> {
         SurfaceSpec::Analytic(a) => return Ok(Substrate::Analytic(a)),
         SurfaceSpec::File(f) => f,
     };
-    let scan = load_scan(&file, false, cfg.conform.fold_gap).map_err(anyhow::Error::from)?;
+    let scan = load_scan(&file, false, cfg.conform.fold_gap, &super::load_options())
+        .map_err(anyhow::Error::from)?;
     for w in &scan.warnings {
         warnln!("{}: {w}", file.display());
     }

@@ -12,7 +12,7 @@ use conduit::conform::{ConformParams, ConformReport, Placement};
 use conduit::emit::robot::Dialect;
 use conduit::geom::Point3;
 use conduit::pipeline::conform::{self as walk, ConformJob, ConformOutput, ConformWalkError, Refs};
-use conduit::scene::{Content, LoadOptions, OutputSet, load};
+use conduit::scene::{Content, OutputSet, load};
 use serde::Serialize;
 
 pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
@@ -37,13 +37,18 @@ pub(crate) fn run(args: ConformArgs) -> Result<(), Failure> {
     let dialect = Dialect::from_name(&dialect_name);
     let orient = orientation(&args, &cfg, dialect)?;
     let place = args.place.as_deref().map(parse_place).transpose()?;
-    let scan = load_scan(&args.surface, args.as_cloud, cfg.conform.fold_gap)
-        .map_err(anyhow::Error::from)?;
+    let scan = load_scan(
+        &args.surface,
+        args.as_cloud,
+        cfg.conform.fold_gap,
+        &super::load_options(),
+    )
+    .map_err(anyhow::Error::from)?;
     for w in &scan.warnings {
         warnln!("{}: {w}", args.surface.display());
     }
     let refs = refs(&args)?;
-    let design = match load(&args.design, &LoadOptions::default())
+    let design = match load(&args.design, &super::load_options())
         .map_err(anyhow::Error::from)?
         .content
     {

@@ -29,7 +29,7 @@ pub(crate) fn run(args: ConvertArgs) -> Result<(), Failure> {
     for job in &jobs {
         inputs.check(&job.output)?;
     }
-    let opts = LoadOptions::default();
+    let opts = super::load_options();
     let bar = progress::bar(jobs.len(), "converting");
     let results: Vec<anyhow::Result<Converted>> = jobs
         .par_iter()
@@ -72,15 +72,24 @@ pub(crate) fn run(args: ConvertArgs) -> Result<(), Failure> {
     }
     for (job, r) in jobs.iter().zip(&results) {
         match r {
-            Ok(_) if args.json => {}
-            Ok(c) => outln!(
-                "{} -> {}: {} object{}, {} triangles",
-                job.input.display(),
-                job.output.display(),
-                c.objects,
-                if c.objects == 1 { "" } else { "s" },
-                c.triangles
-            )?,
+            Ok(c) if args.json => {
+                for w in &c.warnings {
+                    warnln!("{}: {w}", job.input.display());
+                }
+            }
+            Ok(c) => {
+                for w in &c.warnings {
+                    warnln!("{}: {w}", job.input.display());
+                }
+                outln!(
+                    "{} -> {}: {} object{}, {} triangles",
+                    job.input.display(),
+                    job.output.display(),
+                    c.objects,
+                    if c.objects == 1 { "" } else { "s" },
+                    c.triangles
+                )?
+            }
             Err(e) => errorln!("{e:#}"),
         }
     }
@@ -94,6 +103,8 @@ pub(crate) fn run(args: ConvertArgs) -> Result<(), Failure> {
 struct Converted {
     objects: usize,
     triangles: usize,
+    /// The reader's warnings, printed to stderr.
+    warnings: Vec<String>,
 }
 
 /// The inputs with every folder replaced by its mesh files (known extensions, not recursive,
@@ -195,7 +206,7 @@ fn plan(args: &ConvertArgs, inputs: &[PathBuf]) -> Result<Vec<Job>, Failure> {
 }
 
 fn convert_one(job: &Job, opts: &LoadOptions, repair: bool) -> anyhow::Result<Converted> {
-    let (mut scene, _warnings) = load_scene(&job.input, opts)?;
+    let (mut scene, warnings) = load_scene(&job.input, opts)?;
     if scene.triangle_count() == 0 {
         anyhow::bail!("{}: no triangles to convert", job.input.display());
     }
@@ -210,5 +221,6 @@ fn convert_one(job: &Job, opts: &LoadOptions, repair: bool) -> anyhow::Result<Co
     Ok(Converted {
         objects: scene.objects.len(),
         triangles: scene.triangle_count(),
+        warnings,
     })
 }

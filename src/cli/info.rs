@@ -3,7 +3,7 @@
 use super::{Failure, args::InfoArgs};
 use conduit::geom::{BoundingBox, Point3, Tolerances};
 use conduit::mesh::{Mesh, RepairReport, TopologyReport};
-use conduit::scene::{Content, LoadOptions, LoadedFile, MeshDetails, Scene, load};
+use conduit::scene::{Content, LoadedFile, MeshDetails, Scene, load};
 use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::{Value, json};
@@ -33,16 +33,24 @@ struct RepairFindings {
 }
 
 pub(crate) fn run(args: InfoArgs) -> Result<(), Failure> {
-    let opts = LoadOptions::default();
-    let reports: Vec<Result<Value, String>> = args
+    let opts = super::load_options();
+    let loaded: Vec<Result<(Value, Vec<String>), String>> = args
         .files
         .par_iter()
         .map(|path| {
             load(path, &opts)
-                .map(|file| describe(&file, !args.no_repair))
+                .map(|file| (describe(&file, !args.no_repair), file.warnings))
                 .map_err(|e| format!("{e}"))
         })
         .collect();
+    // The readers' warnings go to stderr as well, in the order of the files.
+    for (r, path) in loaded.iter().zip(&args.files) {
+        for w in r.iter().flat_map(|(_, w)| w) {
+            warnln!("{}: {w}", path.display());
+        }
+    }
+    let reports: Vec<Result<Value, String>> =
+        loaded.into_iter().map(|r| r.map(|(v, _)| v)).collect();
     let failed = reports.iter().filter(|r| r.is_err()).count();
     let stdout = std::io::stdout();
     let mut out = stdout.lock();

@@ -183,6 +183,15 @@ pub(crate) fn paths<'a>(paths: impl IntoIterator<Item = &'a std::path::Path>) ->
     paths.into_iter().map(|p| p.display().to_string()).collect()
 }
 
+/// How every command reads its input files, set once from the global options before the
+/// command runs.
+static LOAD_OPTIONS: std::sync::OnceLock<conduit::scene::LoadOptions> = std::sync::OnceLock::new();
+
+/// The options every command reads files with (`--strict` for 3MF).
+pub(crate) fn load_options() -> conduit::scene::LoadOptions {
+    LOAD_OPTIONS.get().cloned().unwrap_or_default()
+}
+
 /// Runs the command line and returns the process exit code.
 pub fn run() -> ExitCode {
     let cli = match args::Cli::try_parse() {
@@ -209,6 +218,10 @@ pub fn run() -> ExitCode {
         Verbosity::Normal
     };
     VERBOSITY.store(verbosity as u8, Ordering::Relaxed);
+    let _ = LOAD_OPTIONS.set(conduit::scene::LoadOptions {
+        threemf_read: conduit_3mf::ReadOptions { strict: cli.strict },
+        ..conduit::scene::LoadOptions::default()
+    });
     let result = match cli.command {
         args::Command::Info(a) => info::run(a),
         args::Command::Convert(a) => convert::run(a),

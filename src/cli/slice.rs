@@ -6,7 +6,7 @@ use conduit::circuit::Electronics;
 use conduit::circuit::stage::pnp_records;
 use conduit::circuit::{Circuit, Placement};
 use conduit::pipeline::{Stage, slice_clfff, slice_scene_with};
-use conduit::scene::{LoadOptions, OutputSet, Scene, load_scene};
+use conduit::scene::{OutputSet, Scene, load_scene};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 
@@ -347,7 +347,7 @@ pub(crate) fn load_models(models: &[std::path::PathBuf]) -> Result<Scene, Failur
     let mut scene = Scene::default();
     for path in models {
         let (s, warnings) =
-            load_scene(path, &LoadOptions::default()).map_err(anyhow::Error::from)?;
+            load_scene(path, &super::load_options()).map_err(anyhow::Error::from)?;
         for w in warnings {
             warnln!("{}: {w}", path.display());
         }

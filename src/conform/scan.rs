@@ -52,10 +52,15 @@ pub enum ScanError {
     },
 }
 
-/// Reads `path` as a surface. A point cloud with faces is meshed as it is unless `as_cloud`;
-/// a bare cloud becomes a height field with `fold_gap` ([`Surface::from_cloud`]).
-pub fn load_scan(path: &Path, as_cloud: bool, fold_gap: f64) -> Result<Scan, ScanError> {
-    let file = load(path, &LoadOptions::default())?;
+/// Reads `path` as a surface with `opts`. A point cloud with faces is meshed as it is unless
+/// `as_cloud`; a bare cloud becomes a height field with `fold_gap` ([`Surface::from_cloud`]).
+pub fn load_scan(
+    path: &Path,
+    as_cloud: bool,
+    fold_gap: f64,
+    opts: &LoadOptions,
+) -> Result<Scan, ScanError> {
+    let file = load(path, opts)?;
     let named = |error: SurfaceError| ScanError::Surface {
         path: path.to_path_buf(),
         error,

@@ -13,6 +13,9 @@ pub struct LoadOptions {
     pub max_file_bytes: u64,
     /// Limits applied to 3MF packages (zip-bomb and count guards).
     pub threemf_limits: conduit_3mf::Limits,
+    /// How 3MF packages are read: the default mode reads past harmless defects with a warning
+    /// each, strict mode refuses them (`conduit --strict`).
+    pub threemf_read: conduit_3mf::ReadOptions,
     /// Curve flattening tolerance for SVG designs, in millimetres.
     pub svg_tolerance_mm: f64,
 }
@@ -22,6 +25,7 @@ impl Default for LoadOptions {
         Self {
             max_file_bytes: 4 << 30,
             threemf_limits: conduit_3mf::Limits::default(),
+            threemf_read: conduit_3mf::ReadOptions::default(),
             svg_tolerance_mm: crate::geom::Tolerances::default().curve_flattening.mm(),
         }
     }
@@ -308,7 +312,7 @@ fn threemf_content(
     opts: &LoadOptions,
     warnings: &mut Vec<String>,
 ) -> Result<Content, LoadErrorKind> {
-    let package = conduit_3mf::read(bytes, &opts.threemf_limits)?;
+    let package = conduit_3mf::read_with(bytes, &opts.threemf_limits, opts.threemf_read)?;
     let flat = package.flatten()?;
     let root = package.root();
     let objects = flat

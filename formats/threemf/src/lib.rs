@@ -4,13 +4,15 @@
 //! pipeline. [`read`] turns package bytes into a [`Package`] of [`Model`]s; [`Package::flatten`]
 //! resolves the build into plain millimetre meshes ([`FlatMesh`]); [`write()`] produces a
 //! single-part package that lib3mf reads without warnings (checked in strict mode with
-//! `bench/lib3mf_check.py`).
+//! `bench/lib3mf_check.py`). [`read_with`] and [`ReadOptions`] choose between the default mode,
+//! which reads past harmless defects with a warning each, and the strict mode.
 //!
 //! # What is read
-//! - **OPC**: `[Content_Types].xml`, `_rels/.rels` and the model parts' `.rels`; exactly one
+//! - **OPC**: `[Content_Types].xml`, `_rels/.rels` and the model parts' `.rels`; one
 //!   3D model StartPart; 3MF relationships (model, thumbnail, print ticket, texture) must target
 //!   existing parts inside the package; at most one print ticket per part; part names compare
-//!   case-insensitively (and percent-decoded); model parts need the 3D model content type.
+//!   case-insensitively (and percent-decoded); model parts need the 3D model content type;
+//!   relationship Ids are unique per `.rels` part.
 //! - **XML**: UTF-8 only (no UTF-16, no other declared encoding), no DTD, one root element,
 //!   namespaces resolved; duplicated attributes and `xml:space` are rejected; numbers are
 //!   `xs:double` with `.` decimals (a comma, `NaN`, `INF` or text is an error).
@@ -26,8 +28,9 @@
 //!   spaces (`schemas.microsoft.com/3dmanufacturing/`, `schemas.3mf.io/3dmanufacturing/`) that
 //!   are not declared `mc:Ignorable`, which are errors. Unknown elements in the core namespace
 //!   are skipped with a warning.
-//! - **Model rules**: unit, object types, metadata (name required, unique per scope), one
-//!   `<resources>` and (root part) one `<build>`; resource ids unique across all resource kinds;
+//! - **Model rules**: unit, object types, metadata (name required, unique per scope,
+//!   well-known or namespace-qualified: see the two modes below), one `<resources>` and (root
+//!   part) one `<build>`; resource ids unique across all resource kinds;
 //!   build items reference existing objects not of type `other`; vertex indices in range and
 //!   distinct; `pid`/`pindex`/`p1..p3` resolve to property groups defined earlier and stay in
 //!   range; colour groups, textures (content type `image/png`/`image/jpeg`, part present),
@@ -35,27 +38,41 @@
 //!   multiproperties inside, at most one colour group and one base/composite group, blend
 //!   methods) are validated; component cycles are errors; slice stacks referenced by a
 //!   `sliceref` must not contain `sliceref`s themselves.
-//!
-//! - **Warnings, not errors** ([`Package::warnings`], at most 1000 per package): metadata
-//!   names that are neither well-known nor namespace-qualified (the 3MF verifier's MUSTPASS
-//!   3.4.1c requires loading them), undeclared metadata prefixes, unknown core elements, the
-//!   legacy namespace, extensions recognised but not interpreted, thumbnails and textures
+//! - **Warnings, not errors** ([`Package::warnings`], at most 1000 per package): unknown core
+//!   elements, the legacy namespace, extensions recognised but not interpreted, thumbnails and textures
 //!   without their relationship, beam-lattice attribute problems, and two defects found in the
 //!   3MF Consortium's own must-pass files (`<multi>` written in the core namespace,
-//!   multiproperties layers naming a `texture2d` or indexing out of range).
-//! - **Strict where the specification is**: exactly one StartPart (a second one is an error,
-//!   although lib3mf only warns), duplicated metadata names and duplicated resource ids are
-//!   errors even in files that lib3mf loads.
+//!   multiproperties layers naming a `texture2d` or indexing out of range) are warnings in both
+//!   modes.
+//!
+//! # Two modes: default and strict
+//! [`read`] (and [`read_with`] with [`ReadOptions::default`]) reads past *harmless defects*,
+//! the ones lib3mf's lenient mode and PrusaSlicer accept, with one warning each naming the
+//! defect, the part (and line) and what was kept; [`ReadOptions::strict`] makes each of them
+//! an error, as the validation suite's MUSTFAIL files demand:
+//! - a `<metadata>` without a name, or with an empty one (the entry is skipped);
+//! - a metadata name used twice in one scope (the first entry is kept);
+//! - a metadata name neither well-known nor qualified by a declared namespace prefix (kept;
+//!   MUSTFAIL 3.4.1a. MUSTPASS 3.4.1c has the very same defect, so strict mode refuses it too,
+//!   as lib3mf's strict mode does);
+//! - a relationship Id used twice in one `.rels` part (the first is kept);
+//! - more than one StartPart relationship: the first target is the root; a further one is
+//!   ignored when it targets a part of the payload or a complete model part that reads without
+//!   an error or a warning, and refused otherwise (MUSTFAIL 2.1.2's second part uses textures
+//!   through the first part's relationships);
+//! - a resource id used twice in one part when nothing references it (the first definition is
+//!   kept; a referenced duplicate is refused in both modes, as either definition could be
+//!   meant).
 //!
 //! # Writing
 //! [`write()`] emits `[Content_Types].xml`, `_rels/.rels` and `/3D/3dmodel.model` with unit,
 //! language, metadata, base materials, colour groups, objects (mesh or components, ordered so
 //! components follow the objects they use) and the build. Bytes are deterministic. Numbers use
 //! the shortest `f32` spelling for f32-exact values, else the shortest `f64` one, never an
-//! exponent. The package is read back with [`read`] before anything reaches the sink, so an
-//! invalid model is refused with [`ThreeMfError::Unwritable`]; metadata names must be
-//! well-known or namespace-qualified (lib3mf's strict mode rejects others); `path`s to other
-//! parts are refused; only the materials extension can be required.
+//! exponent. The package is read back with [`read_with`] in strict mode before anything reaches
+//! the sink, so an invalid model is refused with [`ThreeMfError::Unwritable`]; metadata names
+//! must be well-known or namespace-qualified (lib3mf's strict mode rejects others); `path`s to
+//! other parts are refused; only the materials extension can be required.
 //!
 //! # Limits
 //! [`Limits`] bounds entries, inflated bytes (total, and compression ratio per part, counted
@@ -107,5 +124,5 @@ pub use model::{
     BaseMaterial, BaseMaterials, BuildItem, ColorGroup, Component, IDENTITY, Mesh, Metadata, Model,
     Object, ObjectContent, ObjectType, Package, Triangle, Unit,
 };
-pub use read::read;
+pub use read::{ReadOptions, read, read_with};
 pub use write::{ROOT_MODEL_PATH, format_number, write};

@@ -73,7 +73,8 @@ pub struct Package {
     /// relationship or the referencing `p:path` / `slicepath` (always starting with `/`).
     pub models: BTreeMap<String, Model>,
     /// Non-fatal findings (ignored unknown elements, recognised-but-uninterpreted extensions,
-    /// dangling optional relationships, ...), one line each, naming the part.
+    /// dangling optional relationships, ..., and in the default mode the harmless defects read
+    /// past, see [`crate::ReadOptions`]), one line each, naming the part.
     pub warnings: Vec<String>,
     /// The limits the package was read with; [`Package::flatten`] enforces them on its output.
     pub limits: Limits,

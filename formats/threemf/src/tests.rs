@@ -7,6 +7,8 @@ use zip::{CompressionMethod, ZipWriter};
 
 use crate::*;
 
+mod harmless;
+
 const CT: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
 <Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types"><Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/><Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/><Default Extension="png" ContentType="image/png"/></Types>"#;
 const RELS: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
@@ -56,6 +58,14 @@ fn read_default(bytes: &[u8]) -> Result<Package, ThreeMfError> {
 
 fn err_of(bytes: &[u8]) -> String {
     match read_default(bytes) {
+        Ok(_) => "Ok".into(),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// The error message of reading `bytes` in strict mode (`"Ok"` when it reads).
+fn err_strict(bytes: &[u8]) -> String {
+    match read_with(bytes, &Limits::default(), ReadOptions { strict: true }) {
         Ok(_) => "Ok".into(),
         Err(e) => e.to_string(),
     }
@@ -546,17 +556,29 @@ fn spec_violations_are_rejected_with_located_messages() {
         ),
         (
             "repeated vertex",
-            model_xml("", &ok_obj.replace(r#"v1="1" v2="2""#, r#"v1="2" v2="2""#), item),
+            model_xml(
+                "",
+                &ok_obj.replace(r#"v1="1" v2="2""#, r#"v1="2" v2="2""#),
+                item,
+            ),
             "distinct",
         ),
         (
             "other-type item",
-            model_xml("", &ok_obj.replace(r#"id="1""#, r#"id="1" type="other""#), item),
+            model_xml(
+                "",
+                &ok_obj.replace(r#"id="1""#, r#"id="1" type="other""#),
+                item,
+            ),
             "type \"other\"",
         ),
         (
             "pindex without pid",
-            model_xml("", &ok_obj.replace(r#"id="1""#, r#"id="1" pindex="0""#), item),
+            model_xml(
+                "",
+                &ok_obj.replace(r#"id="1""#, r#"id="1" pindex="0""#),
+                item,
+            ),
             "pindex is given without a pid",
         ),
         (
@@ -568,14 +590,18 @@ fn spec_violations_are_rejected_with_located_messages() {
             "duplicate id",
             model_xml(
                 "",
-                &format!(r##"<m:colorgroup id="1"><m:color color="#000000"/></m:colorgroup>{ok_obj}"##),
+                &format!(
+                    r##"<m:colorgroup id="1"><m:color color="#000000"/></m:colorgroup>{ok_obj}"##
+                ),
                 item,
             ),
             "resource id 1 is already used",
         ),
         (
             "missing build",
-            model_xml("", &ok_obj, item).replace("<build>", "<!--").replace("</build>", "-->"),
+            model_xml("", &ok_obj, item)
+                .replace("<build>", "<!--")
+                .replace("</build>", "-->"),
             "has no <build>",
         ),
         (
@@ -622,20 +648,6 @@ fn spec_violations_are_rejected_with_located_messages() {
             "more than one root element",
         ),
         (
-            "duplicate metadata",
-            model_xml("", &ok_obj, item).replacen(
-                "<resources>",
-                r#"<metadata name="Title">a</metadata><metadata name="Title">b</metadata><resources>"#,
-                1,
-            ),
-            "duplicated metadata name",
-        ),
-        (
-            "metadata without name",
-            model_xml("", &ok_obj, item).replacen("<resources>", "<metadata>a</metadata><resources>", 1),
-            "missing required attribute \"name\"",
-        ),
-        (
             "xml:space",
             model_xml(r#"xml:space="preserve""#, &ok_obj, item),
             "xml:space",
@@ -644,7 +656,9 @@ fn spec_violations_are_rejected_with_located_messages() {
             "texture content type",
             model_xml(
                 "",
-                &format!(r#"<m:texture2d id="5" path="/3D/t.png" contenttype="image/gif"/>{ok_obj}"#),
+                &format!(
+                    r#"<m:texture2d id="5" path="/3D/t.png" contenttype="image/gif"/>{ok_obj}"#
+                ),
                 item,
             ),
             "image/png or image/jpeg",
@@ -653,7 +667,9 @@ fn spec_violations_are_rejected_with_located_messages() {
             "missing texture part",
             model_xml(
                 "",
-                &format!(r#"<m:texture2d id="5" path="/3D/none.png" contenttype="image/png"/>{ok_obj}"#),
+                &format!(
+                    r#"<m:texture2d id="5" path="/3D/none.png" contenttype="image/png"/>{ok_obj}"#
+                ),
                 item,
             ),
             "texture part does not exist",
@@ -736,7 +752,7 @@ fn package_level_violations_are_rejected() {
         "</Relationships>",
         r#"<Relationship Target="/3D/b.model" Id="rel1" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>"#,
     );
-    let e = err_of(&zip_of(&[
+    let e = err_strict(&zip_of(&[
         ("[Content_Types].xml", CT.as_bytes()),
         ("_rels/.rels", two.as_bytes()),
         ("3D/3dmodel.model", m),

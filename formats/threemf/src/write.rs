@@ -13,7 +13,7 @@ use crate::error::ThreeMfError;
 use crate::model::{Mesh, Model, Object, ObjectContent};
 use crate::opc;
 use crate::xml::{NS_CORE, NS_CT, NS_MATERIAL, NS_RELS};
-use crate::{Limits, read};
+use crate::{Limits, ReadOptions, read_with};
 
 /// Part name of the model the writer produces.
 pub const ROOT_MODEL_PATH: &str = "/3D/3dmodel.model";
@@ -25,10 +25,10 @@ pub const ROOT_MODEL_PATH: &str = "/3D/3dmodel.model";
 /// shortest `f32` spelling when the value is an `f32`, else the shortest `f64` spelling, never
 /// in exponent notation. `required_extensions` is honoured only for the materials extension,
 /// the one whose markup the writer emits; other entries are dropped. Before anything is
-/// written to `w`, the package is read back with
-/// [`read`]; a model that would produce an invalid file (dangling references, duplicate ids,
-/// out-of-range indices, non-finite numbers, `path`s to other parts) is refused with
-/// [`ThreeMfError::Unwritable`] and `w` is left untouched.
+/// written to `w`, the package is read back with [`read_with`] in strict mode; a model that
+/// would produce an invalid file (dangling references, duplicate ids, out-of-range indices,
+/// non-finite numbers, `path`s to other parts) is refused with [`ThreeMfError::Unwritable`]
+/// and `w` is left untouched.
 pub fn write<W: Write + Seek>(mut w: W, model: &Model) -> Result<(), ThreeMfError> {
     let xml = model_xml(model)?;
     let mut buf = Cursor::new(Vec::new());
@@ -63,7 +63,7 @@ pub fn write<W: Write + Seek>(mut w: W, model: &Model) -> Result<(), ThreeMfErro
         max_objects: usize::MAX,
         ..Limits::default()
     };
-    if let Err(e) = read(&bytes, &limits) {
+    if let Err(e) = read_with(&bytes, &limits, ReadOptions { strict: true }) {
         return Err(ThreeMfError::Unwritable {
             reason: format!("the written package would not be valid: {e}"),
         });

@@ -4,6 +4,10 @@ use quick_xml::events::BytesStart;
 
 use super::*;
 
+/// What is wrong with a metadata name that is neither well-known nor namespace-qualified.
+const UNDEFINED_METADATA: &str =
+    "is neither a well-known name nor qualified by a declared namespace prefix";
+
 impl<'x> Parser<'x, '_, '_, '_> {
     pub(super) fn model(&mut self) -> Result<(), ThreeMfError> {
         let (e, empty) = self.root_element()?;
@@ -180,34 +184,52 @@ impl<'x> Parser<'x, '_, '_, '_> {
             }
         }
         let Some(name) = name else {
-            return Err(ThreeMfError::MissingAttribute {
-                at,
-                element: "metadata",
-                attribute: "name",
-            });
+            return self.ctx.defect(
+                || ThreeMfError::MissingAttribute {
+                    at: at.clone(),
+                    element: "metadata",
+                    attribute: "name",
+                },
+                || format!("{at}: <metadata> has no name attribute; the entry is skipped"),
+            );
         };
         if name.trim().is_empty() {
-            return Err(ThreeMfError::InvalidAttribute {
-                at,
-                element: "metadata".into(),
-                attribute: "name".into(),
-                value: name,
-                reason: "metadata name must not be empty",
-            });
+            return self.ctx.defect(
+                || ThreeMfError::InvalidAttribute {
+                    at: at.clone(),
+                    element: "metadata".into(),
+                    attribute: "name".into(),
+                    value: name.clone(),
+                    reason: "metadata name must not be empty",
+                },
+                || format!("{at}: metadata name is empty; the entry is skipped"),
+            );
         }
-        if !scope.names.insert(name.clone()) {
-            return Err(ThreeMfError::DuplicateMetadata { at, name });
+        if scope.names.contains(&name) {
+            return self.ctx.defect(
+                || ThreeMfError::DuplicateMetadata {
+                    at: at.clone(),
+                    name: name.clone(),
+                },
+                || format!("{at}: metadata name {name:?} appears twice; the first is kept"),
+            );
         }
-        if let Some((prefix, _)) = name.split_once(':') {
-            if self.x.resolve_prefix(prefix).is_none() {
-                self.ctx.warn(format!(
-                    "{at}: metadata name {name:?} uses namespace prefix {prefix:?}, which is not declared"
-                ));
-            }
-        } else if !WELL_KNOWN_METADATA.contains(&name.as_str()) {
-            self.ctx.warn(format!(
-                "{at}: metadata name {name:?} is neither a well-known name nor namespace-qualified"
-            ));
+        scope.names.insert(name.clone());
+        let defined = match name.split_once(':') {
+            Some((prefix, _)) => self.x.resolve_prefix(prefix).is_some(),
+            None => WELL_KNOWN_METADATA.contains(&name.as_str()),
+        };
+        if !defined {
+            self.ctx.defect(
+                || ThreeMfError::InvalidAttribute {
+                    at: at.clone(),
+                    element: "metadata".into(),
+                    attribute: "name".into(),
+                    value: clip(&name),
+                    reason: UNDEFINED_METADATA,
+                },
+                || format!("{at}: metadata name {name:?} {UNDEFINED_METADATA}; the entry is kept"),
+            )?;
         }
         scope.entries.push(Metadata { name, value });
         Ok(())
@@ -256,7 +278,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
             Some(t) => ObjectType::from_attr(t)
                 .ok_or_else(|| self.invalid("object", "type", t, "unknown object type"))?,
         };
-        self.add_res(id, Res::Object(kind))?;
+        let own = self.add_res(id, Res::Object(kind))?;
         let name = Self::get(&attrs, Ns::None, "name").map(str::to_string);
         let pid = Self::get(&attrs, Ns::None, "pid")
             .map(|v| self.u32_attr("object", "pid", v))
@@ -295,6 +317,9 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 element: "components",
                 rule: "a components element needs at least one component",
             });
+        }
+        if !own {
+            return Ok(());
         }
         self.info.model.objects.push(Object {
             id,

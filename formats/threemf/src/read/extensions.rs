@@ -12,7 +12,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
     ) -> Result<(), ThreeMfError> {
         let attrs = self.attrs(e)?;
         let id = self.id_attr("slicestack", &attrs)?;
-        self.add_res(id, Res::SliceStack { has_refs: false })?;
+        let own = self.add_res(id, Res::SliceStack { has_refs: false })?;
         let (mut slices, mut refs) = (0usize, 0usize);
         if !empty {
             self.children(|p, e, empty| {
@@ -59,9 +59,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 "a slice stack contains either slices or slicerefs, not both",
             ));
         }
-        self.info
-            .res
-            .insert(id, Res::SliceStack { has_refs: refs > 0 });
+        self.set_res(own, id, Res::SliceStack { has_refs: refs > 0 });
         Ok(())
     }
 
@@ -85,7 +83,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
             if let Some(v) = Self::get(&attrs, Ns::None, a) {
                 let ok = parse_u32(v)
                     .ok()
-                    .and_then(|id| self.info.res.get(&id))
+                    .and_then(|id| self.res_ref(id))
                     .is_some_and(|r| matches!(r, Res::Object(_)));
                 if !ok {
                     self.warn(format_args!(

@@ -13,7 +13,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
     ) -> Result<(), ThreeMfError> {
         let attrs = self.attrs(e)?;
         let id = self.id_attr("basematerials", &attrs)?;
-        self.add_res(id, Res::Base(0))?;
+        let own = self.add_res(id, Res::Base(0))?;
         let mut materials = Vec::new();
         if !empty {
             self.children(|p, e, empty| {
@@ -38,11 +38,13 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 Ok(())
             })?;
         }
-        self.info.res.insert(id, Res::Base(materials.len()));
-        self.info
-            .model
-            .base_materials
-            .push(BaseMaterials { id, materials });
+        self.set_res(own, id, Res::Base(materials.len()));
+        if own {
+            self.info
+                .model
+                .base_materials
+                .push(BaseMaterials { id, materials });
+        }
         Ok(())
     }
 
@@ -53,7 +55,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
     ) -> Result<(), ThreeMfError> {
         let attrs = self.attrs(e)?;
         let id = self.id_attr("colorgroup", &attrs)?;
-        self.add_res(id, Res::Color(0))?;
+        let own = self.add_res(id, Res::Color(0))?;
         let mut colors = Vec::new();
         if !empty {
             self.children(|p, e, empty| {
@@ -70,8 +72,10 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 Ok(())
             })?;
         }
-        self.info.res.insert(id, Res::Color(colors.len()));
-        self.info.model.color_groups.push(ColorGroup { id, colors });
+        self.set_res(own, id, Res::Color(colors.len()));
+        if own {
+            self.info.model.color_groups.push(ColorGroup { id, colors });
+        }
         Ok(())
     }
 
@@ -125,7 +129,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
         let texid = Self::get(&attrs, Ns::None, "texid")
             .ok_or_else(|| self.missing("texture2dgroup", "texid"))?;
         let texid = self.u32_attr("texture2dgroup", "texid", texid)?;
-        if self.info.res.get(&texid) != Some(&Res::Texture) {
+        if self.res_ref(texid) != Some(Res::Texture) {
             return Err(ThreeMfError::UnresolvedReference {
                 at: self.x.loc(),
                 element: "texture2dgroup",
@@ -134,7 +138,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 expected: "a texture2d defined earlier",
             });
         }
-        self.add_res(id, Res::TexGroup(0))?;
+        let own = self.add_res(id, Res::TexGroup(0))?;
         let mut n = 0usize;
         if !empty {
             self.children(|p, e, empty| {
@@ -154,7 +158,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 Ok(())
             })?;
         }
-        self.info.res.insert(id, Res::TexGroup(n));
+        self.set_res(own, id, Res::TexGroup(n));
         Ok(())
     }
 
@@ -171,7 +175,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
         let mi = Self::get(&attrs, Ns::None, "matindices")
             .ok_or_else(|| self.missing("compositematerials", "matindices"))?;
         let matindices = self.u32_list("compositematerials", "matindices", mi)?;
-        let Some(Res::Base(count)) = self.info.res.get(&matid).copied() else {
+        let Some(Res::Base(count)) = self.res_ref(matid) else {
             return Err(ThreeMfError::UnresolvedReference {
                 at: self.x.loc(),
                 element: "compositematerials",
@@ -194,7 +198,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 });
             }
         }
-        self.add_res(id, Res::Composite(0))?;
+        let own = self.add_res(id, Res::Composite(0))?;
         let mut n = 0usize;
         if !empty {
             self.children(|p, e, empty| {
@@ -216,7 +220,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 Ok(())
             })?;
         }
-        self.info.res.insert(id, Res::Composite(n));
+        self.set_res(own, id, Res::Composite(n));
         Ok(())
     }
 
@@ -233,13 +237,13 @@ impl<'x> Parser<'x, '_, '_, '_> {
         if let Some(bm) = Self::get(&attrs, Ns::None, "blendmethods") {
             self.blend_methods(bm, pids.len())?;
         }
-        self.add_res(id, Res::Multi(0))?;
+        let own = self.add_res(id, Res::Multi(0))?;
         let n = if empty {
             0
         } else {
             self.multi_children(id, &pids, &counts)?
         };
-        self.info.res.insert(id, Res::Multi(n));
+        self.set_res(own, id, Res::Multi(n));
         Ok(())
     }
 
@@ -251,7 +255,7 @@ impl<'x> Parser<'x, '_, '_, '_> {
         let mut counts = Vec::with_capacity(pids.len());
         let (mut colors, mut materials) = (0, 0);
         for &pid in pids {
-            let r = self.info.res.get(&pid).copied();
+            let r = self.res_ref(pid);
             let unresolved = |expected| ThreeMfError::UnresolvedReference {
                 at: self.x.loc(),
                 element: "multiproperties",

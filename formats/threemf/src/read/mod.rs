@@ -16,7 +16,7 @@ mod extensions;
 mod materials;
 mod validate;
 
-use validate::{check_component_graph, validate_cross_part};
+use validate::{check_component_graph, check_duplicate_ids, validate_cross_part};
 
 /// Well-known metadata names of the core specification.
 pub(crate) const WELL_KNOWN_METADATA: &[&str] = &[
@@ -31,26 +31,47 @@ pub(crate) const WELL_KNOWN_METADATA: &[&str] = &[
     "Application",
 ];
 
-/// Reads a 3MF package from its bytes.
+/// How the reader treats harmless defects: files that break a rule of the specification in a
+/// way that leaves no doubt about the model (a metadata name missing, duplicated or undefined,
+/// a relationship Id used twice, a second StartPart that is a complete model of its own, a
+/// duplicated resource id that nothing references).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ReadOptions {
+    /// `false` (the default): such a defect is read past and reported as one warning in
+    /// [`Package::warnings`] naming the defect, the part and what was kept, as lib3mf's lenient
+    /// mode and PrusaSlicer read these files. `true`: it is an error, as the 3MF Consortium's
+    /// validation suite (its MUSTFAIL files) demands.
+    pub strict: bool,
+}
+
+/// Reads a 3MF package from its bytes in the default mode (harmless defects become warnings;
+/// see [`ReadOptions`]).
 ///
 /// Every model part reachable from the root model (production `p:path`, slice `slicepath`,
 /// and `3dmodel` relationships of the root model) is read and validated; see the crate
 /// documentation for the rules enforced and [`Limits`] for the resource bounds.
 pub fn read(bytes: &[u8], limits: &Limits) -> Result<Package, ThreeMfError> {
+    read_with(bytes, limits, ReadOptions::default())
+}
+
+/// Reads a 3MF package from its bytes with `options` (the default mode, or strict).
+pub fn read_with(
+    bytes: &[u8],
+    limits: &Limits,
+    options: ReadOptions,
+) -> Result<Package, ThreeMfError> {
     let mut ar = Archive::open(bytes, limits)?;
-    let mut ctx = Ctx {
-        limits,
-        warnings: Vec::new(),
-        suppressed: 0,
-        vertices: 0,
-        triangles: 0,
-        resources: 0,
-    };
-    let root_path = root_model_path(&mut ar, &mut ctx)?;
+    let mut ctx = Ctx::new(limits, options.strict);
+    let (root_path, extra_starts) = root_model_path(&mut ar, &mut ctx)?;
     let (parts, seen) = read_model_parts(&mut ar, &root_path, &mut ctx)?;
 
+    // Duplicated ids first: a reference to a dropped duplicate is reported as the duplicate.
+    for w in check_duplicate_ids(&parts, &seen)? {
+        ctx.warn(w);
+    }
     validate_cross_part(&parts, &seen, &root_path)?;
     check_component_graph(&parts, limits)?;
+    check_extra_starts(&mut ar, &root_path, &extra_starts, &seen, &mut ctx)?;
 
     let models = parts.into_iter().map(|(k, v)| (k, v.model)).collect();
     Ok(Package {
@@ -67,9 +88,14 @@ pub fn read(bytes: &[u8], limits: &Limits) -> Result<Package, ThreeMfError> {
     })
 }
 
-/// The path of the root model part: the one target of the package's 3D model relationship,
-/// which must be a part inside the package.
-fn root_model_path(ar: &mut Archive<'_>, ctx: &mut Ctx<'_>) -> Result<String, ThreeMfError> {
+/// The path of the root model part: the target of the package's 3D model relationship,
+/// which must be a part inside the package. Further StartPart relationships are an error in
+/// strict mode; otherwise they are returned (relationship, resolved target) for
+/// [`check_extra_starts`].
+fn root_model_path(
+    ar: &mut Archive<'_>,
+    ctx: &mut Ctx<'_>,
+) -> Result<(String, Vec<Relationship>), ThreeMfError> {
     if !ar.exists("/_rels/.rels") {
         return Err(ThreeMfError::MissingPart {
             part: "/_rels/.rels".into(),
@@ -77,24 +103,10 @@ fn root_model_path(ar: &mut Archive<'_>, ctx: &mut Ctx<'_>) -> Result<String, Th
         });
     }
     let rels = ar.relationships("/")?;
-    check_relationships(ar, "/", &rels, ctx)?;
+    let rels = check_relationships(ar, "/", rels, ctx)?;
     let starts: Vec<&Relationship> = rels.iter().filter(|r| r.kind == opc::REL_MODEL).collect();
-    if starts.len() != 1 {
-        return Err(ThreeMfError::StartPart {
-            found: starts.len(),
-            detail: if starts.is_empty() {
-                String::new()
-            } else {
-                format!(
-                    ": {}",
-                    starts
-                        .iter()
-                        .map(|r| r.target.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            },
-        });
+    if starts.is_empty() || (starts.len() > 1 && ctx.strict) {
+        return Err(start_part_error(&starts));
     }
     let root_rel = starts[0];
     let Some(root_path) = root_rel.part.clone() else {
@@ -105,7 +117,78 @@ fn root_model_path(ar: &mut Archive<'_>, ctx: &mut Ctx<'_>) -> Result<String, Th
             reason: "the 3D model must be a part inside the package",
         });
     };
-    Ok(root_path)
+    let extra = starts[1..].iter().map(|r| (*r).clone()).collect();
+    Ok((root_path, extra))
+}
+
+/// The error for a package without exactly one StartPart relationship.
+fn start_part_error(starts: &[&Relationship]) -> ThreeMfError {
+    ThreeMfError::StartPart {
+        found: starts.len(),
+        detail: if starts.is_empty() {
+            String::new()
+        } else {
+            format!(
+                ": {}",
+                starts
+                    .iter()
+                    .map(|r| r.target.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        },
+    }
+}
+
+/// Default mode: a StartPart relationship after the first is ignored with a warning when its
+/// target is the root part again or a part already read as part of the payload, or a complete
+/// 3D model part of its own (it reads without an error or a warning). Any other second
+/// StartPart (a broken part, or one that uses textures through the first part's
+/// relationships, as in the validation suite's MUSTFAIL 2.1.2) leaves it unclear which part is
+/// the payload, and the package is refused.
+fn check_extra_starts(
+    ar: &mut Archive<'_>,
+    root_path: &str,
+    extra: &[Relationship],
+    seen: &HashMap<String, String>,
+    ctx: &mut Ctx<'_>,
+) -> Result<(), ThreeMfError> {
+    if extra.is_empty() {
+        return Ok(());
+    }
+    let all = || {
+        let mut v: Vec<Relationship> = Vec::with_capacity(extra.len() + 1);
+        v.push(Relationship {
+            id: String::new(),
+            kind: opc::REL_MODEL.into(),
+            target: root_path.into(),
+            part: Some(root_path.into()),
+        });
+        v.extend(extra.iter().cloned());
+        v
+    };
+    for r in extra {
+        // External targets were refused by `check_relationships`.
+        let Some(target) = r.part.as_deref() else {
+            return Err(start_part_error(&all().iter().collect::<Vec<_>>()));
+        };
+        if !seen.contains_key(&opc::key(target)) {
+            let mut scratch = Ctx::new(ctx.limits, false);
+            let clean = read_model_part(ar, target, true, &mut scratch).is_ok()
+                && scratch.warnings.is_empty()
+                && scratch.suppressed == 0;
+            if !clean {
+                return Err(start_part_error(&all().iter().collect::<Vec<_>>()));
+            }
+        }
+        ctx.warn(format!(
+            "/_rels/.rels: {} StartPart relationships of type 3dmodel; {root_path} is read and {} (relationship {:?}) is ignored",
+            extra.len() + 1,
+            r.target,
+            r.id
+        ));
+    }
+    Ok(())
 }
 
 /// The model parts read, by path, and every part path seen, by lookup key.
@@ -178,7 +261,7 @@ fn read_model_part(
         });
     };
     let rels = ar.relationships(path)?;
-    check_relationships(ar, path, &rels, ctx)?;
+    let rels = check_relationships(ar, path, rels, ctx)?;
     let info = parse_part(path, &bytes, is_root, ar, &rels, ctx)?;
     let mut refs: Vec<String> = info.referenced_parts.clone();
     if is_root {
@@ -194,9 +277,11 @@ fn read_model_part(
 /// Most warnings kept per package; the rest are counted.
 const MAX_WARNINGS: usize = 1000;
 
-/// Shared reading state: limits, counters over the whole package, warnings.
+/// Shared reading state: limits, the mode, counters over the whole package, warnings.
 struct Ctx<'l> {
     limits: &'l Limits,
+    /// Harmless defects are errors ([`ReadOptions::strict`]).
+    strict: bool,
     warnings: Vec<String>,
     suppressed: usize,
     vertices: usize,
@@ -204,7 +289,34 @@ struct Ctx<'l> {
     resources: usize,
 }
 
-impl Ctx<'_> {
+impl<'l> Ctx<'l> {
+    fn new(limits: &'l Limits, strict: bool) -> Ctx<'l> {
+        Ctx {
+            limits,
+            strict,
+            warnings: Vec::new(),
+            suppressed: 0,
+            vertices: 0,
+            triangles: 0,
+            resources: 0,
+        }
+    }
+
+    /// A harmless defect: `error` in strict mode, else the warning `warning` (built only when
+    /// needed).
+    fn defect(
+        &mut self,
+        error: impl FnOnce() -> ThreeMfError,
+        warning: impl FnOnce() -> String,
+    ) -> Result<(), ThreeMfError> {
+        if self.strict {
+            return Err(error());
+        }
+        let w = warning();
+        self.warn(w);
+        Ok(())
+    }
+
     fn warn(&mut self, msg: String) {
         if self.warnings.len() < MAX_WARNINGS {
             self.warnings.push(msg);
@@ -215,13 +327,14 @@ impl Ctx<'_> {
 }
 
 /// 3MF-defined relationship types must target existing parts inside the package, and a part
-/// has at most one print ticket.
+/// has at most one print ticket. A relationship Id used twice is a harmless defect: the first
+/// relationship is kept. Returns the relationships kept.
 fn check_relationships(
     ar: &Archive<'_>,
     source: &str,
-    rels: &[Relationship],
+    rels: Vec<Relationship>,
     ctx: &mut Ctx<'_>,
-) -> Result<(), ThreeMfError> {
+) -> Result<Vec<Relationship>, ThreeMfError> {
     let rels_part = opc::rels_part_of(source);
     let err = |r: &Relationship, reason: &'static str| ThreeMfError::Relationship {
         rels_part: rels_part.clone(),
@@ -237,12 +350,25 @@ fn check_relationships(
         return Err(err(second, "more than one print ticket for one part"));
     }
     let mut ids = HashSet::new();
+    let mut kept = Vec::with_capacity(rels.len());
     for r in rels {
-        if !ids.insert(r.id.as_str()) {
-            return Err(err(r, "relationship Id is used twice in this part"));
+        if ids.contains(&r.id) {
+            ctx.defect(
+                || err(&r, "relationship Id is used twice in this part"),
+                || {
+                    format!(
+                        "{rels_part}: relationship Id {:?} is used twice (the second targets {}); the first is kept",
+                        r.id, r.target
+                    )
+                },
+            )?;
+            continue;
         }
+        ids.insert(r.id.clone());
+        kept.push(r);
     }
-    for r in rels {
+    let rels = kept;
+    for r in &rels {
         let is_3mf = [
             opc::REL_MODEL,
             opc::REL_THUMBNAIL,
@@ -270,7 +396,7 @@ fn check_relationships(
             Some(_) => {}
         }
     }
-    Ok(())
+    Ok(rels)
 }
 
 /// Kind of a resource id in one model part.
@@ -324,6 +450,11 @@ struct PartInfo {
     slice_refs: Vec<SliceRef>,
     slicestack_uses: Vec<(Location, u32)>,
     referenced_parts: Vec<String>,
+    /// Ids referenced inside this part while it was parsed (`pid`, `texid`, `matid`, `pids`).
+    used_ids: HashSet<u32>,
+    /// Default mode: resources whose id an earlier resource of this part already had (where
+    /// the later one is, its id); they were dropped, the first definition kept.
+    duplicate_ids: Vec<(Location, u32)>,
 }
 
 fn parse_part(
@@ -355,6 +486,8 @@ fn parse_part(
             slice_refs: Vec::new(),
             slicestack_uses: Vec::new(),
             referenced_parts: Vec::new(),
+            used_ids: HashSet::new(),
+            duplicate_ids: Vec::new(),
         },
         slicestack_uses: Vec::new(),
     };
@@ -473,8 +606,11 @@ impl<'x> Parser<'x, '_, '_, '_> {
         Ok(out)
     }
 
-    /// Registers a resource id, rejecting duplicates and enforcing `max_objects`.
-    fn add_res(&mut self, id: u32, kind: Res) -> Result<(), ThreeMfError> {
+    /// Registers a resource id, enforcing `max_objects`. A duplicated id is an error in strict
+    /// mode; in the default mode the first definition is kept and `Ok(false)` tells the caller
+    /// to drop this one ([`check_duplicate_ids`] refuses the package if anything references
+    /// the id, since a reference could then mean either).
+    fn add_res(&mut self, id: u32, kind: Res) -> Result<bool, ThreeMfError> {
         self.ctx.resources += 1;
         if self.ctx.resources > self.ctx.limits.max_objects {
             return Err(ThreeMfError::LimitExceeded {
@@ -484,13 +620,32 @@ impl<'x> Parser<'x, '_, '_, '_> {
                 found: self.ctx.resources as u64,
             });
         }
-        if self.info.res.insert(id, kind).is_some() {
-            return Err(ThreeMfError::DuplicateResourceId {
-                at: self.x.loc(),
-                id,
-            });
+        if self.info.res.contains_key(&id) {
+            if self.ctx.strict {
+                return Err(ThreeMfError::DuplicateResourceId {
+                    at: self.x.loc(),
+                    id,
+                });
+            }
+            self.info.duplicate_ids.push((self.x.loc(), id));
+            return Ok(false);
         }
-        Ok(())
+        self.info.res.insert(id, kind);
+        Ok(true)
+    }
+
+    /// Records the final kind (with its entry count) of a resource registered by
+    /// [`Self::add_res`], unless it was a dropped duplicate.
+    fn set_res(&mut self, own: bool, id: u32, kind: Res) {
+        if own {
+            self.info.res.insert(id, kind);
+        }
+    }
+
+    /// Looks up resource `id` as a reference, recording that it is used.
+    fn res_ref(&mut self, id: u32) -> Option<Res> {
+        self.info.used_ids.insert(id);
+        self.info.res.get(&id).copied()
     }
 
     /// Handles an element conduit does not interpret at this position: unbound prefixes and
@@ -575,12 +730,12 @@ impl<'x> Parser<'x, '_, '_, '_> {
 
     /// Checks that `pid` names a property group defined so far and `index` is inside it.
     fn check_property(
-        &self,
+        &mut self,
         element: &'static str,
         pid: u32,
         indices: &[(&'static str, u32)],
     ) -> Result<(), ThreeMfError> {
-        let Some(count) = self.info.res.get(&pid).and_then(|r| r.property_count()) else {
+        let Some(count) = self.res_ref(pid).and_then(|r| r.property_count()) else {
             return Err(ThreeMfError::UnresolvedReference {
                 at: self.x.loc(),
                 element,

@@ -203,3 +203,52 @@ pub(super) fn check_component_graph(
     }
     Ok(())
 }
+
+/// Default mode: a resource id that an earlier resource of the same part already had is
+/// harmless when nothing references the id (the later definition was dropped, the first
+/// kept); one warning each. When something references it, the reference could mean either
+/// definition and the package is refused, as in strict mode.
+pub(super) fn check_duplicate_ids(
+    parts: &BTreeMap<String, PartInfo>,
+    seen: &HashMap<String, String>,
+) -> Result<Vec<String>, ThreeMfError> {
+    if parts.values().all(|p| p.duplicate_ids.is_empty()) {
+        return Ok(Vec::new());
+    }
+    // (part key, id) of every reference across parts.
+    let mut used: HashSet<(String, u32)> = HashSet::new();
+    for (name, info) in parts {
+        let me = opc::key(name);
+        let target = |path: Option<&str>| {
+            path.map(|p| {
+                seen.get(&opc::key(p))
+                    .map_or_else(|| opc::key(p), |t| opc::key(t))
+            })
+            .unwrap_or_else(|| me.clone())
+        };
+        used.extend(info.used_ids.iter().map(|&id| (me.clone(), id)));
+        used.extend(info.slicestack_uses.iter().map(|&(_, id)| (me.clone(), id)));
+        for r in &info.object_refs {
+            used.insert((target(r.path.as_deref()), r.object_id));
+        }
+        for s in &info.slice_refs {
+            used.insert((target(s.path.as_deref()), s.stack_id));
+        }
+    }
+    let mut warnings = Vec::new();
+    for (name, info) in parts {
+        let me = opc::key(name);
+        for (at, id) in &info.duplicate_ids {
+            if used.contains(&(me.clone(), *id)) {
+                return Err(ThreeMfError::DuplicateResourceId {
+                    at: at.clone(),
+                    id: *id,
+                });
+            }
+            warnings.push(format!(
+                "{at}: resource id {id} is already used by another resource in this part; nothing references it, the first definition is kept"
+            ));
+        }
+    }
+    Ok(warnings)
+}
