@@ -344,3 +344,39 @@ fn a_part_not_placed_is_a_warning_and_a_tilted_part_is_refused_by_name() {
     );
     assert!(!tilted.out.exists());
 }
+
+#[test]
+fn info_lists_the_circuit_parts_pads_and_nets_with_the_single_pin_net() {
+    let job = job("");
+    let o = conduit(["info".as_ref(), "--json".as_ref(), job.sch.as_os_str()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    let c = &v[0]["circuit"];
+    assert_eq!(v[0]["nets"], 3);
+    assert_eq!(v[0]["parts"], 1 + LEDS);
+    let net = |name: &str| {
+        c["nets"]
+            .as_array()
+            .expect("nets")
+            .iter()
+            .find(|n| n["name"] == name)
+            .map(|n| n["pins"].clone())
+    };
+    assert_eq!(net("IN"), Some(serde_json::json!(["R1.1"])));
+    let anodes: Vec<String> = std::iter::once("R1.2".to_owned())
+        .chain((1..=LEDS).map(|k| format!("LED{k}.A")))
+        .collect();
+    let mut vp: Vec<String> = serde_json::from_value(net("VP").expect("VP")).expect("pins");
+    vp.sort();
+    let mut want = anodes;
+    want.sort();
+    assert_eq!(vp, want);
+    // R1's pads: 1 × 1.3 mm at ±0.95 mm, together 2.9 × 1.3 mm.
+    let r1 = &c["parts"][0];
+    assert_eq!(r1["name"], "R1");
+    assert_eq!(r1["package"], "R0805");
+    assert_eq!(r1["pads_size"], serde_json::json!([2.9, 1.3]));
+    assert_eq!(r1["pads"][0]["at"], serde_json::json!([-0.95, 0.0]));
+    assert_eq!(r1["pads"][0]["size"], serde_json::json!([1.0, 1.3]));
+    assert_eq!(r1["pads"][0]["kind"], "smd");
+}

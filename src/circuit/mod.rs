@@ -330,7 +330,7 @@ pub enum CircuitError {
 
 impl Circuit {
     /// The circuit of an EAGLE schematic. Parts without a package (supply symbols, frames) are
-    /// not in it; neither are nets with fewer than two pads.
+    /// not in it; nets without a pad are not either (a net with one pad is kept).
     pub fn from_schematic(s: &conduit_eagle::Schematic) -> Self {
         let parts = s
             .parts
@@ -353,8 +353,8 @@ impl Circuit {
         }
     }
 
-    /// The circuit of an EAGLE board: every element with its package's pads, and the signals.
-    /// Nets with fewer than two pads are dropped.
+    /// The circuit of an EAGLE board: every element with its package's pads, and the signals
+    /// with at least one pad.
     pub fn from_board(b: &conduit_eagle::Board) -> Self {
         let parts = b
             .elements

@@ -198,16 +198,29 @@ fn describe_eagle(doc: &conduit_eagle::Document) -> Value {
                 .flat_map(|p| p.pin_pads.values())
                 .filter(|v| v.len() > 1)
                 .count();
+            let circuit = conduit::circuit::Circuit::from_schematic(s);
+            let dropped: Vec<Value> = s
+                .dropped_parts
+                .iter()
+                .map(|name| {
+                    json!({
+                        "name": name,
+                        "reason": "no package: a supply symbol, frame or other part with \
+                                   nothing to place",
+                    })
+                })
+                .collect();
             json!({
                 "eagle": "schematic",
                 "version": s.version,
-                "parts": s.parts.len(),
-                "dropped_parts": s.dropped_parts,
+                "parts": circuit.parts.len(),
+                "dropped_parts": dropped,
                 "packages": packages.len(),
-                "nets": s.nets.len(),
+                "nets": circuit.nets.len(),
                 "connected_pins": pins,
                 "pin_pad_connections": pin_pads,
                 "pins_on_several_pads": multi,
+                "circuit": describe_circuit(&circuit),
             })
         }
         Document::Board(b) => {
@@ -216,6 +229,7 @@ fn describe_eagle(doc: &conduit_eagle::Document) -> Value {
                 .iter()
                 .map(|e| (e.package.library.as_str(), e.package.name.as_str()))
                 .collect();
+            let circuit = conduit::circuit::Circuit::from_board(b);
             json!({
                 "eagle": "board",
                 "version": b.version,
@@ -223,11 +237,84 @@ fn describe_eagle(doc: &conduit_eagle::Document) -> Value {
                 "bottom_elements": b.elements.iter().filter(|e| e.rotation.mirror).count(),
                 "packages": packages.len(),
                 "pads": b.elements.iter().map(|e| e.package.pads.len()).sum::<usize>(),
-                "nets": b.nets.len(),
+                "nets": circuit.nets.len(),
+                "circuit": describe_circuit(&circuit),
             })
         }
         Document::Library => json!({ "eagle": "library" }),
     }
+}
+
+/// What a circuit holds, as conduit places and routes it: per part its value, package, pads
+/// (package frame: centre, rotation, size, SMD or through-hole) and the size of the pads'
+/// bounding box; per net its pins (`PART.PAD`). A net with one pin is kept: a placement may wire
+/// it to a terminal.
+fn describe_circuit(circuit: &conduit::circuit::Circuit) -> Value {
+    use conduit::circuit::PadShape;
+    let parts: Vec<Value> = circuit
+        .parts
+        .iter()
+        .map(|p| {
+            let mut lo = [f64::INFINITY; 2];
+            let mut hi = [f64::NEG_INFINITY; 2];
+            let pads: Vec<Value> =
+                p.pads
+                    .iter()
+                    .map(|pad| {
+                        let (w, h) = match pad.shape {
+                            PadShape::Round { diameter } => (diameter, diameter),
+                            PadShape::Rect { width, height }
+                            | PadShape::Oblong { width, height } => (width, height),
+                        };
+                        // The pad's half extent along x and y, turned by its rotation.
+                        let (sn, c) = pad.rotation_deg.to_radians().sin_cos();
+                        let half = [
+                            ((w * c).abs() + (h * sn).abs()) / 2.0,
+                            ((w * sn).abs() + (h * c).abs()) / 2.0,
+                        ];
+                        for (k, v) in [pad.x, pad.y].into_iter().enumerate() {
+                            lo[k] = lo[k].min(v - half[k]);
+                            hi[k] = hi[k].max(v + half[k]);
+                        }
+                        json!({
+                            "name": pad.name,
+                            "at": [round(pad.x), round(pad.y)],
+                            "rotation_deg": round(pad.rotation_deg),
+                            "size": [round(w), round(h)],
+                            "kind": if pad.smd { "smd" } else { "through-hole" },
+                        })
+                    })
+                    .collect();
+            let size = if p.pads.is_empty() {
+                Value::Null
+            } else {
+                json!([round(hi[0] - lo[0]), round(hi[1] - lo[1])])
+            };
+            json!({
+                "name": p.name,
+                "value": p.value,
+                "package": p.package,
+                "pads_size": size,
+                "pads": pads,
+            })
+        })
+        .collect();
+    let nets: Vec<Value> = circuit
+        .nets
+        .iter()
+        .map(|n| {
+            json!({
+                "name": n.name,
+                "pins": n.pins.iter().map(ToString::to_string).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    json!({ "parts": parts, "nets": nets })
+}
+
+/// `v` rounded to the micrometre, for display.
+fn round(v: f64) -> f64 {
+    (v * 1000.0).round() / 1000.0
 }
 
 /// Prints a JSON value as indented `key: value` lines.
