@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Long fuzzing run on the stable toolchain: every target of tests/fuzz_stable/targets.rs (each
-# format crate's reader and the library's readers) for N mutated inputs, in release mode under a
-# 2 GiB address-space cap, one process per target. Prints per target: executions, executions per
+# format crate's reader and the library's readers) for N mutated inputs, built with the `fuzz`
+# profile (release speed with overflow checks and debug assertions) under a 2 GiB address-space
+# cap, one process per target. Prints per target: executions, executions per
 # second, panics, hangs, huge allocations, slow executions, the slowest execution and the peak
 # resident memory. Failing inputs are saved under target/fuzz-findings/.
 # usage: bench/fuzz.sh [EXECS_PER_TARGET] [TARGET...]   (default 1000000, or FUZZ_EXECS; all targets)
@@ -11,8 +12,8 @@ cd "$(dirname "$0")/.."
 execs=${1:-${FUZZ_EXECS:-1000000}}
 shift $(( $# > 0 ? 1 : 0 ))
 seed=${FUZZ_SEED:-1}
-cargo build --release --quiet --example fuzz_stable || exit 2
-bin=./target/release/examples/fuzz_stable
+cargo build --profile fuzz --quiet --example fuzz_stable || exit 2
+bin=./target/fuzz/examples/fuzz_stable
 findings=target/fuzz-findings
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then

@@ -77,8 +77,7 @@ pub fn all() -> Vec<Target> {
             ],
             run: |i| {
                 conduit_3mf::read(i.bytes, &conduit_3mf::Limits::default())
-                    .and_then(|p| p.flatten())
-                    .is_ok()
+                    .is_ok_and(|p| p.flatten().is_ok())
             },
             ci_execs: CI,
         },
