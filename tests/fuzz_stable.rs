@@ -1,6 +1,5 @@
 //! Fuzzing on the stable toolchain, bounded for CI: every target of `fuzz_stable/targets.rs`
-//! runs its `ci_execs` mutated inputs (20 000 per target, the library readers included; 5 000
-//! for `scan`, which builds a surface from every mesh that reads) from the
+//! runs its `ci_execs` mutated inputs (20 000 per target, the library readers included) from the
 //! seeds in `fuzz_stable/seeds/`, `samples/` and, when present, the shared corpus and regression
 //! files (seeds of at most 64 KiB). Each test asserts no panic and
 //! no execution over 10 s; a failing input is saved under `target/fuzz-findings/`.

@@ -2,8 +2,7 @@
 //! loading by format, configs, placements, designs, circuits), each called in-process on one
 //! mutated input. A target returns whether the input was read; it must never panic.
 //!
-//! `ci_execs` is the count of the CI test (`tests/fuzz_stable.rs`): 20 000 for every target
-//! but `scan` (5 000; it builds a surface from every mesh that reads).
+//! `ci_execs` is the count of the CI test (`tests/fuzz_stable.rs`): 20 000 for every target.
 //! The library readers that take a path (`scene`, `placement`, `design`, `circuit`) get the
 //! input written to a file in an in-memory scratch folder first.
 
@@ -461,9 +460,7 @@ pub fn all() -> Vec<Target> {
             accepts: |s| ext_in(s, &["stl", "obj", "off", "ply", "xyz"]),
             dict: &["1e308 ", "0 0 0\n", "NaN ", "vertex 0 0 0\n"],
             run: |i| conduit::conform::scan::load_scan(&i.file(None), false, 1.0).is_ok(),
-            // Builds a surface (a ray-cast mesh or a height field) from every input that reads:
-            // 5 000 executions keep the CI test short.
-            ci_execs: 5_000,
+            ci_execs: CI,
         },
         Target {
             name: "robot_csv",
