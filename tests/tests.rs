@@ -15,6 +15,7 @@ mod curved;
 mod docs;
 mod electronics;
 mod electronics_corpus;
+mod fuzz_stable;
 mod golden;
 mod grammar;
 mod jet;

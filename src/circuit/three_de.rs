@@ -239,13 +239,16 @@ const MAX_DEPTH: usize = 64;
 /// (entities decoded), nothing else; errors carry the line.
 fn parse_xml(xml: &str) -> Result<Node, PlacementError> {
     let src = xml.strip_prefix('\u{feff}').unwrap_or(xml);
+    // Offsets of the line breaks, found once: every element asks for its line.
+    let newlines: Vec<usize> = src
+        .bytes()
+        .enumerate()
+        .filter(|(_, b)| *b == b'\n')
+        .map(|(i, _)| i)
+        .collect();
     let line_of = |pos: u64| {
-        let end = usize::try_from(pos).unwrap_or(usize::MAX).min(src.len());
-        src.as_bytes()[..end]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count()
-            + 1
+        let pos = usize::try_from(pos).unwrap_or(usize::MAX);
+        newlines.partition_point(|&nl| nl < pos) + 1
     };
     let fail = |pos: u64, message: String| PlacementError::ThreeDe {
         line: line_of(pos),

@@ -100,7 +100,7 @@ impl Board {
 }
 
 /// Reads the `<board>` element of a parsed document.
-pub(crate) fn read(doc: &Doc<'_>, version: String, brd: &Node) -> Result<Board, EagleError> {
+pub(crate) fn read(doc: &Doc, version: String, brd: &Node) -> Result<Board, EagleError> {
     let libs = Libraries::read(doc, brd)?;
     let classes: Vec<(String, String)> = brd
         .list("classes", "class")
@@ -214,7 +214,7 @@ pub(crate) fn read(doc: &Doc<'_>, version: String, brd: &Node) -> Result<Board, 
 }
 
 /// The copper `<wire>`s of one `<signal>` (layers 1-16).
-fn signal_wires(doc: &Doc<'_>, signal: &Node) -> Result<Vec<SignalWire>, EagleError> {
+fn signal_wires(doc: &Doc, signal: &Node) -> Result<Vec<SignalWire>, EagleError> {
     let mut out = Vec::new();
     for w in signal.children_named("wire") {
         let Some(layer) = doc.opt_u32(w, "layer")? else {
@@ -237,7 +237,7 @@ fn signal_wires(doc: &Doc<'_>, signal: &Node) -> Result<Vec<SignalWire>, EagleEr
 }
 
 /// A `<wire>`'s end points `[x1, y1, x2, y2]`, mm.
-fn wire_ends(doc: &Doc<'_>, w: &Node) -> Result<[f64; 4], EagleError> {
+fn wire_ends(doc: &Doc, w: &Node) -> Result<[f64; 4], EagleError> {
     Ok([
         doc.f64(w, "x1")?,
         doc.f64(w, "y1")?,

@@ -24,31 +24,40 @@ const OPTIONS: Options = Options {
     max_depth: MAX_DEPTH,
 };
 
-/// Parsed document plus the source needed to turn byte offsets into line numbers.
-pub(crate) struct Doc<'a> {
+/// Parsed document plus the offsets of its line breaks, to turn byte offsets into line numbers.
+pub(crate) struct Doc {
     pub(crate) root: Node,
-    src: &'a [u8],
+    /// Byte offsets of every `\n` of the source, ascending.
+    newlines: Vec<usize>,
 }
 
-impl Doc<'_> {
-    /// 1-based line of a byte offset.
+impl Doc {
+    /// 1-based line of a byte offset (offsets past the end count as the end), as
+    /// [`conduit_xml::line_of`] gives it, in logarithmic time: readers ask it for every part
+    /// and element.
     pub(crate) fn line(&self, pos: usize) -> usize {
-        conduit_xml::line_of(self.src, pos)
+        self.newlines.partition_point(|&nl| nl < pos) + 1
     }
 }
 
 /// Parses `src` (UTF-8, optional BOM) into an element tree; an input without any element is
 /// [`EagleError::NotEagle`].
-pub(crate) fn parse(src: &[u8]) -> Result<Doc<'_>, EagleError> {
+pub(crate) fn parse(src: &[u8]) -> Result<Doc, EagleError> {
     let root = conduit_xml::parse(src, &OPTIONS)
         .map_err(|e| EagleError::from_xml(src, e))?
         .ok_or(EagleError::NotEagle {
             found: String::new(),
         })?;
-    Ok(Doc { root, src })
+    let newlines = src
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == b'\n')
+        .map(|(i, _)| i)
+        .collect();
+    Ok(Doc { root, newlines })
 }
 
-impl Doc<'_> {
+impl Doc {
     /// A required attribute.
     pub(crate) fn req<'n>(&self, n: &'n Node, key: &'static str) -> Result<&'n str, EagleError> {
         n.attr(key).ok_or_else(|| EagleError::MissingAttribute {

@@ -137,7 +137,7 @@ pub(crate) struct Libraries {
 
 impl Libraries {
     /// Reads `<libraries>` under `parent` (a `<schematic>` or `<board>`).
-    pub(crate) fn read(doc: &Doc<'_>, parent: &Node) -> Result<Self, EagleError> {
+    pub(crate) fn read(doc: &Doc, parent: &Node) -> Result<Self, EagleError> {
         let mut list = Vec::new();
         for lib in parent.list("libraries", "library") {
             list.push(read_library(doc, lib)?);
@@ -166,7 +166,7 @@ impl Libraries {
     }
 }
 
-fn read_library(doc: &Doc<'_>, lib: &Node) -> Result<Library, EagleError> {
+fn read_library(doc: &Doc, lib: &Node) -> Result<Library, EagleError> {
     // Libraries inside .sch/.brd always carry a name; a stand-alone .lbr does not.
     let name = lib.attr("name").unwrap_or_default().to_owned();
     let mut packages = BTreeMap::new();
@@ -240,7 +240,7 @@ fn read_library(doc: &Doc<'_>, lib: &Node) -> Result<Library, EagleError> {
     })
 }
 
-fn read_package(doc: &Doc<'_>, p: &Node, library: &str) -> Result<Package, EagleError> {
+fn read_package(doc: &Doc, p: &Node, library: &str) -> Result<Package, EagleError> {
     let name = doc.req(p, "name")?.to_owned();
     let mut pads = Vec::new();
     for c in &p.children {

@@ -61,7 +61,7 @@ impl Schematic {
 }
 
 /// Reads the `<schematic>` element of a parsed document.
-pub(crate) fn read(doc: &Doc<'_>, version: String, sch: &Node) -> Result<Schematic, EagleError> {
+pub(crate) fn read(doc: &Doc, version: String, sch: &Node) -> Result<Schematic, EagleError> {
     let libs = Libraries::read(doc, sch)?;
     let classes = sch
         .list("classes", "class")
@@ -134,7 +134,7 @@ struct LocalPart<'l> {
 }
 
 struct Flattener<'d, 'l> {
-    doc: &'d Doc<'d>,
+    doc: &'d Doc,
     libs: &'l Libraries,
     classes: HashMap<String, String>,
     modules: BTreeMap<String, &'d Node>,

@@ -226,12 +226,25 @@ fn parse_finite(s: &str) -> Option<f64> {
     s.trim().parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
-/// 1-based line of byte offset `pos` in `text`.
-fn line_of(text: &str, pos: u64) -> usize {
-    let end = usize::try_from(pos).unwrap_or(usize::MAX).min(text.len());
-    text.as_bytes()[..end]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
+/// Line numbers of byte offsets in one text: the offsets of its line breaks, found once, so that
+/// a reader can ask for the line of every element without counting from the start each time.
+struct Lines(Vec<usize>);
+
+impl Lines {
+    /// The line breaks of `text`.
+    fn new(text: &str) -> Self {
+        Lines(
+            text.bytes()
+                .enumerate()
+                .filter(|(_, b)| *b == b'\n')
+                .map(|(i, _)| i)
+                .collect(),
+        )
+    }
+
+    /// 1-based line of byte offset `pos` (offsets past the end count as the end).
+    fn of(&self, pos: u64) -> usize {
+        let pos = usize::try_from(pos).unwrap_or(usize::MAX);
+        self.0.partition_point(|&nl| nl < pos) + 1
+    }
 }

@@ -12,7 +12,7 @@ use std::io;
 use quick_xml::XmlVersion;
 use quick_xml::events::{BytesStart, Event};
 
-use crate::{PlacementRecord, PnpError, Side, fixed4, line_of, normalized_rotation, parse_finite};
+use crate::{Lines, PlacementRecord, PnpError, Side, fixed4, normalized_rotation, parse_finite};
 
 /// Writes an OpenPnP board named `name` holding `records` in the given order, all of type
 /// `Placement`, with locations in millimetres: `enabled="false"` for records the machine does
@@ -110,6 +110,7 @@ struct Open {
 /// naming the `<placement>` or `<location>` element and its line.
 pub fn read_openpnp_board(text: &str) -> Result<Vec<PlacementRecord>, PnpError> {
     let mut reader = quick_xml::Reader::from_str(text);
+    let lines = Lines::new(text);
     let mut path: Vec<String> = Vec::new();
     let mut open: Option<Open> = None;
     let mut records = Vec::new();
@@ -117,7 +118,7 @@ pub fn read_openpnp_board(text: &str) -> Result<Vec<PlacementRecord>, PnpError> 
     loop {
         let before = reader.buffer_position();
         let event = reader.read_event().map_err(|source| PnpError::Xml {
-            line: line_of(text, reader.error_position()),
+            line: lines.of(reader.error_position()),
             source,
         })?;
         let (start, empty) = match event {
@@ -133,7 +134,7 @@ pub fn read_openpnp_board(text: &str) -> Result<Vec<PlacementRecord>, PnpError> 
             Event::Eof => break,
             _ => continue,
         };
-        let line = line_of(text, before);
+        let line = lines.of(before);
         let name = start.name().as_ref().to_owned();
         let xml_err = |source| PnpError::Xml { line, source };
         match path.iter().map(String::as_str).collect::<Vec<_>>()[..] {
