@@ -58,9 +58,11 @@
 //! [`emit::preview`](crate::emit::preview), and the checker steps the same machine, with
 //! [`CheckParams::flavor`] as its [`Firmware`].
 
+pub mod electrical;
 mod machine;
 mod time;
 
+pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical};
 pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves};
 
 use std::collections::BTreeMap;
