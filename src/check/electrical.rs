@@ -346,18 +346,26 @@ fn height_of(m: &Move, heights: &[f64]) -> f64 {
 }
 
 /// An extruding move of the object's plastic: another tool than the conductive one, and not
-/// skirt, brim, start G-code, support or a tower (roles as `postprocess` reads them).
+/// skirt, brim, start G-code (roles as `postprocess` reads them), support or a tower.
 fn is_plastic(m: &Move, conductive_tool: usize) -> bool {
     if !m.extruding || !m.has_xy || m.tool == conductive_tool || m.to[2].is_none() {
         return false;
     }
-    match m.role.as_deref() {
-        None => true,
-        Some(name) => !matches!(
-            crate::postprocess::role_of(name),
-            None | Some(Role::Skirt | Role::Custom)
-        ),
+    let Some(name) = m.role.as_deref() else {
+        return true;
+    };
+    if matches!(
+        crate::postprocess::role_of(name),
+        Some(Role::Skirt | Role::Custom)
+    ) {
+        return false;
     }
+    // Unknown names count as the object's (a host file without feature comments keeps the
+    // role of a block inserted before), except the features beside the object.
+    let lower = name.to_ascii_lowercase();
+    !["support", "tower", "wipe", "prime"]
+        .iter()
+        .any(|w| lower.contains(w))
 }
 
 /// The xy points of a move's path (unknown positions dropped).
