@@ -79,9 +79,7 @@ fn open_nets(e: &Value) -> Vec<String> {
 }
 
 fn count(e: &Value, key: &str) -> u64 {
-    e[key]
-        .as_u64()
-        .unwrap_or_else(|| panic!("{key} in {e}"))
+    e[key].as_u64().unwrap_or_else(|| panic!("{key} in {e}"))
 }
 
 /// The first conductive trace of the demo: VCC from R1.1 to the waypoint's trace. Its only
@@ -160,7 +158,10 @@ fn a_line_joining_two_nets_is_a_short_where_they_touch() {
         .map(|k| s["at"][k].as_f64().expect("coordinate"))
         .collect();
     // On the bridge, at the seating plane.
-    assert!((128.0..=139.0).contains(&at[0]) && (124.0..=131.0).contains(&at[1]), "{at:?}");
+    assert!(
+        (128.0..=139.0).contains(&at[0]) && (124.0..=131.0).contains(&at[1]),
+        "{at:?}"
+    );
     assert!((at[2] - 4.0).abs() < 1e-9);
     // Every net is still connected; the nets merely touch.
     assert!(open_nets(&e).is_empty());
@@ -169,9 +170,8 @@ fn a_line_joining_two_nets_is_a_short_where_they_touch() {
 #[test]
 fn a_trace_past_the_wall_is_material_outside_the_solid() {
     // The VCC trace runs on to x = 100, 5 mm past the block's wall at x = 105.
-    let (code, e) = check_demo(|g| {
-        g.replacen(VCC_TRACE, ";DISPENSE:ON\nG1 X109 Y118\nG1 X100 Y118\n", 1)
-    });
+    let (code, e) =
+        check_demo(|g| g.replacen(VCC_TRACE, ";DISPENSE:ON\nG1 X109 Y118\nG1 X100 Y118\n", 1));
     assert_eq!(code, 1);
     assert_eq!(count(&e, "outside_count"), 1, "{e}");
     let run = &e["outside"][0];
@@ -211,7 +211,10 @@ fn a_removed_event_is_missing() {
     assert_eq!(code, 1);
     let events = e["events"].as_array().expect("events");
     assert_eq!(events.len(), 1, "{e}");
-    assert_eq!((&events[0]["part"], &events[0]["kind"]), (&"R1".into(), &"missing".into()));
+    assert_eq!(
+        (&events[0]["part"], &events[0]["kind"]),
+        (&"R1".into(), &"missing".into())
+    );
 }
 
 /// Postprocesses `host` (copied into a temp dir) with the cube's circuit and checks the result.

@@ -66,8 +66,8 @@ use conduit_gcode::{Gcode, Move, moves};
 use crate::circuit::stage::{Electronics, ElectronicsError, ElectronicsParams, place_circuit};
 use crate::circuit::{PlacedPart, PlacingMethod};
 use crate::geom::{
-    BoundingBox, Cap, ExPolygon, FillRule, Join, Point2, Polyline, offset,
-    polygons_to_expolygons, stroke, union,
+    BoundingBox, Cap, ExPolygon, FillRule, Join, Point2, Polyline, offset, polygons_to_expolygons,
+    stroke, union,
 };
 use crate::program::Role;
 use crate::program::machine::Flavor;
@@ -370,10 +370,7 @@ fn is_plastic(m: &Move, conductive_tool: usize) -> bool {
 
 /// The xy points of a move's path (unknown positions dropped).
 fn path_xy(m: &Move) -> Vec<P2> {
-    m.path
-        .iter()
-        .filter_map(|p| Some([p[0]?, p[1]?]))
-        .collect()
+    m.path.iter().filter_map(|p| Some([p[0]?, p[1]?])).collect()
 }
 
 /// The bounding box of the plastic beads (each point grown by half its width), z from 0 to
@@ -511,13 +508,21 @@ fn segment_gap(a: P2, b: P2, c: P2, d: P2) -> (f64, P2) {
         let t = cross(c, d, a) / (cross(c, d, a) - cross(c, d, b));
         return (0.0, [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
     }
-    [(a, c, d, true), (b, c, d, true), (c, a, b, false), (d, a, b, false)]
-        .into_iter()
-        .map(|(p, s, e, _)| {
-            let q = nearest_on(p, s, e);
-            (dist(p, q), [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0])
-        })
-        .fold((f64::INFINITY, a), |best, x| if x.0 < best.0 { x } else { best })
+    [
+        (a, c, d, true),
+        (b, c, d, true),
+        (c, a, b, false),
+        (d, a, b, false),
+    ]
+    .into_iter()
+    .map(|(p, s, e, _)| {
+        let q = nearest_on(p, s, e);
+        (dist(p, q), [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0])
+    })
+    .fold(
+        (f64::INFINITY, a),
+        |best, x| if x.0 < best.0 { x } else { best },
+    )
 }
 
 /// Whether `p` lies inside the polygon `ring` (even-odd).
@@ -548,7 +553,10 @@ fn outline_gap(a: P2, b: P2, ring: &[P2]) -> (f64, P2) {
     let n = ring.len();
     (0..n)
         .map(|i| segment_gap(a, b, ring[i], ring[(i + 1) % n]))
-        .fold((f64::INFINITY, a), |best, x| if x.0 < best.0 { x } else { best })
+        .fold(
+            (f64::INFINITY, a),
+            |best, x| if x.0 < best.0 { x } else { best },
+        )
 }
 
 /// Two beads at `z1`, `z2` (heights `h1`, `h2`) lie in one layer or adjacent ones.
@@ -760,12 +768,7 @@ fn net_checks(nets: &[String], terminals: &[Terminal], graph: &Graph, n: usize) 
 
 /// The pairs of nets whose material touches or comes closer than the spacing, smallest gap
 /// each, touching pairs first, then by gap and names.
-fn shorts(
-    graph: &Graph,
-    labels: &[Option<usize>],
-    beads: &[Bead],
-    nets: &[String],
-) -> Vec<Short> {
+fn shorts(graph: &Graph, labels: &[Option<usize>], beads: &[Bead], nets: &[String]) -> Vec<Short> {
     let n = beads.len();
     let mut best: BTreeMap<(usize, usize), Short> = BTreeMap::new();
     for e in graph.touching.iter().chain(&graph.near) {
@@ -806,11 +809,7 @@ fn level_key(z: f64) -> i64 {
 }
 
 /// The runs of conductive beads outside the solid (see the [module docs](self#outside-the-solid)).
-fn outside_runs(
-    beads: &[Bead],
-    plastic: &[&Move],
-    params: &ElectricalParams,
-) -> Vec<OutsideRun> {
+fn outside_runs(beads: &[Bead], plastic: &[&Move], params: &ElectricalParams) -> Vec<OutsideRun> {
     let mut by_level: BTreeMap<i64, Vec<&Move>> = BTreeMap::new();
     for m in plastic {
         if let Some(z) = m.to[2] {
@@ -849,7 +848,10 @@ fn outside_runs(
             let outside = (0..=steps)
                 .filter(|&s| {
                     let t = s as f64 / steps as f64;
-                    let p = Point2::from_mm(b.a[0] + t * (b.b[0] - b.a[0]), b.a[1] + t * (b.b[1] - b.a[1]));
+                    let p = Point2::from_mm(
+                        b.a[0] + t * (b.b[0] - b.a[0]),
+                        b.a[1] + t * (b.b[1] - b.a[1]),
+                    );
                     !outline.is_some_and(|o| o.iter().any(|x| x.contains(p)))
                 })
                 .count();
@@ -1061,8 +1063,7 @@ fn lid_before(part: &PlacedPart, top: f64, before: &[&Move], heights: &[f64]) ->
     }
     let n = ring.len();
     let deep = |p: P2| {
-        inside(p, &ring)
-            && (0..n).all(|i| dist(p, nearest_on(p, ring[i], ring[(i + 1) % n])) > 0.1)
+        inside(p, &ring) && (0..n).all(|i| dist(p, nearest_on(p, ring[i], ring[(i + 1) % n])) > 0.1)
     };
     before.iter().find_map(|m| {
         let z = m.to[2]?;
@@ -1089,7 +1090,13 @@ impl fmt::Display for ElectricalReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         for n in self.open_nets() {
             let groups: Vec<String> = n.groups.iter().map(|g| g.join(" ")).collect();
-            writeln!(f, "open: net {} is in {} pieces: {}", n.net, n.groups.len(), groups.join(" | "))?;
+            writeln!(
+                f,
+                "open: net {} is in {} pieces: {}",
+                n.net,
+                n.groups.len(),
+                groups.join(" | ")
+            )?;
         }
         for s in &self.shorts {
             let what = if s.touching {
@@ -1113,7 +1120,11 @@ impl fmt::Display for ElectricalReport {
             )?;
         }
         if self.short_count > self.shorts.len() {
-            writeln!(f, "... and {} more shorts", self.short_count - self.shorts.len())?;
+            writeln!(
+                f,
+                "... and {} more shorts",
+                self.short_count - self.shorts.len()
+            )?;
         }
         for r in &self.outside {
             writeln!(
@@ -1132,13 +1143,21 @@ impl fmt::Display for ElectricalReport {
             )?;
         }
         if self.outside_count > self.outside.len() {
-            writeln!(f, "... and {} more runs outside", self.outside_count - self.outside.len())?;
+            writeln!(
+                f,
+                "... and {} more runs outside",
+                self.outside_count - self.outside.len()
+            )?;
         }
         for e in &self.events {
             writeln!(f, "event: {}", e.message)?;
         }
         if !self.unplaced_pins.is_empty() {
-            writeln!(f, "not checked: {} pins on unplaced parts", self.unplaced_pins.len())?;
+            writeln!(
+                f,
+                "not checked: {} pins on unplaced parts",
+                self.unplaced_pins.len()
+            )?;
         }
         let connected = self.nets.iter().filter(|n| n.connected).count();
         writeln!(

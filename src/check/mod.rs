@@ -62,8 +62,8 @@ pub mod electrical;
 mod machine;
 mod time;
 
-pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical};
 pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves};
+pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical};
 
 use std::collections::BTreeMap;
 use std::fmt;

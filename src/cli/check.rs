@@ -6,8 +6,8 @@ use anyhow::Context;
 use conduit::check::{ElectricalParams, ElectricalReport, Frame, check, check_electrical};
 use conduit::circuit::{Circuit, Electronics, Placement};
 use conduit::pipeline::{model_bboxes, place_on_bed_with_offsets};
-use conduit::scene::{LoadOptions, load_scene};
 use conduit::scene::FileKind;
+use conduit::scene::{LoadOptions, load_scene};
 use std::path::Path;
 
 /// Reads a G-code input, refusing a file that is something else (an STL, a 3MF, …) by its
