@@ -168,6 +168,22 @@ fn a_line_joining_two_nets_is_a_short_where_they_touch() {
 }
 
 #[test]
+fn a_trace_closer_to_another_net_than_the_clearance_is_reported_with_its_gap() {
+    // A VCC stub from R1.1 (136.05,118) to (137,121) ends 0.729 mm from the centreline of the
+    // N1 trace (137,131)–(137.95,118): 0.6 mm traces 0.129 mm apart, under the 0.2 mm of
+    // route.channel_extra, without touching.
+    let stub = ";DISPENSE:OFF\nG1 X136.05 Y118\n;DISPENSE:ON\nG1 X137 Y121\n;DISPENSE:OFF\n";
+    let (code, e) = check_demo(|g| g.replacen(";DISPENSE:OFF\n", stub, 1));
+    assert_eq!(code, 1);
+    assert_eq!(count(&e, "short_count"), 1, "{e}");
+    let s = &e["shorts"][0];
+    assert_eq!(s["nets"], serde_json::json!(["N1", "VCC"]));
+    assert_eq!(s["touching"], false);
+    assert_eq!(s["gap"], 0.129);
+    assert!(open_nets(&e).is_empty());
+}
+
+#[test]
 fn a_trace_past_the_wall_is_material_outside_the_solid() {
     // The VCC trace runs on to x = 100, 5 mm past the block's wall at x = 105.
     let (code, e) =
