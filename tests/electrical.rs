@@ -143,6 +143,27 @@ fn a_deleted_trace_is_an_open_net_with_its_pieces() {
 }
 
 #[test]
+fn a_trace_moved_one_layer_up_still_connects_by_stacking_two_layers_up_not() {
+    // The VCC trace printed at the end of the layer above (z 4.2 or 4.4) instead of at z 4.
+    let moved = |z: &str, layer: &str| {
+        let g = demo_gcode().replacen(VCC_TRACE, ";DISPENSE:ON\n", 1);
+        let mark = format!(";LAYER_CHANGE\n;Z:{layer}\n");
+        assert!(g.contains(&mark));
+        let trace = format!(
+            "T1\nG1 Z{z}\nG1 X136.05 Y118\n;DISPENSE:ON\nG1 X109 Y118\n;DISPENSE:OFF\nT0\n{mark}"
+        );
+        g.replacen(&mark, &trace, 1)
+    };
+    let (code, e) = check_demo(|_| moved("4.2", "4.4"));
+    assert_eq!(code, 0, "{e}");
+    assert!(open_nets(&e).is_empty());
+    let (code, e) = check_demo(|_| moved("4.4", "4.6"));
+    assert_eq!(code, 1);
+    assert_eq!(open_nets(&e), ["VCC"]);
+    assert_eq!(count(&e, "floating_beads"), 1);
+}
+
+#[test]
 fn a_line_joining_two_nets_is_a_short_where_they_touch() {
     // From a point of the GND trace (120,125)–(137,133) to one of the N1 trace
     // (137,131)–(137.95,118), printed right after the first trace (tool 1, z 4).
