@@ -219,6 +219,21 @@ fn a_trace_past_the_wall_is_material_outside_the_solid() {
 }
 
 #[test]
+fn a_stray_trace_far_off_the_bed_is_outside_and_checked_quickly() {
+    let (code, e) = check_demo(|g| {
+        g.replacen(
+            VCC_TRACE,
+            ";DISPENSE:ON\nG1 X109 Y118\nG1 X900000 Y-900000\n",
+            1,
+        )
+    });
+    assert_eq!(code, 1);
+    assert_eq!(count(&e, "outside_count"), 1, "{e}");
+    let length = e["outside_length"].as_f64().expect("length");
+    assert!(length > 1.2e6, "{length}");
+}
+
+#[test]
 fn a_part_placed_before_its_cavity_is_complete_is_early() {
     // The coin cell (top at z 7.2) placed before the layer at z 4.2.
     let (code, e) = check_demo(|g| {

@@ -458,7 +458,13 @@ fn beads(all: &[Move], heights: &[f64], params: &ElectricalParams) -> Vec<Bead> 
         let Some(z) = m.to[2] else { continue };
         let r = m.width.unwrap_or(params.default_width) / 2.0;
         let h = height_of(m, heights);
+        if !(z.is_finite() && r.is_finite() && r >= 0.0) {
+            continue;
+        }
         for w in path_xy(m).windows(2) {
+            if !w.iter().flatten().all(|v| v.is_finite()) {
+                continue;
+            }
             out.push(Bead {
                 a: w[0],
                 b: w[1],
@@ -565,6 +571,12 @@ fn stacked(z1: f64, h1: f64, z2: f64, h2: f64, tol: f64) -> bool {
     (z1 - z2).abs() <= upper_h.max(0.0) + tol
 }
 
+/// Most grid cells along the beads' extent.
+const GRID_SPAN: f64 = 256.0;
+
+/// Most points tested along one bead or plastic move.
+const MAX_SAMPLES: usize = 10_000;
+
 /// An edge of the bead graph: nodes are beads (`0..n`) then terminals (`n..`).
 #[derive(Debug, Clone, Copy)]
 struct Edge {
@@ -588,7 +600,15 @@ impl Graph {
         let n = beads.len();
         let reach = params.spacing + params.tolerance;
         let max_r = beads.iter().map(|b| b.r).fold(0.0, f64::max);
-        let cell = (2.0 * max_r + reach).max(0.5);
+        // At most GRID_SPAN cells along the beads' extent, so a stray move far off the bed
+        // cannot make a bead cover millions of cells.
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for b in beads {
+            lo = lo.min(b.a[0].min(b.b[0])).min(b.a[1].min(b.b[1]));
+            hi = hi.max(b.a[0].max(b.b[0])).max(b.a[1].max(b.b[1]));
+        }
+        let extent = if hi > lo { hi - lo } else { 0.0 };
+        let cell = (2.0 * max_r + reach).max(0.5).max(extent / GRID_SPAN);
         let key = |x: f64| (x / cell).floor() as i64;
         let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
         let grown = |b: &Bead| {
@@ -844,7 +864,7 @@ fn outside_runs(beads: &[Bead], plastic: &[&Move], params: &ElectricalParams) ->
             len
         } else {
             let outline = level_of(b.z).and_then(|k| outlines.get(&k));
-            let steps = ((len / params.sample_step).ceil() as usize).max(1);
+            let steps = ((len / params.sample_step).ceil() as usize).clamp(1, MAX_SAMPLES);
             let outside = (0..=steps)
                 .filter(|&s| {
                     let t = s as f64 / steps as f64;
@@ -1072,7 +1092,7 @@ fn lid_before(part: &PlacedPart, top: f64, before: &[&Move], heights: &[f64]) ->
         }
         let pts = path_xy(m);
         let hit = pts.windows(2).any(|w| {
-            let steps = ((dist(w[0], w[1]) / 0.5).ceil() as usize).max(1);
+            let steps = ((dist(w[0], w[1]) / 0.5).ceil() as usize).clamp(1, MAX_SAMPLES);
             (0..=steps).any(|s| {
                 let t = s as f64 / steps as f64;
                 deep([
