@@ -481,6 +481,22 @@ fn lilypad_tri_color_led_routes_completely_through_the_cli() {
     assert!(!err.contains("could not be routed"), "{err}");
     let check = conduit(["check".as_ref(), gcode.as_os_str()]);
     assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+    // The circuit rebuilt from the G-code alone: every net connected, nothing else wrong.
+    let sch = schematic(&corpus().expect("corpus"), board.name);
+    let dir = dir.path();
+    let check = conduit([
+        "check".as_ref(),
+        gcode.as_os_str(),
+        "--circuit".as_ref(),
+        sch.as_os_str(),
+        "--placement".as_ref(),
+        dir.join("placement.toml").as_os_str(),
+        "--model".as_ref(),
+        dir.join("block.stl").as_os_str(),
+    ]);
+    let out = crate::support::stdout(&check);
+    assert_eq!(check.status.code(), Some(0), "{out}{}", stderr(&check));
+    assert!(out.contains(" 0 shorts, 0 runs outside the solid"), "{out}");
 }
 
 /// OpenLog's config: its ATmega328 is a TQFP-32 at 0.8 mm pitch, where two 0.6 mm traces with

@@ -13,6 +13,7 @@ mod conform;
 mod conformance;
 mod curved;
 mod docs;
+mod electrical;
 mod electronics;
 mod electronics_corpus;
 mod fuzz_stable;

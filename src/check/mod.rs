@@ -58,10 +58,12 @@
 //! [`emit::preview`](crate::emit::preview), and the checker steps the same machine, with
 //! [`CheckParams::flavor`] as its [`Firmware`].
 
+pub mod electrical;
 mod machine;
 mod time;
 
 pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves};
+pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical};
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -396,6 +396,17 @@ pub struct CheckArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Check the circuit in the G-code too: nets connected, no shorts, no conductive material
+    /// outside the solid, part events after their cavity (EAGLE `.sch` or `.brd`).
+    #[arg(long, value_name = "FILE", requires = "placement")]
+    pub circuit: Option<PathBuf>,
+    /// Where the circuit's parts sit (`.toml` or `.3de`), as given to slice or postprocess.
+    #[arg(long, value_name = "FILE", requires = "circuit")]
+    pub placement: Option<PathBuf>,
+    /// The model the G-code was sliced from by `conduit slice`: its frame places a placement
+    /// with `origin = "model"` (without it, the G-code's coordinates are the frame).
+    #[arg(long, value_name = "MODEL", requires = "circuit")]
+    pub model: Option<PathBuf>,
 }
 
 /// Arguments of `conduit preview`.

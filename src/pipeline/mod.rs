@@ -227,6 +227,20 @@ pub fn place_on_bed_with_offsets(scene: &Scene, cfg: &Config) -> (Vec<Mesh>, Vec
     (meshes, offsets)
 }
 
+/// Each object's model-space bounding box (an empty box at the origin for an empty object): the
+/// frame of a placement with `origin = "model"` or `"bbox_center"`, as `conduit slice` uses it.
+pub fn model_bboxes(scene: &Scene) -> Vec<BoundingBox> {
+    placed_meshes(scene)
+        .iter()
+        .map(|m| {
+            m.bounding_box().unwrap_or(BoundingBox {
+                min: [0.0; 3],
+                max: [0.0; 3],
+            })
+        })
+        .collect()
+}
+
 /// Runs the whole planar pipeline on a scene; `progress` is told when each stage starts.
 pub fn slice_scene(
     scene: &Scene,
@@ -283,15 +297,7 @@ fn front(
         return Err(PipelineError::EmptyScene);
     }
     progress(Stage::Place);
-    let model_boxes: Vec<BoundingBox> = placed_meshes(scene)
-        .iter()
-        .map(|m| {
-            m.bounding_box().unwrap_or(BoundingBox {
-                min: [0.0; 3],
-                max: [0.0; 3],
-            })
-        })
-        .collect();
+    let model_boxes = model_bboxes(scene);
     let (meshes, offsets) = place_on_bed_with_offsets(scene, cfg);
     check_fits(&meshes, cfg)?;
     laps.lap(Stage::Place);
