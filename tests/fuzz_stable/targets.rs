@@ -275,9 +275,10 @@ pub fn all() -> Vec<Target> {
             ],
             run: |i| {
                 let t = i.text();
-                let a = conduit_pnp::read_kicad_pos(&t).is_ok();
-                let b = conduit_pnp::read_openpnp_board(&t).is_ok();
-                a || b
+                let a = conduit_pnp::read_kicad_csv(&t).is_ok();
+                let b = conduit_pnp::read_kicad_ascii(&t).is_ok();
+                let c = conduit_pnp::read_openpnp_board(&t).is_ok();
+                a || b || c
             },
             ci_execs: CI,
         },
@@ -459,7 +460,15 @@ pub fn all() -> Vec<Target> {
             // (`threemf` and `scene` read packages).
             accepts: |s| ext_in(s, &["stl", "obj", "off", "ply", "xyz"]),
             dict: &["1e308 ", "0 0 0\n", "NaN ", "vertex 0 0 0\n"],
-            run: |i| conduit::conform::scan::load_scan(&i.file(None), false, 1.0).is_ok(),
+            run: |i| {
+                conduit::conform::scan::load_scan(
+                    &i.file(None),
+                    false,
+                    1.0,
+                    &conduit::scene::LoadOptions::default(),
+                )
+                .is_ok()
+            },
             ci_execs: CI,
         },
         Target {
