@@ -304,6 +304,25 @@ fn a_ring_of_leds_with_terminals_chains_and_branches_routes_completely() {
         corners.dedup();
         assert_eq!(corners.len(), 24, "{t}: ring corners {corners:?}");
     }
+    // The electrical check, from the G-code alone: every net (terminals included) connected,
+    // nothing shorted, nothing outside the ring.
+    let check = conduit([
+        "check".as_ref(),
+        job.out.as_os_str(),
+        "--circuit".as_ref(),
+        job.sch.as_os_str(),
+        "--placement".as_ref(),
+        job.placement.as_os_str(),
+        "--model".as_ref(),
+        job.model.as_os_str(),
+        "--json".as_ref(),
+    ]);
+    assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+    let v: Value = serde_json::from_slice(&check.stdout).expect("check JSON");
+    let el = &v["electrical"];
+    let nets = el["nets"].as_array().expect("nets");
+    assert_eq!(nets.len(), 3, "{el}");
+    assert!(nets.iter().all(|n| n["connected"] == true), "{el}");
 }
 
 #[test]

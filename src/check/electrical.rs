@@ -418,15 +418,7 @@ fn terminals(
                 net,
                 label: format!("{}.{}", part.name, pad.name),
                 z: pad.centre.z,
-                outline: pad
-                    .outline
-                    .points
-                    .iter()
-                    .map(|p| {
-                        let (x, y) = p.to_mm();
-                        [x, y]
-                    })
-                    .collect(),
+                outline: pad.outline.points_mm(),
             });
         }
     }
@@ -1069,15 +1061,7 @@ fn event_problems(
 /// The z of a plastic layer lying wholly above `top` that was printed over the part's footprint
 /// (0.1 mm in from its edge) among `before`, if any.
 fn lid_before(part: &PlacedPart, top: f64, before: &[&Move], heights: &[f64]) -> Option<f64> {
-    let ring: Vec<P2> = part
-        .footprint
-        .points
-        .iter()
-        .map(|p| {
-            let (x, y) = p.to_mm();
-            [x, y]
-        })
-        .collect();
+    let ring: Vec<P2> = part.footprint.points_mm();
     if ring.len() < 3 {
         return None;
     }

@@ -58,6 +58,17 @@ impl Polygon {
             .sum()
     }
 
+    /// The vertices as `[x, y]` in mm.
+    pub fn points_mm(&self) -> Vec<[f64; 2]> {
+        self.points
+            .iter()
+            .map(|p| {
+                let (x, y) = p.to_mm();
+                [x, y]
+            })
+            .collect()
+    }
+
     /// Signed area in mm² (positive when counter-clockwise).
     pub fn area_mm2(&self) -> f64 {
         self.signed_area2() as f64 / 2.0 / 1e12

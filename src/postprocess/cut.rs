@@ -34,14 +34,7 @@ impl CutRegion {
         let (mut min, mut max) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for area in areas {
             for ring in std::iter::once(&area.contour).chain(&area.holes) {
-                let points: Vec<[f64; 2]> = ring
-                    .points
-                    .iter()
-                    .map(|p| {
-                        let (x, y) = p.to_mm();
-                        [x, y]
-                    })
-                    .collect();
+                let points: Vec<[f64; 2]> = ring.points_mm();
                 if points.len() < 3 {
                     continue;
                 }
