@@ -130,6 +130,57 @@ fn prusaslicer_runs_conduit_as_its_post_processing_script() {
     assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
 }
 
+#[test]
+fn prusaslicer_fails_the_export_with_conduits_message_when_the_circuit_cannot_be_built() {
+    let Some(prusa) = installed("prusa-slicer", "prusaslicer_fails_the_export") else {
+        return;
+    };
+    let dir = temp_dir();
+    let ini = dir.path().join("printer.ini");
+    std::fs::write(&ini, PRUSA_INI).expect("ini written");
+    // The sample placement with the LED moved 30 mm beside the cube.
+    let text = std::fs::read_to_string(postprocess_sample("toml")).expect("placement");
+    let at = text.find("name = \"LED1\"").expect("LED1 in the sample");
+    let (head, tail) = text.split_at(at);
+    let moved = format!("{head}{}", tail.replacen("x = 4.0", "x = 34.0", 1));
+    let toml = dir.path().join("outside.toml");
+    std::fs::write(&toml, moved).expect("placement written");
+    let line = format!(
+        "{} postprocess --circuit {} --placement {}",
+        quoted(Path::new(env!("CARGO_BIN_EXE_conduit"))),
+        quoted(&postprocess_sample("sch")),
+        quoted(&toml)
+    );
+    let out = dir.path().join("failed.gcode");
+    let o = Command::new(&prusa)
+        .args(["--export-gcode", "--load"])
+        .arg(&ini)
+        .arg(sample("cube_20mm.stl"))
+        .arg("-o")
+        .arg(&out)
+        .arg("--post-process")
+        .arg(&line)
+        .output()
+        .expect("prusa-slicer starts");
+    // PrusaSlicer fails the export and shows the script's error output.
+    assert_ne!(o.status.code(), Some(0), "the export succeeded");
+    let said = format!("{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+    assert!(
+        said.contains("part LED1 is not inside the object")
+            && said.contains("the circuit was not built as asked"),
+        "{said}"
+    );
+    // PrusaSlicer's command line runs the script on the file it exported and keeps it when the
+    // script fails (its GUI exports nothing): the file is the host's own, left unedited.
+    if out.exists() {
+        let text = std::fs::read_to_string(&out).expect("readable");
+        assert!(
+            !text.contains("; conduit postprocess:") && !text.contains(";TYPE:Conductive trace"),
+            "the failed run edited the host's file"
+        );
+    }
+}
+
 /// The CuraEngine output cut like Cura hands it to scripts: the header and start G-code, then
 /// one piece per `;LAYER:` block.
 const CURA_DRIVER: &str = r#"
