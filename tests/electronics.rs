@@ -531,3 +531,116 @@ fn a_circuit_not_built_as_asked_fails_with_each_problem_named_and_writes_nothing
     assert_eq!(code, Some(0), "{err}");
     assert!(!err.contains("error") && !err.contains("warning"), "{err}");
 }
+
+#[test]
+fn the_gcode_carries_octopnps_part_description_for_every_machine_placed_part() {
+    let dir = temp_dir();
+    let out = dir.path().join("demo.gcode");
+    let report = dir.path().join("demo.json");
+    let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
+    let o = conduit([
+        "slice".as_ref(),
+        demo("block.stl").as_os_str(),
+        "--circuit".as_ref(),
+        demo("led_coin.sch").as_os_str(),
+        "--placement".as_ref(),
+        demo("placement.toml").as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--report".as_ref(),
+        report.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).expect("G-code");
+    // OctoPNP's reader: from every line, the text from its first `<` to its last `>`, joined;
+    // wrapped in an <object> unless the first such line opens one.
+    let mut xml = String::new();
+    for line in text.lines() {
+        if let (Some(a), Some(b)) = (line.find('<'), line.rfind('>')) {
+            if a < b {
+                xml.push_str(&line[a..=b]);
+                xml.push('\n');
+            }
+        }
+    }
+    assert!(
+        xml.lines().next().is_some_and(|l| l.starts_with("<object")),
+        "{xml}"
+    );
+    let options = conduit_xml::Options {
+        names: conduit_xml::Names::Qualified,
+        entities: conduit_xml::Entities::Strict,
+        depth_check: conduit_xml::DepthCheck::BeforeAttributes,
+        max_depth: 16,
+    };
+    let root = conduit_xml::parse(xml.as_bytes(), &options)
+        .expect("well-formed XML")
+        .expect("a root element");
+    assert_eq!(root.name, "object");
+    // Every M361 P<id> has its part, with OctoPNP's required fields as numbers.
+    let ids: Vec<String> = text
+        .lines()
+        .filter_map(|l| {
+            l.split(';')
+                .next()?
+                .trim()
+                .strip_prefix("M361 P")
+                .map(str::to_owned)
+        })
+        .collect();
+    assert_eq!(ids, ["2", "3"]);
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let parts = v["electronics"]["parts"].as_array().expect("parts");
+    let described: Vec<&conduit_xml::Node> = root.children_named("part").collect();
+    assert_eq!(described.len(), ids.len());
+    for ((part, id), (box_number, (name, height, size))) in described
+        .iter()
+        .zip(&ids)
+        .zip([(1, ("R1", 0.6, [2.9, 1.3])), (2, ("LED1", 1.0, [3.0, 1.2]))])
+    {
+        let number = |node: &conduit_xml::Node, key: &str| -> f64 {
+            node.attr(key)
+                .and_then(|v| v.parse().ok())
+                .unwrap_or_else(|| panic!("{name}: {key} is not a number"))
+        };
+        assert_eq!(part.attr("id"), Some(id.as_str()));
+        assert_eq!(part.attr("name"), Some(name));
+        let child = |n: &str| part.child(n).unwrap_or_else(|| panic!("{name}: no <{n}>"));
+        assert_eq!(
+            child("position").attr("box"),
+            Some(box_number.to_string().as_str())
+        );
+        assert_eq!(number(child("size"), "height"), height);
+        // The outline spans the package's pads.
+        let xs: Vec<f64> = child("shape")
+            .children
+            .iter()
+            .map(|p| number(p, "x"))
+            .collect();
+        let ys: Vec<f64> = child("shape")
+            .children
+            .iter()
+            .map(|p| number(p, "y"))
+            .collect();
+        let span = |v: &[f64]| {
+            v.iter().copied().fold(f64::MIN, f64::max) - v.iter().copied().fold(f64::MAX, f64::min)
+        };
+        assert!((span(&xs) - size[0]).abs() < 1e-9 && (span(&ys) - size[1]).abs() < 1e-9);
+        assert_eq!(child("pads").children.len(), 2);
+        let report_part = parts
+            .iter()
+            .find(|p| p["name"] == name)
+            .expect("in the report");
+        let destination = child("destination");
+        for (k, key) in ["x", "y", "z"].into_iter().enumerate() {
+            let want = report_part["position"][k].as_f64().expect("coordinate");
+            assert!(
+                (number(destination, key) - want).abs() < 1e-4,
+                "{name} {key}"
+            );
+        }
+        let rotation = report_part["rotation_deg"].as_f64().expect("rotation");
+        assert_eq!(number(destination, "orientation"), rotation);
+    }
+}

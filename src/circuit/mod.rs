@@ -15,6 +15,7 @@
 mod placed;
 mod placement;
 mod rubberband;
+pub mod octopnp;
 pub mod settings;
 pub mod stage;
 mod three_de;

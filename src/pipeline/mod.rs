@@ -515,6 +515,12 @@ pub fn slice_scene_with(
     progress(Stage::Emit);
     let mut gcode = Vec::new();
     let stats = write_gcode(&program, &cfg.gcode_params(), &mut gcode)?;
+    if let Some(e) = circuit {
+        // What OctoPNP needs to answer the `M361 P<id>` events, after the program.
+        let name = scene.objects.first().map_or("object", |o| o.name.as_str());
+        let block = crate::circuit::octopnp::octopnp_block(&e.circuit, &parts, name);
+        gcode.extend_from_slice(block.as_bytes());
+    }
     laps.lap(Stage::Emit);
 
     let summary = SliceSummary {
