@@ -18,18 +18,7 @@ fn demo_gcode() -> &'static str {
     static TEXT: OnceLock<String> = OnceLock::new();
     TEXT.get_or_init(|| {
         let dir = temp_dir();
-        let out = dir.path().join("demo.gcode");
-        let o = conduit([
-            "slice".as_ref(),
-            demo("block.stl").as_os_str(),
-            "--circuit".as_ref(),
-            demo("led_coin.sch").as_os_str(),
-            "--placement".as_ref(),
-            demo("placement.toml").as_os_str(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        let (out, _) = crate::electronics::slice_demo(dir.path());
         std::fs::read_to_string(&out).expect("G-code written")
     })
 }

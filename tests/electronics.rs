@@ -80,11 +80,10 @@ pub(crate) fn replay(text: &str) -> Replayed {
     out
 }
 
-#[test]
-fn demo_circuit_slices_with_cavities_traces_events_and_placement_files() {
-    let dir = temp_dir();
-    let out = dir.path().join("demo.gcode");
-    let report = dir.path().join("demo.json");
+/// Slices the bundled demo (block, LED and coin cell) into `dir`: `demo.gcode` and its report
+/// `demo.json`, whose paths it returns.
+pub(crate) fn slice_demo(dir: &Path) -> (PathBuf, PathBuf) {
+    let (out, report) = (dir.join("demo.gcode"), dir.join("demo.json"));
     let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
     let o = conduit([
         "slice".as_ref(),
@@ -99,6 +98,13 @@ fn demo_circuit_slices_with_cavities_traces_events_and_placement_files() {
         report.as_os_str(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    (out, report)
+}
+
+#[test]
+fn demo_circuit_slices_with_cavities_traces_events_and_placement_files() {
+    let dir = temp_dir();
+    let (out, report) = slice_demo(dir.path());
     let check = conduit(["check".as_ref(), out.as_os_str()]);
     assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
 
@@ -535,22 +541,7 @@ fn a_circuit_not_built_as_asked_fails_with_each_problem_named_and_writes_nothing
 #[test]
 fn the_gcode_carries_octopnps_part_description_for_every_machine_placed_part() {
     let dir = temp_dir();
-    let out = dir.path().join("demo.gcode");
-    let report = dir.path().join("demo.json");
-    let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
-    let o = conduit([
-        "slice".as_ref(),
-        demo("block.stl").as_os_str(),
-        "--circuit".as_ref(),
-        demo("led_coin.sch").as_os_str(),
-        "--placement".as_ref(),
-        demo("placement.toml").as_os_str(),
-        "-o".as_ref(),
-        out.as_os_str(),
-        "--report".as_ref(),
-        report.as_os_str(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let (out, report) = slice_demo(dir.path());
     let text = std::fs::read_to_string(&out).expect("G-code");
     // OctoPNP's reader: from every line, the text from its first `<` to its last `>`, joined;
     // wrapped in an <object> unless the first such line opens one.
