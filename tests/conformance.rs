@@ -118,9 +118,8 @@ fn warning_problem(out: &Output, name: &str) -> Option<String> {
     (warnings == 0).then(|| "the JSON has no warnings".to_string())
 }
 
-/// The kind of a reader's refusal: the message without `error: FILE: FORMAT: `, the location
-/// (up to the next `": "`), quoted text and digits, so the same defect in two files compares
-/// equal.
+/// The kind of a reader's refusal: the message without `error: FILE: FORMAT: `, then
+/// [`conduit_3mf::error_kind`], so the same defect in two files compares equal.
 fn kind(line: &str, name: &str) -> String {
     let msg = line
         .trim()
@@ -130,27 +129,7 @@ fn kind(line: &str, name: &str) -> String {
         .unwrap_or(line)
         .trim_start_matches(": ")
         .trim_start_matches("3MF: ");
-    let rest = msg.split_once(": ").map_or(msg, |(_, r)| r);
-    let mut out = String::new();
-    let mut quoted = false;
-    for c in rest.chars() {
-        match c {
-            '"' => {
-                quoted = !quoted;
-                if quoted {
-                    out.push_str("\"_\"");
-                }
-            }
-            _ if quoted => {}
-            '0'..='9' => {
-                if !out.ends_with('#') {
-                    out.push('#');
-                }
-            }
-            _ => out.push(c),
-        }
-    }
-    out
+    conduit_3mf::error_kind(msg)
 }
 
 #[test]

@@ -57,6 +57,16 @@ pub enum PadShape {
 }
 
 impl PadShape {
+    /// Width and height along the pad's own x and y axes, mm (a round pad's diameter twice).
+    pub fn size(&self) -> (f64, f64) {
+        match *self {
+            PadShape::Round { diameter } => (diameter, diameter),
+            PadShape::Rect { width, height } | PadShape::Oblong { width, height } => {
+                (width, height)
+            }
+        }
+    }
+
     /// Maps an EAGLE pad shape:
     /// - SMD pads are [`PadShape::Rect`]; with `roundness` 100 they are [`PadShape::Oblong`]
     ///   (or [`PadShape::Round`] when square). Partial roundness is drawn as a sharp rectangle,
@@ -115,6 +125,19 @@ pub struct Pad {
     pub shape: PadShape,
     /// Surface-mount (`true`) or through-hole (`false`).
     pub smd: bool,
+}
+
+impl Pad {
+    /// Half the size of the pad's bounding box along the package's x and y axes, mm: its
+    /// [`PadShape::size`] turned by its rotation.
+    pub fn half_extent(&self) -> [f64; 2] {
+        let (w, h) = self.shape.size();
+        let (s, c) = self.rotation_deg.to_radians().sin_cos();
+        [
+            ((w * c).abs() + (h * s).abs()) / 2.0,
+            ((w * s).abs() + (h * c).abs()) / 2.0,
+        ]
+    }
 }
 
 /// A number for a message: plain below a million, in scientific notation above, so a value of

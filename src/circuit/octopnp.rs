@@ -17,7 +17,7 @@
 
 use std::fmt::Write as _;
 
-use super::{Circuit, PadShape, PlacedPart, PlacingMethod};
+use super::{Circuit, PlacedPart, PlacingMethod};
 
 /// The OctoPNP block for `parts` (bed coordinates, placement order) of `circuit`, as `;`
 /// comment lines, or an empty string when no part is placed by the machine. `name` names the
@@ -48,17 +48,7 @@ pub fn octopnp_block(circuit: &Circuit, parts: &[PlacedPart], name: &str) -> Str
         out.push_str(";  </shape>\n;  <pads>\n");
         let pads = circuit.part(&part.name).map_or(&[][..], |c| &c.pads[..]);
         for pad in pads {
-            let (w, h) = match pad.shape {
-                PadShape::Round { diameter } => (diameter, diameter),
-                PadShape::Rect { width, height } | PadShape::Oblong { width, height } => {
-                    (width, height)
-                }
-            };
-            let (s, c) = pad.rotation_deg.to_radians().sin_cos();
-            let half = [
-                ((w * c).abs() + (h * s).abs()) / 2.0,
-                ((w * s).abs() + (h * c).abs()) / 2.0,
-            ];
+            let half = pad.half_extent();
             let _ = writeln!(
                 out,
                 ";    <pad x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>",

@@ -250,41 +250,31 @@ fn describe_eagle(doc: &conduit_eagle::Document) -> Value {
 /// bounding box; per net its pins (`PART.PAD`). A net with one pin is kept: a placement may wire
 /// it to a terminal.
 fn describe_circuit(circuit: &conduit::circuit::Circuit) -> Value {
-    use conduit::circuit::PadShape;
     let parts: Vec<Value> = circuit
         .parts
         .iter()
         .map(|p| {
             let mut lo = [f64::INFINITY; 2];
             let mut hi = [f64::NEG_INFINITY; 2];
-            let pads: Vec<Value> =
-                p.pads
-                    .iter()
-                    .map(|pad| {
-                        let (w, h) = match pad.shape {
-                            PadShape::Round { diameter } => (diameter, diameter),
-                            PadShape::Rect { width, height }
-                            | PadShape::Oblong { width, height } => (width, height),
-                        };
-                        // The pad's half extent along x and y, turned by its rotation.
-                        let (sn, c) = pad.rotation_deg.to_radians().sin_cos();
-                        let half = [
-                            ((w * c).abs() + (h * sn).abs()) / 2.0,
-                            ((w * sn).abs() + (h * c).abs()) / 2.0,
-                        ];
-                        for (k, v) in [pad.x, pad.y].into_iter().enumerate() {
-                            lo[k] = lo[k].min(v - half[k]);
-                            hi[k] = hi[k].max(v + half[k]);
-                        }
-                        json!({
-                            "name": pad.name,
-                            "at": [round(pad.x), round(pad.y)],
-                            "rotation_deg": round(pad.rotation_deg),
-                            "size": [round(w), round(h)],
-                            "kind": if pad.smd { "smd" } else { "through-hole" },
-                        })
+            let pads: Vec<Value> = p
+                .pads
+                .iter()
+                .map(|pad| {
+                    let (w, h) = pad.shape.size();
+                    let half = pad.half_extent();
+                    for (k, v) in [pad.x, pad.y].into_iter().enumerate() {
+                        lo[k] = lo[k].min(v - half[k]);
+                        hi[k] = hi[k].max(v + half[k]);
+                    }
+                    json!({
+                        "name": pad.name,
+                        "at": [round(pad.x), round(pad.y)],
+                        "rotation_deg": round(pad.rotation_deg),
+                        "size": [round(w), round(h)],
+                        "kind": if pad.smd { "smd" } else { "through-hole" },
                     })
-                    .collect();
+                })
+                .collect();
             let size = if p.pads.is_empty() {
                 Value::Null
             } else {

@@ -25,36 +25,11 @@ use std::collections::BTreeMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 
+use crate::error_kind as kind;
 use crate::{Limits, Model, ObjectContent, ReadOptions, read, read_with, write};
 
 /// The note of the manifest's `either` entries whose defect is harmless.
 const HARMLESS_NOTE: &str = "a harmless defect";
-
-/// The kind of a reader error: its message without the location (everything up to the first
-/// `": "`), with quoted text and digits blanked, so the same defect in two files compares equal.
-fn kind(message: &str) -> String {
-    let rest = message.split_once(": ").map_or(message, |(_, r)| r);
-    let mut out = String::new();
-    let mut quoted = false;
-    for c in rest.chars() {
-        match c {
-            '"' => {
-                quoted = !quoted;
-                if quoted {
-                    out.push_str("\"_\"");
-                }
-            }
-            _ if quoted => {}
-            '0'..='9' => {
-                if !out.ends_with('#') {
-                    out.push('#');
-                }
-            }
-            _ => out.push(c),
-        }
-    }
-    out
-}
 
 #[test]
 fn kinds_ignore_locations_names_and_numbers() {

@@ -293,3 +293,31 @@ impl ThreeMfError {
         }
     }
 }
+
+/// The kind of a reader error message: the message without its location (everything up to the
+/// first `": "`), quoted text blanked to `"_"` and each run of digits to `#`, so the same defect
+/// found in two files compares equal (`/3D/a.model:4:3: duplicated metadata name "Title"` and
+/// `/3D/3dmodel.model:8:3: duplicated metadata name "Description"` are one kind).
+pub fn error_kind(message: &str) -> String {
+    let rest = message.split_once(": ").map_or(message, |(_, r)| r);
+    let mut out = String::new();
+    let mut quoted = false;
+    for c in rest.chars() {
+        match c {
+            '"' => {
+                quoted = !quoted;
+                if quoted {
+                    out.push_str("\"_\"");
+                }
+            }
+            _ if quoted => {}
+            '0'..='9' => {
+                if !out.ends_with('#') {
+                    out.push('#');
+                }
+            }
+            _ => out.push(c),
+        }
+    }
+    out
+}

@@ -117,7 +117,7 @@ mod corpus_tests;
 #[cfg(test)]
 mod tests;
 
-pub use error::{Location, ThreeMfError};
+pub use error::{Location, ThreeMfError, error_kind};
 pub use flatten::{FlatMesh, apply as apply_transform, compose as compose_transforms};
 pub use limits::{Limits, RATIO_CHECK_FLOOR};
 pub use model::{
