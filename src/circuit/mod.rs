@@ -12,8 +12,11 @@
 //! module turns its [`conduit_eagle::Schematic`] or [`conduit_eagle::Board`] into a
 //! [`Circuit`] the pipeline uses.
 
+pub mod board_layout;
+pub mod fit;
 mod placed;
 mod placement;
+pub mod placement_toml;
 mod rubberband;
 pub mod octopnp;
 pub mod settings;

@@ -67,6 +67,10 @@ pub struct RouteSettings {
     /// Electronic Slic3r wire single-pin nets to such waypoints). 0 prints none. From 0 to
     /// 50 mm. Default 2.
     pub terminal_pad: f64,
+    /// Material kept between a part's cavity and the object's outer surface, and between the
+    /// cavities of two parts, mm: what `conduit place` keeps when it lays parts out, and what
+    /// it warns about when a placement leaves less. About two perimeters. Default 1.
+    pub wall_clearance: f64,
 }
 
 impl Default for RouteSettings {
@@ -92,6 +96,7 @@ impl Default for RouteSettings {
             detour_slack: r.detour_slack,
             pad_drops: false,
             terminal_pad: 2.0,
+            wall_clearance: 1.0,
         }
     }
 }
@@ -143,6 +148,7 @@ impl RouteSettings {
             ("cavity_offset", self.cavity_offset),
             ("layer_change_penalty", self.layer_change_penalty),
             ("detour_slack", self.detour_slack),
+            ("wall_clearance", self.wall_clearance),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 out.push(format!("route.{key} must be ≥ 0, got {v}"));

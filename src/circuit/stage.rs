@@ -361,7 +361,11 @@ pub fn object_stage(
         .collect();
     report
         .part_problems
-        .extend(part_problems(&mine, islands, zs));
+        .extend(super::fit::part_problems(
+            &mine.iter().map(|(_, p)| *p).collect::<Vec<_>>(),
+            islands,
+            zs,
+        ));
     let cavities = carve_part_cavities(&mine, islands, zs, params.cavity_offset);
     let (mine_wires, between): (Vec<&CircuitWire>, Vec<&CircuitWire>) = circuit
         .wires
@@ -439,109 +443,6 @@ impl TraceStyle {
             height: params.conductive_height,
         }
     }
-}
-
-/// Footprint area beyond the solid (or overlap between two footprints) that is still taken as
-/// none, mm²: polygon rounding at the nanometre grid, and pads flush with a wall.
-const PROBLEM_AREA_MM2: f64 = 0.05;
-
-/// What is wrong with where the object's parts sit, before their cavities are cut: a part
-/// above the object, a footprint reaching beyond the solid at its seating plane (the layer
-/// under it, or the first layer for a part on the bed), two parts whose footprints overlap at
-/// heights both bodies take up (cavities merely touching are one pocket, which is fine).
-fn part_problems(
-    mine: &[(usize, &PlacedPart)],
-    islands: &[Vec<ExPolygon>],
-    zs: &[LayerZ],
-) -> Vec<String> {
-    let mut problems = Vec::new();
-    let Some(last) = zs.last() else {
-        return problems;
-    };
-    for (_, part) in mine {
-        let z = part.position.z;
-        if z > last.top + 1e-6 {
-            problems.push(format!(
-                "part {} is above the object: its seating plane z {z:.3} mm is {:.3} mm over \
-                 the object's top ({:.3} mm)",
-                part.name,
-                z - last.top,
-                last.top
-            ));
-            continue;
-        }
-        let layer = zs.iter().rposition(|l| l.top <= z + 1e-6).unwrap_or(0);
-        let footprint = [ExPolygon {
-            contour: part.footprint.clone(),
-            holes: Vec::new(),
-        }];
-        let beyond: f64 = crate::geom::difference(&footprint, &islands[layer])
-            .iter()
-            .map(ExPolygon::area_mm2)
-            .sum();
-        if beyond > PROBLEM_AREA_MM2 {
-            let reach = part
-                .footprint
-                .points
-                .iter()
-                .map(|&p| distance_outside(p, &islands[layer]))
-                .fold(0.0, f64::max);
-            problems.push(format!(
-                "part {} is not inside the object: {beyond:.1} of its {:.1} mm² footprint lies \
-                 outside the solid at z {:.3} mm, up to {reach:.2} mm beyond its edge",
-                part.name,
-                part.footprint.area_mm2().abs(),
-                zs[layer].top
-            ));
-        }
-    }
-    for (i, (_, a)) in mine.iter().enumerate() {
-        for (_, b) in &mine[i + 1..] {
-            let (a_top, b_top) = (a.position.z + a.body_height, b.position.z + b.body_height);
-            if a.position.z.max(b.position.z) >= a_top.min(b_top) - 1e-6 {
-                continue;
-            }
-            let body = |p: &PlacedPart| {
-                [ExPolygon {
-                    contour: p.footprint.clone(),
-                    holes: Vec::new(),
-                }]
-            };
-            let shared: f64 = crate::geom::intersection(&body(a), &body(b))
-                .iter()
-                .map(ExPolygon::area_mm2)
-                .sum();
-            if shared > PROBLEM_AREA_MM2 {
-                problems.push(format!(
-                    "parts {} and {} collide: their footprints share {shared:.1} mm² between z \
-                     {:.3} and {:.3} mm",
-                    a.name,
-                    b.name,
-                    a.position.z.max(b.position.z),
-                    a_top.min(b_top)
-                ));
-            }
-        }
-    }
-    problems
-}
-
-/// How far `p` lies outside `islands`, mm: 0 inside, else the distance to the nearest edge.
-fn distance_outside(p: Point2, islands: &[ExPolygon]) -> f64 {
-    if islands.iter().any(|i| i.contains(p)) {
-        return 0.0;
-    }
-    islands
-        .iter()
-        .flat_map(|i| std::iter::once(&i.contour).chain(&i.holes))
-        .flat_map(|ring| {
-            let n = ring.points.len();
-            (0..n).map(move |k| {
-                crate::geom::segment_distance(p, ring.points[k], ring.points[(k + 1) % n])
-                    / scaled(1.0) as f64
-            })
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// The cavities of the object's parts (`mine`, with their placement indices), carved from its

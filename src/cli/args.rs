@@ -52,6 +52,10 @@ pub enum Command {
     /// Place a circuit in models and route its nets, without G-code: a report and one SVG per
     /// layer (material, cavities, channels, traces).
     Route(RouteArgs),
+    /// Write a placement (TOML to edit) for a circuit in a model: an EAGLE board's layout moved
+    /// into the object (`--from-brd`), or the parts packed inside its solid (`--auto`); every
+    /// part is checked against the solid and the others.
+    Place(PlaceArgs),
     /// Slicer plugin mode: read another slicer's G-code (PrusaSlicer, SuperSlicer, OrcaSlicer,
     /// Cura, Slic3r...) with its settings (unless `-c` is given) and edit it in place; without a
     /// circuit it only reports what it finds.
@@ -103,6 +107,108 @@ pub struct ConfigSource {
     /// Override one setting, e.g. `--set slice.layer_height=0.3` or `--set tools.1.temperature=25`.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+}
+
+/// Arguments of `conduit place`.
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("how").required(true).args(["from_brd", "auto"])))]
+pub struct PlaceArgs {
+    /// The model the parts go into (STL, 3MF, OBJ, OFF, PLY; its first object).
+    #[arg(long, value_name = "MODEL")]
+    pub model: PathBuf,
+    /// Lay the parts out as this EAGLE board has them.
+    #[arg(long, value_name = "X.brd")]
+    pub from_brd: Option<PathBuf>,
+    /// Pack the parts inside the model's solid, keeping nets short.
+    #[arg(long)]
+    pub auto: bool,
+    /// The circuit (.sch or .brd) the placement is for; with --from-brd, the board by default.
+    #[arg(long, value_name = "X.sch|X.brd", required_unless_present = "from_brd")]
+    pub circuit: Option<PathBuf>,
+    /// Settings (`route.wall_clearance`, `route.cavity_offset`, the trace width, the layers).
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// The placement TOML to write.
+    #[arg(short, long, value_name = "P.toml")]
+    pub output: PathBuf,
+    /// Write the placement even when a part is outside the solid or in another's cavity.
+    #[arg(long)]
+    pub force: bool,
+    /// Seating plane of the (top) parts, model z in mm; by default under the model's top by the
+    /// body height and `route.wall_clearance`.
+    #[arg(long, value_name = "Z", conflicts_with_all = ["z_from_top", "z_range"])]
+    pub z: Option<f64>,
+    /// Seating plane this far below the model's top, mm.
+    #[arg(long, value_name = "D", conflicts_with = "z_range")]
+    pub z_from_top: Option<f64>,
+    /// With --from-brd: where the board's centre goes, `X,Y` in model mm (default: the middle
+    /// of the model's bounding box).
+    #[arg(long, value_name = "X,Y", value_parser = parse_xy, requires = "from_brd")]
+    pub at: Option<[f64; 2]>,
+    /// With --from-brd: turn the layout about the board's centre, degrees counter-clockwise.
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, requires = "from_brd")]
+    pub rotate: f64,
+    /// With --from-brd: spread the layout (distances between parts times S; parts keep their
+    /// size). The summary suggests the smallest scale that leaves traces room between pads.
+    #[arg(long, value_name = "S", default_value_t = 1.0, requires = "from_brd")]
+    pub scale: f64,
+    /// With --from-brd: seating plane of the bottom-side parts (face up); by default under
+    /// the top plane by the body height and `route.wall_clearance`.
+    #[arg(long, value_name = "Z", requires = "from_brd", conflicts_with = "bottom")]
+    pub bottom_z: Option<f64>,
+    /// With --from-brd: `refuse` fails on a board with bottom-side parts instead of placing
+    /// them face up below the top parts.
+    #[arg(long, value_name = "below|refuse", value_parser = ["below", "refuse"], requires = "from_brd")]
+    pub bottom: Option<String>,
+    /// Body height written for every part, mm (board files have none: measure your parts).
+    #[arg(long, value_name = "H", default_value_t = 1.0)]
+    pub body_height: f64,
+    /// With --auto: the seating plane is chosen in this range of model z, `A..B` mm (default:
+    /// from `route.wall_clearance` above the bottom to under the top by the body height and
+    /// `route.wall_clearance`).
+    #[arg(long, value_name = "A..B", value_parser = parse_range, requires = "auto")]
+    pub z_range: Option<[f64; 2]>,
+    /// With --auto: smallest distance between two parts' footprints, mm (default: both
+    /// cavities, `route.wall_clearance` and two traces with their channels).
+    #[arg(long, value_name = "MM", requires = "auto")]
+    pub spacing: Option<f64>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `X,Y` as two numbers.
+fn parse_xy(s: &str) -> Result<[f64; 2], String> {
+    let (x, y) = s
+        .split_once(',')
+        .ok_or_else(|| format!("expected X,Y (two numbers in mm), got {s:?}"))?;
+    let num = |t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{t:?} is not a number"))
+    };
+    Ok([num(x)?, num(y)?])
+}
+
+/// `A..B` as two numbers, A ≤ B.
+fn parse_range(s: &str) -> Result<[f64; 2], String> {
+    let (a, b) = s
+        .split_once("..")
+        .ok_or_else(|| format!("expected A..B (two heights in mm), got {s:?}"))?;
+    let num = |t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{t:?} is not a number"))
+    };
+    let (a, b) = (num(a)?, num(b)?);
+    if a > b {
+        return Err(format!("{a} is above {b}: give the lower height first"));
+    }
+    Ok([a, b])
 }
 
 /// Arguments of `conduit slice`.

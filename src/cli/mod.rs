@@ -77,6 +77,7 @@ mod jet;
 mod postprocess;
 mod preview;
 mod progress;
+mod place;
 mod route;
 mod slice;
 
@@ -230,6 +231,7 @@ pub fn run() -> ExitCode {
         args::Command::Config(a) => config::run(a),
         args::Command::Preview(a) => preview::run(a),
         args::Command::Route(a) => route::run(a),
+        args::Command::Place(a) => place::run(a),
         args::Command::Postprocess(a) => postprocess::run(a),
         args::Command::Conform(a) => conform::run(a),
         args::Command::Jet(a) => jet::run(a),

@@ -9,6 +9,7 @@
 pub mod compensate;
 pub mod conform;
 pub mod jet;
+pub mod place;
 pub mod postprocess;
 
 pub use crate::circuit::stage::{self as electronics, Electronics, ElectronicsReport};

@@ -1,0 +1,496 @@
+//! An EAGLE board's layout moved into a printed object: where `conduit place --from-brd` puts
+//! each part, and the scale that leaves printed traces room between the parts.
+//!
+//! Place in the pipeline: before everything else of the electronics line, it writes the
+//! [`Placement`] a user then edits and slices with. The board's centre (its outline's, or its
+//! elements' when it has none) goes to a point of the object, turned and spread about it; top
+//! parts sit on one plane, bottom-side (mirrored) parts face up on a second plane below it,
+//! where they keep their place as seen from above. A printed part cannot be mirrored, so a
+//! bottom part is turned to the quarter turn that puts its pads nearest to where the board's
+//! mirrored copper has them (their nets are routed to them wherever they are). A top part whose
+//! pads surround another top part (a socket or module standing over parts on the board) goes
+//! to the lower plane too, under the parts it covers.
+
+use std::collections::BTreeMap;
+
+use super::placed::place;
+use super::placement::{Connection, Origin, PartPlacement, Placement, PlacingMethod};
+use super::{Circuit, Part};
+use crate::geom::BoundingBox;
+
+/// How a board's layout is moved into the object (model coordinates, mm and degrees).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoardLayoutParams {
+    /// Where the board's centre goes, x and y.
+    pub centre: [f64; 2],
+    /// Turn of the whole layout about the board's centre, counter-clockwise seen from above.
+    pub rotate_deg: f64,
+    /// Factor the distances between parts are multiplied by (the parts keep their size).
+    pub scale: f64,
+    /// Seating plane of the top-side parts.
+    pub top_z: f64,
+    /// Seating plane of the bottom-side parts; `None` refuses a board that has any.
+    pub bottom_z: Option<f64>,
+    /// Height given to every part's body (a board file does not know it).
+    pub body_height: f64,
+}
+
+/// A board's side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// Top side: the part keeps its board rotation.
+    Top,
+    /// Bottom side (mirrored on the board): placed face up on the lower plane.
+    Bottom,
+    /// A top part whose pads surround another top part (a socket or module that stands over
+    /// parts on the board): put on the lower plane, under the parts it covers.
+    Under,
+}
+
+/// A board layout in the object.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoardLayout {
+    /// The placement, model coordinates.
+    pub placement: Placement,
+    /// The side each placed part came from.
+    pub sides: BTreeMap<String, Side>,
+    /// Board elements left out, with the reason, one line each.
+    pub left_out: Vec<String>,
+}
+
+/// Why a board cannot be laid out.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum BoardLayoutError {
+    /// Bottom-side parts on a board laid out with bottom parts refused.
+    #[error(
+        "{} bottom-side part(s) ({}): a printed part cannot be mirrored; place them face up \
+         below the top parts (leave out --bottom refuse, or give --bottom-z)",
+        parts.len(),
+        parts.join(", ")
+    )]
+    BottomParts {
+        /// Their names.
+        parts: Vec<String>,
+    },
+    /// No element of the board is a circuit part with pads.
+    #[error("no element of the board is a part of the circuit with pads")]
+    NoParts,
+    /// A number that cannot lay out anything.
+    #[error("{what} must be {rule}, got {value}")]
+    BadNumber {
+        /// Which option.
+        what: &'static str,
+        /// The rule.
+        rule: &'static str,
+        /// The value.
+        value: f64,
+    },
+}
+
+/// The board's centre, mm: the middle of its outline's bounding box (the straight and curved
+/// wires of the Dimension layer), or, when it has none (a round board drawn as a circle), of
+/// the origins of the elements that are circuit parts with a pad on a net (a drawing frame
+/// or logo far from the board does not count).
+pub fn board_centre(board: &conduit_eagle::Board, circuit: &Circuit) -> [f64; 2] {
+    let mut points: Vec<[f64; 2]> = board
+        .outline
+        .iter()
+        .flat_map(|s| [[s.x1, s.y1], [s.x2, s.y2]])
+        .collect();
+    if points.is_empty() {
+        points = board
+            .elements
+            .iter()
+            .filter(|e| {
+                circuit
+                    .part(&e.name)
+                    .is_some_and(|p| has_connected_pads(circuit, p))
+            })
+            .map(|e| [e.x, e.y])
+            .collect();
+    }
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for p in &points {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if points.is_empty() {
+        return [0.0; 2];
+    }
+    [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0]
+}
+
+/// The face-up rotation of a bottom-side part whose board rotation is `MR<degrees>`: the
+/// quarter turn whose pads come nearest, in the least-squares sense, to where the mirrored
+/// package has them (the best rigid fit of the pads, rounded to a quarter turn). A package the
+/// fit cannot tell turns by `−degrees`, the rotation that keeps its outline.
+pub fn face_up_rotation(part: &Part, degrees: f64) -> f64 {
+    let (s, c) = degrees.to_radians().sin_cos();
+    let (mut cross, mut dot) = (0.0, 0.0);
+    for pad in &part.pads {
+        let (x, y) = (pad.x, pad.y);
+        // Where EAGLE's MR<degrees> puts the pad: rotated, then x negated.
+        let (qx, qy) = (-(x * c - y * s), x * s + y * c);
+        cross += x * qy - y * qx;
+        dot += x * qx + y * qy;
+    }
+    let angle = if cross.hypot(dot) < 1e-9 {
+        -degrees
+    } else {
+        cross.atan2(dot).to_degrees()
+    };
+    let quarter = (angle / 90.0).round() * 90.0;
+    quarter.rem_euclid(360.0)
+}
+
+/// The top-side elements whose pads' extent (their package's pad rectangle, turned as the
+/// board turns it) holds the centre of a smaller top-side element's pads: on the board they
+/// stand over that part, which a print can only do with them on a lower plane.
+fn covering_parts(
+    board: &conduit_eagle::Board,
+    circuit: &Circuit,
+) -> std::collections::BTreeSet<String> {
+    struct Extent {
+        name: String,
+        centre: [f64; 2],
+        at: [f64; 2],
+        turn: f64,
+        lo: [f64; 2],
+        hi: [f64; 2],
+    }
+    let extents: Vec<Extent> = board
+        .elements
+        .iter()
+        .filter(|e| !e.rotation.mirror)
+        .filter_map(|e| {
+            let part = circuit.part(&e.name).filter(|p| has_connected_pads(circuit, p))?;
+            let mut lo = [f64::INFINITY; 2];
+            let mut hi = [f64::NEG_INFINITY; 2];
+            for pad in &part.pads {
+                let [hx, hy] = pad.half_extent();
+                lo = [lo[0].min(pad.x - hx), lo[1].min(pad.y - hy)];
+                hi = [hi[0].max(pad.x + hx), hi[1].max(pad.y + hy)];
+            }
+            let (s, c) = e.rotation.degrees.to_radians().sin_cos();
+            let (mx, my) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
+            Some(Extent {
+                name: e.name.clone(),
+                centre: [e.x + mx * c - my * s, e.y + mx * s + my * c],
+                at: [e.x, e.y],
+                turn: e.rotation.degrees,
+                lo,
+                hi,
+            })
+        })
+        .collect();
+    let mut out = std::collections::BTreeSet::new();
+    for a in &extents {
+        let (s, c) = a.turn.to_radians().sin_cos();
+        let holds = |p: [f64; 2]| {
+            let (dx, dy) = (p[0] - a.at[0], p[1] - a.at[1]);
+            // Into the package frame: the inverse turn.
+            let (x, y) = (dx * c + dy * s, -dx * s + dy * c);
+            x > a.lo[0] && x < a.hi[0] && y > a.lo[1] && y < a.hi[1]
+        };
+        let area = |e: &Extent| (e.hi[0] - e.lo[0]) * (e.hi[1] - e.lo[1]);
+        // Only the larger of two parts can stand over the other.
+        if extents
+            .iter()
+            .any(|b| b.name != a.name && area(b) < area(a) && holds(b.centre))
+        {
+            out.insert(a.name.clone());
+        }
+    }
+    out
+}
+
+/// Whether a circuit part takes part in the layout: it has pads, one of them on a net.
+fn has_connected_pads(circuit: &Circuit, part: &Part) -> bool {
+    circuit
+        .nets
+        .iter()
+        .flat_map(|n| &n.pins)
+        .any(|pin| pin.part == part.name && part.pad(&pin.pad).is_some())
+}
+
+/// Lays the board out in the object (see the module documentation). Elements that are not
+/// circuit parts with a pad on a net (frames, logos, fiducials, mounting holes) are left out
+/// and listed.
+///
+/// # Errors
+/// [`BoardLayoutError`] for refused bottom parts, a board without parts, or a scale or body
+/// height that is not a positive number.
+pub fn layout_board(
+    board: &conduit_eagle::Board,
+    circuit: &Circuit,
+    params: &BoardLayoutParams,
+) -> Result<BoardLayout, BoardLayoutError> {
+    if !(params.scale.is_finite() && params.scale > 0.0) {
+        return Err(BoardLayoutError::BadNumber {
+            what: "--scale",
+            rule: "a number > 0",
+            value: params.scale,
+        });
+    }
+    if !(params.body_height.is_finite() && params.body_height > 0.0) {
+        return Err(BoardLayoutError::BadNumber {
+            what: "--body-height",
+            rule: "a number of mm > 0",
+            value: params.body_height,
+        });
+    }
+    let centre = board_centre(board, circuit);
+    let (s, c) = params.rotate_deg.to_radians().sin_cos();
+    let mut out = BoardLayout {
+        placement: Placement {
+            origin: Origin::Model,
+            ..Placement::default()
+        },
+        sides: BTreeMap::new(),
+        left_out: Vec::new(),
+    };
+    let mut refused = Vec::new();
+    let covering = covering_parts(board, circuit);
+    for e in &board.elements {
+        let Some(part) = circuit.part(&e.name) else {
+            out.left_out
+                .push(format!("{}: not a part of the circuit", e.name));
+            continue;
+        };
+        if part.pads.is_empty() {
+            out.left_out.push(format!("{}: no pads", e.name));
+            continue;
+        }
+        if !has_connected_pads(circuit, part) {
+            out.left_out
+                .push(format!("{}: none of its pads is on a net", e.name));
+            continue;
+        }
+        let (side, z, rotation) = if e.rotation.mirror {
+            let Some(z) = params.bottom_z else {
+                refused.push(e.name.clone());
+                continue;
+            };
+            (Side::Bottom, z, face_up_rotation(part, e.rotation.degrees))
+        } else if let (true, Some(z)) = (covering.contains(&e.name), params.bottom_z) {
+            (Side::Under, z, e.rotation.degrees)
+        } else {
+            (Side::Top, params.top_z, e.rotation.degrees)
+        };
+        let (dx, dy) = (
+            (e.x - centre[0]) * params.scale,
+            (e.y - centre[1]) * params.scale,
+        );
+        out.placement.parts.push(PartPlacement {
+            name: e.name.clone(),
+            x: params.centre[0] + dx * c - dy * s,
+            y: params.centre[1] + dx * s + dy * c,
+            z,
+            rotation: (rotation + params.rotate_deg).rem_euclid(360.0),
+            tilt: [0.0; 2],
+            mirror: false,
+            method: PlacingMethod::Auto,
+            connection: Connection::None,
+            body_height: params.body_height,
+            footprint_height: 0.0,
+            body_size: None,
+            object: 0,
+        });
+        out.sides.insert(e.name.clone(), side);
+    }
+    for part in &circuit.parts {
+        if board.element(&part.name).is_none() && has_connected_pads(circuit, part) {
+            out.left_out
+                .push(format!("{}: in the circuit but not on the board", part.name));
+        }
+    }
+    if !refused.is_empty() {
+        return Err(BoardLayoutError::BottomParts { parts: refused });
+    }
+    if out.placement.parts.is_empty() {
+        return Err(BoardLayoutError::NoParts);
+    }
+    Ok(out)
+}
+
+/// The smallest gap between two pads of different nets on different parts seated on the same
+/// plane, mm, with the two pins (`PART.PAD`); `None` without such a pair. Pads that overlap
+/// count as 0.
+pub fn closest_foreign_pads(
+    circuit: &Circuit,
+    placement: &Placement,
+) -> Option<(f64, String, String)> {
+    let boxes = [BoundingBox {
+        min: [0.0; 3],
+        max: [0.0; 3],
+    }];
+    let parts = place(circuit, placement, &boxes).ok()?;
+    struct Copper<'a> {
+        pin: String,
+        net: Option<&'a str>,
+        part: usize,
+        z: f64,
+        lo: [f64; 2],
+        hi: [f64; 2],
+        outline: &'a crate::geom::Polygon,
+    }
+    let mut pads: Vec<Copper> = Vec::new();
+    for (k, part) in parts.iter().enumerate() {
+        for pad in &part.pads {
+            let pts = pad.outline.points_mm();
+            let mut lo = [f64::INFINITY; 2];
+            let mut hi = [f64::NEG_INFINITY; 2];
+            for p in &pts {
+                for i in 0..2 {
+                    lo[i] = lo[i].min(p[i]);
+                    hi[i] = hi[i].max(p[i]);
+                }
+            }
+            pads.push(Copper {
+                pin: format!("{}.{}", part.name, pad.name),
+                net: pad.net.as_deref(),
+                part: k,
+                z: pad.centre.z,
+                lo,
+                hi,
+                outline: &pad.outline,
+            });
+        }
+    }
+    // Sweep along x: only pads whose boxes come within the best gap so far are measured.
+    pads.sort_by(|a, b| a.lo[0].total_cmp(&b.lo[0]));
+    let mut best: Option<(f64, String, String)> = None;
+    for (i, a) in pads.iter().enumerate() {
+        for b in &pads[i + 1..] {
+            let limit = best.as_ref().map_or(f64::INFINITY, |b| b.0);
+            if b.lo[0] - a.hi[0] > limit {
+                break;
+            }
+            if a.part == b.part || (a.z - b.z).abs() > 1e-6 {
+                continue;
+            }
+            if a.net.is_some() && a.net == b.net {
+                continue;
+            }
+            let box_gap = (b.lo[1] - a.hi[1]).max(a.lo[1] - b.hi[1]);
+            if box_gap > limit {
+                continue;
+            }
+            let overlap = a.outline.points.iter().any(|&p| b.outline.contains(p))
+                || b.outline.points.iter().any(|&p| a.outline.contains(p));
+            let gap = if overlap {
+                0.0
+            } else {
+                super::fit::ring_gap(a.outline, b.outline)
+            };
+            if gap < limit {
+                let (x, y) = if a.pin <= b.pin {
+                    (&a.pin, &b.pin)
+                } else {
+                    (&b.pin, &a.pin)
+                };
+                best = Some((gap, x.clone(), y.clone()));
+            }
+        }
+    }
+    best
+}
+
+/// The smallest gap between the footprints of two parts whose bodies share heights, mm (0
+/// for footprints that overlap), with the two parts' names; `None` without such a pair. Pairs
+/// whose bounding boxes are `limit` or more apart are not measured.
+pub fn closest_parts(
+    circuit: &Circuit,
+    placement: &Placement,
+    limit: f64,
+) -> Option<(f64, String, String)> {
+    let boxes = [BoundingBox {
+        min: [0.0; 3],
+        max: [0.0; 3],
+    }];
+    let parts = place(circuit, placement, &boxes).ok()?;
+    let bounds: Vec<([f64; 2], [f64; 2])> = parts
+        .iter()
+        .map(|p| {
+            let mut lo = [f64::INFINITY; 2];
+            let mut hi = [f64::NEG_INFINITY; 2];
+            for q in p.footprint.points_mm() {
+                for i in 0..2 {
+                    lo[i] = lo[i].min(q[i]);
+                    hi[i] = hi[i].max(q[i]);
+                }
+            }
+            (lo, hi)
+        })
+        .collect();
+    let mut best: Option<(f64, String, String)> = None;
+    for (i, a) in parts.iter().enumerate() {
+        for (j, b) in parts.iter().enumerate().skip(i + 1) {
+            let low = a.position.z.max(b.position.z);
+            let high = (a.position.z + a.body_height).min(b.position.z + b.body_height);
+            if low >= high - 1e-6 {
+                continue;
+            }
+            let (la, ha) = bounds[i];
+            let (lb, hb) = bounds[j];
+            let box_gap = (lb[0] - ha[0])
+                .max(la[0] - hb[0])
+                .max(lb[1] - ha[1])
+                .max(la[1] - hb[1]);
+            let bound = best.as_ref().map_or(limit, |b| b.0.min(limit));
+            if box_gap >= bound {
+                continue;
+            }
+            let overlap = a.footprint.points.iter().any(|&p| b.footprint.contains(p))
+                || b.footprint.points.iter().any(|&p| a.footprint.contains(p));
+            let gap = if overlap {
+                0.0
+            } else {
+                super::fit::ring_gap(&a.footprint, &b.footprint)
+            };
+            if gap < bound {
+                best = Some((gap, a.name.clone(), b.name.clone()));
+            }
+        }
+    }
+    best
+}
+
+/// The room a layout must leave, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Room {
+    /// Between two pads of different nets on different parts: a trace and its clearance on
+    /// both sides.
+    pub trace: f64,
+    /// Between the footprints of two parts at the same heights: both cavities and the wall
+    /// between them.
+    pub parts: f64,
+}
+
+/// The largest scale [`suggest_scale`] tries.
+pub const MAX_SUGGESTED_SCALE: f64 = 10.0;
+
+/// The smallest scale, in steps of 0.05 from 1 up to [`MAX_SUGGESTED_SCALE`], at which every
+/// pair of pads of different nets on different parts is `room.trace` apart and every pair of
+/// parts at the same heights `room.parts`, with the board laid out by `params` otherwise;
+/// `None` when even the largest does not do it.
+pub fn suggest_scale(
+    board: &conduit_eagle::Board,
+    circuit: &Circuit,
+    params: &BoardLayoutParams,
+    room: Room,
+) -> Option<f64> {
+    let steps = ((MAX_SUGGESTED_SCALE - 1.0) / 0.05).round() as usize;
+    (0..=steps).map(|k| 1.0 + k as f64 * 0.05).find(|&scale| {
+        let at = BoardLayoutParams { scale, ..*params };
+        layout_board(board, circuit, &at).is_ok_and(|l| {
+            closest_foreign_pads(circuit, &l.placement)
+                .is_none_or(|(gap, _, _)| gap >= room.trace - 1e-9)
+                && closest_parts(circuit, &l.placement, room.parts)
+                    .is_none_or(|(gap, _, _)| gap >= room.parts - 1e-9)
+        })
+    })
+}

@@ -1,0 +1,321 @@
+//! The `conduit place` walk: a placement written for a circuit and a model, from an EAGLE
+//! board's layout or packed automatically, and checked against the model's solid.
+//!
+//! Place in the pipeline: before the electronics line — its result is the `--placement` the
+//! other walks read. The model is put on the bed and sliced as `slice` would (so the checks
+//! see the layers the print has), the layout is made in model coordinates
+//! (`origin = "model"`), written as TOML, read back, placed by
+//! [`crate::circuit::stage::place_circuit`] and checked by
+//! [`crate::circuit::fit::placement_problems`].
+
+use crate::circuit::board_layout::{
+    BoardLayoutError, BoardLayoutParams, Room, Side, closest_foreign_pads, layout_board,
+    suggest_scale,
+};
+use crate::circuit::fit::{FitParams, placement_problems};
+use crate::circuit::placement_toml::placement_toml;
+use crate::circuit::stage::place_circuit;
+use crate::circuit::{Circuit, Electronics, Placement, PlacementError};
+use crate::config::Config;
+use crate::geom::{BoundingBox, ExPolygon};
+use crate::scene::Scene;
+use crate::slice::{LayerZ, SliceParams, slice_mesh};
+
+use super::{PipelineError, model_bboxes, place_on_bed_with_offsets};
+
+/// Where the top parts' seating plane goes (model coordinates).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PlaneChoice {
+    /// Under the model's top by the body height and `route.wall_clearance` of cover.
+    UnderTop,
+    /// At this z.
+    At(f64),
+    /// This far below the model's top.
+    FromTop(f64),
+}
+
+/// What happens to a board's bottom-side parts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BottomChoice {
+    /// Face up on a plane below the top parts: at this z, or (`None`) under the top plane by
+    /// the body height and `route.wall_clearance`.
+    Below(Option<f64>),
+    /// Refused.
+    Refuse,
+}
+
+/// How `conduit place --from-brd` lays a board out.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FromBoard {
+    /// Where the board's centre goes (x, y, model coordinates); the model's bounding-box
+    /// centre when `None`.
+    pub at: Option<[f64; 2]>,
+    /// Turn of the layout about the board's centre, degrees counter-clockwise.
+    pub rotate_deg: f64,
+    /// Spread of the layout (distances between parts multiplied).
+    pub scale: f64,
+    /// The top parts' plane.
+    pub plane: PlaneChoice,
+    /// The bottom parts.
+    pub bottom: BottomChoice,
+    /// Every part's body height, mm.
+    pub body_height: f64,
+}
+
+/// A placement made by `conduit place`, with what the checks found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaceOutcome {
+    /// The placement as written.
+    pub placement: Placement,
+    /// Its TOML text.
+    pub toml: String,
+    /// Problems a print cannot have: parts outside the solid, reaching into another part's
+    /// cavity (each names the part and a distance).
+    pub problems: Vec<String>,
+    /// Thin material between cavities and the surface or each other.
+    pub notes: Vec<String>,
+    /// Board elements or circuit parts not placed, with the reason.
+    pub left_out: Vec<String>,
+    /// The seating planes used, model z, top first.
+    pub planes: Vec<f64>,
+    /// The smallest gap between pads of different nets on different parts, with the pins.
+    pub closest_pads: Option<(f64, String, String)>,
+    /// The room wanted between pads and between parts.
+    pub room: Room,
+    /// For a board layout: the smallest scale giving every pad pair and every part pair its
+    /// room.
+    pub suggested_scale: Option<f64>,
+}
+
+/// Why no placement could be made.
+#[derive(Debug, thiserror::Error)]
+pub enum PlaceError {
+    /// The model could not be put on the bed or sliced.
+    #[error(transparent)]
+    Pipeline(#[from] PipelineError),
+    /// The board cannot be laid out.
+    #[error(transparent)]
+    Board(#[from] BoardLayoutError),
+    /// The placement made does not read back or place (a bug, or a circuit the board does not
+    /// match).
+    #[error(transparent)]
+    Placement(#[from] PlacementError),
+    /// A seating plane outside the model's height.
+    #[error(
+        "the seating plane z {z:.3} mm is outside the model, which spans z {low:.3} to {high:.3} mm"
+    )]
+    PlaneOutside {
+        /// The plane.
+        z: f64,
+        /// The model's bottom.
+        low: f64,
+        /// The model's top.
+        high: f64,
+    },
+}
+
+/// The model as the checks see it: object 0 on the bed, sliced.
+struct Solid {
+    /// Model-space bounding box of object 0.
+    bbox: BoundingBox,
+    /// Object 0's move from model to bed coordinates.
+    offset: [f64; 3],
+    /// Model-space bounding boxes of every object (the placement frame).
+    bboxes: Vec<BoundingBox>,
+    /// Every object's move to the bed.
+    offsets: Vec<[f64; 3]>,
+    /// Object 0's layers (bed coordinates) and their islands.
+    zs: Vec<LayerZ>,
+    islands: Vec<Vec<ExPolygon>>,
+}
+
+impl Solid {
+    fn of(scene: &Scene, cfg: &Config) -> Result<Self, PipelineError> {
+        if scene.triangle_count() == 0 {
+            return Err(PipelineError::EmptyScene);
+        }
+        let bboxes = model_bboxes(scene);
+        let (meshes, offsets) = place_on_bed_with_offsets(scene, cfg);
+        let params = SliceParams::new(cfg.slice.layer_height, cfg.slice.first_layer_height)?;
+        let (layers, _) = slice_mesh(&meshes[0], &params);
+        Ok(Self {
+            bbox: bboxes[0],
+            offset: offsets[0],
+            zs: layers.iter().map(|l| l.z).collect(),
+            islands: layers.into_iter().map(|l| l.islands).collect(),
+            bboxes,
+            offsets,
+        })
+    }
+
+    /// The model z of the top of the layer nearest to `z` (a seating plane sits on a layer's
+    /// top), within the model.
+    fn snap(&self, z: f64) -> f64 {
+        self.zs
+            .iter()
+            .map(|l| l.top - self.offset[2])
+            .min_by(|a, b| (a - z).abs().total_cmp(&(b - z).abs()))
+            .unwrap_or(z)
+    }
+
+    fn check_plane(&self, z: f64) -> Result<(), PlaceError> {
+        let (low, high) = (self.bbox.min[2], self.bbox.max[2]);
+        if !(z.is_finite() && z >= low - 1e-9 && z <= high + 1e-9) {
+            return Err(PlaceError::PlaneOutside { z, low, high });
+        }
+        Ok(())
+    }
+}
+
+/// Lays `board` out in object 0 of `scene` for `circuit` (see
+/// [`crate::circuit::board_layout`]), writes the placement and checks it. `source` is the
+/// circuit file the placement names.
+///
+/// # Errors
+/// [`PlaceError`] when the model cannot be sliced, a plane is outside the model, or the board
+/// cannot be laid out; problems with the layout itself are in the outcome.
+pub fn place_from_board(
+    scene: &Scene,
+    cfg: &Config,
+    circuit: &Circuit,
+    board: &conduit_eagle::Board,
+    how: &FromBoard,
+    source: Option<String>,
+) -> Result<PlaceOutcome, PlaceError> {
+    let solid = Solid::of(scene, cfg)?;
+    let b = &solid.bbox;
+    let cover = how.body_height + cfg.route.wall_clearance;
+    let top_z = match how.plane {
+        PlaneChoice::UnderTop => solid.snap(b.max[2] - cover),
+        PlaneChoice::At(z) => z,
+        PlaneChoice::FromTop(d) => b.max[2] - d,
+    };
+    solid.check_plane(top_z)?;
+    let bottom_z = match how.bottom {
+        BottomChoice::Refuse => None,
+        BottomChoice::Below(Some(z)) => Some(z),
+        BottomChoice::Below(None) => Some(solid.snap(top_z - cover)),
+    };
+
+    let params = BoardLayoutParams {
+        centre: how
+            .at
+            .unwrap_or([(b.min[0] + b.max[0]) / 2.0, (b.min[1] + b.max[1]) / 2.0]),
+        rotate_deg: how.rotate_deg,
+        scale: how.scale,
+        top_z,
+        bottom_z,
+        body_height: how.body_height,
+    };
+    let mut layout = layout_board(board, circuit, &params)?;
+    if let (true, Some(z)) = (layout.sides.values().any(|s| *s != Side::Top), bottom_z) {
+        solid.check_plane(z)?;
+    }
+    layout.placement.source = source;
+    let room = room(cfg);
+    let suggested_scale = suggest_scale(board, circuit, &params, room);
+    let header = vec![
+        format!(
+            "Board layout: centre at x {:.3}, y {:.3} mm, turned {} deg, scale {}; edit freely.",
+            params.centre[0],
+            params.centre[1],
+            crate::circuit::placement_toml::toml_number(params.rotate_deg),
+            crate::circuit::placement_toml::toml_number(params.scale),
+        ),
+        "z is the seating plane (the bottom of the part, where its pads are); rotation is \
+         degrees counter-clockwise seen from above."
+            .to_owned(),
+        "body_height is a guess (a board file has none): measure your parts.".to_owned(),
+    ];
+    let sides = layout.sides.clone();
+    let describe = |name: &str| {
+        let part = circuit.part(name)?;
+        let side = match sides.get(name) {
+            Some(Side::Bottom) => "bottom side, placed face up below the top parts",
+            Some(Side::Under) => "top side, below the parts its pads surround",
+            _ => "top side",
+        };
+        Some(describe_part(part, side))
+    };
+    let toml = placement_toml(&layout.placement, &header, describe);
+    let mut planes = vec![top_z];
+    if sides.values().any(|s| *s != Side::Top)
+        && let Some(z) = bottom_z
+    {
+        planes.push(z);
+    }
+    let mut outcome = check(&solid, cfg, circuit, toml, planes)?;
+    outcome.left_out = layout.left_out;
+    outcome.suggested_scale = suggested_scale;
+    Ok(outcome)
+}
+
+/// The room a trace needs between two pads of different nets (`route.conductive_width` and
+/// `route.channel_extra` on each side) and two parts need between their footprints (both
+/// `route.cavity_offset`s and `route.wall_clearance`).
+fn room(cfg: &Config) -> Room {
+    let r = &cfg.route;
+    Room {
+        trace: r.conductive_width + 2.0 * r.channel_extra,
+        parts: 2.0 * r.cavity_offset + r.wall_clearance,
+    }
+}
+
+/// `R1: 10k, package 0603` and the side.
+fn describe_part(part: &crate::circuit::Part, side: &str) -> String {
+    let mut s = part.name.clone();
+    s.push(':');
+    if let Some(v) = part.value.as_deref().filter(|v| !v.is_empty()) {
+        s.push_str(&format!(" {v},"));
+    }
+    s.push_str(&format!(" package {}, {} pads, {side}", part.package, part.pads.len()));
+    s
+}
+
+/// Reads `toml` back, places it and checks it against the solid.
+fn check(
+    solid: &Solid,
+    cfg: &Config,
+    circuit: &Circuit,
+    toml: String,
+    planes: Vec<f64>,
+) -> Result<PlaceOutcome, PlaceError> {
+    let placement = Placement::from_toml(&toml)?;
+    let electronics = Electronics {
+        circuit: circuit.clone(),
+        placement: placement.clone(),
+    };
+    let placed = place_circuit(
+        &electronics,
+        &solid.bboxes,
+        &solid.offsets,
+        &cfg.electronics_params(),
+    )
+    .map_err(|e| match e {
+        crate::circuit::ElectronicsError::Placement(p) => PlaceError::Placement(p),
+        other => PlaceError::Pipeline(PipelineError::Electronics(other)),
+    })?;
+    let mine: Vec<&crate::circuit::PlacedPart> =
+        placed.parts.iter().filter(|p| p.object == 0).collect();
+    let found = placement_problems(
+        &mine,
+        &solid.islands,
+        &solid.zs,
+        FitParams {
+            cavity_offset: cfg.route.cavity_offset,
+            wall_clearance: cfg.route.wall_clearance,
+        },
+    );
+    let closest_pads = closest_foreign_pads(circuit, &placement);
+    Ok(PlaceOutcome {
+        placement,
+        toml,
+        problems: found.problems,
+        notes: found.notes,
+        left_out: Vec::new(),
+        planes,
+        closest_pads,
+        room: room(cfg),
+        suggested_scale: None,
+    })
+}
