@@ -111,6 +111,7 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
             },
             "parts": o.placement.parts.len(),
             "planes": o.planes,
+            "span_mm": o.span,
             "problems": o.problems,
             "notes": o.notes,
             "left_out": o.left_out,
@@ -121,9 +122,11 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
     }
     let planes: Vec<String> = o.planes.iter().map(|z| format!("z {z:.3} mm")).collect();
     outln!(
-        "{}: {} parts {from}, seated on {}",
+        "{}: {} parts {from}, {:.1} × {:.1} mm, seated on {}",
         args.output.display(),
         o.placement.parts.len(),
+        o.span[0],
+        o.span[1],
         planes.join(" (top) and ") + if o.planes.len() > 1 { " (lower)" } else { "" }
     )?;
     if let Some((gap, a, b)) = &o.closest_pads {

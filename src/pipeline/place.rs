@@ -76,6 +76,8 @@ pub struct PlaceOutcome {
     pub notes: Vec<String>,
     /// Board elements or circuit parts not placed, with the reason.
     pub left_out: Vec<String>,
+    /// Width and depth of the parts' footprints together, mm (the model must be larger).
+    pub span: [f64; 2],
     /// The seating planes used, model z, top first.
     pub planes: Vec<f64>,
     /// The smallest gap between pads of different nets on different parts, with the pins.
@@ -153,7 +155,8 @@ impl Solid {
     fn snap(&self, z: f64) -> f64 {
         self.zs
             .iter()
-            .map(|l| l.top - self.offset[2])
+            // To the nanometre: a layer top is a sum of layer heights.
+            .map(|l| ((l.top - self.offset[2]) * 1e6).round() / 1e6)
             .min_by(|a, b| (a - z).abs().total_cmp(&(b - z).abs()))
             .unwrap_or(z)
     }
@@ -307,12 +310,26 @@ fn check(
         },
     );
     let closest_pads = closest_foreign_pads(circuit, &placement);
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for p in mine.iter().flat_map(|p| p.footprint.points_mm()) {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let span = if mine.is_empty() {
+        [0.0; 2]
+    } else {
+        [hi[0] - lo[0], hi[1] - lo[1]]
+    };
     Ok(PlaceOutcome {
         placement,
         toml,
         problems: found.problems,
         notes: found.notes,
         left_out: Vec::new(),
+        span,
         planes,
         closest_pads,
         room: room(cfg),

@@ -1,0 +1,195 @@
+//! `conduit place --from-brd`: the corpus boards' layouts moved into a block, checked, and
+//! sliced; the layout's geometry against the board file; the refusals.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use conduit::geom::{Point3, Transform};
+use conduit::mesh::Mesh;
+use conduit::scene::{MeshFormat, Scene, SceneObject, save};
+use serde_json::Value;
+
+use crate::support::{conduit, corpus, stderr, stdout, temp_dir};
+
+/// The `.brd` of corpus board `name` (`eagle/<name>/*/*.brd`).
+fn board_file(corpus: &Path, name: &str) -> PathBuf {
+    let dir = corpus.join("eagle").join(name);
+    let mut found: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("board folder")
+        .flat_map(|e| std::fs::read_dir(e.expect("entry").path()).into_iter().flatten())
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "brd"))
+        .collect();
+    assert_eq!(found.len(), 1, "one .brd under {}", dir.display());
+    found.remove(0)
+}
+
+/// A block `size` mm with its bottom centre at the origin, written as STL.
+fn block(dir: &Path, name: &str, size: [f64; 3]) -> PathBuf {
+    let mesh = Mesh::cuboid(
+        name,
+        Point3::new(-size[0] / 2.0, -size[1] / 2.0, 0.0),
+        Point3::new(size[0] / 2.0, size[1] / 2.0, size[2]),
+    );
+    let scene = Scene {
+        objects: vec![SceneObject {
+            name: name.into(),
+            mesh,
+            transform: Transform::identity(),
+            tool: None,
+        }],
+    };
+    let path = dir.join(format!("{name}.stl"));
+    save(&scene, &path, MeshFormat::Stl).expect("block written");
+    path
+}
+
+/// Runs `conduit place --json` with `args`; the exit code and the summary.
+fn place(args: &[&std::ffi::OsStr]) -> (Option<i32>, Value, String) {
+    let mut all: Vec<&std::ffi::OsStr> = vec!["place".as_ref(), "--json".as_ref()];
+    all.extend_from_slice(args);
+    let o = conduit(all);
+    let summary = serde_json::from_str(&stdout(&o)).unwrap_or(Value::Null);
+    (o.status.code(), summary, stderr(&o))
+}
+
+/// The parts of a placement TOML by name: (x, y, z, rotation).
+fn parts(toml_path: &Path) -> BTreeMap<String, [f64; 4]> {
+    let text = std::fs::read_to_string(toml_path).expect("placement written");
+    let p = conduit::circuit::Placement::from_toml(&text).expect("placement reads back");
+    p.parts
+        .iter()
+        .map(|q| (q.name.clone(), [q.x, q.y, q.z, q.rotation]))
+        .collect()
+}
+
+/// Every corpus board with a readable `.brd`: laid out at the scale the first run suggests in
+/// a block the layout fits, the placement passes its checks (exit 0), holds every part with a
+/// pad on a net (bottom-side parts on the lower plane, face up), and slices.
+#[test]
+fn every_corpus_board_is_placed_from_its_board_and_slices() {
+    let Some(corpus) = corpus() else {
+        return;
+    };
+    let dir = temp_dir();
+    let d = dir.path();
+    for name in [
+        "LilyPad_Vibe_Board",
+        "LilyPad_Tri-Color_LED",
+        "OpenLog",
+        "Serial7SegmentDisplay",
+        "RedBot",
+    ] {
+        let brd = board_file(&corpus, name);
+        let probe = block(d, "probe", [400.0, 400.0, 8.0]);
+        let out = d.join(format!("{name}.toml"));
+        let (_, first, err) = place(&[
+            "--model".as_ref(),
+            probe.as_os_str(),
+            "--from-brd".as_ref(),
+            brd.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ]);
+        let scale = first["suggested_scale"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{name}: no scale suggested: {first} {err}"));
+        // The layout at that scale, its span read from a probe run, in a block 6 mm larger.
+        let s = format!("{scale}");
+        let (_, sized, err) = place(&[
+            "--model".as_ref(),
+            probe.as_os_str(),
+            "--from-brd".as_ref(),
+            brd.as_os_str(),
+            "--scale".as_ref(),
+            s.as_ref(),
+            "--at".as_ref(),
+            "0,0".as_ref(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ]);
+        let span = [
+            sized["span_mm"][0].as_f64().unwrap_or_else(|| panic!("{name}: {sized} {err}")),
+            sized["span_mm"][1].as_f64().expect("span"),
+        ];
+        let model = block(d, name, [span[0] + 12.0, span[1] + 12.0, 8.0]);
+        let (code, summary, err) = place(&[
+            "--model".as_ref(),
+            model.as_os_str(),
+            "--from-brd".as_ref(),
+            brd.as_os_str(),
+            "--scale".as_ref(),
+            s.as_ref(),
+            "--at".as_ref(),
+            "0,0".as_ref(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ]);
+        assert_eq!(code, Some(0), "{name}: {summary} {err}");
+        assert_eq!(summary["problems"], Value::Array(Vec::new()), "{name}");
+        let placed = parts(&out);
+        assert_eq!(
+            placed.len() as u64,
+            summary["parts"].as_u64().expect("parts"),
+            "{name}"
+        );
+        // Every element left out is one without a pad on a net; every other is placed.
+        let board = conduit_eagle::read_board(&std::fs::read(&brd).expect("brd")).expect("brd");
+        let left: Vec<&str> = summary["left_out"]
+            .as_array()
+            .expect("left_out")
+            .iter()
+            .map(|l| l.as_str().expect("line"))
+            .collect();
+        for e in &board.elements {
+            let listed = left.iter().any(|l| l.starts_with(&format!("{}: ", e.name)));
+            assert_ne!(placed.contains_key(&e.name), listed, "{name}: {}", e.name);
+        }
+        // Two planes when the board has bottom-side parts; those sit on the lower one.
+        let planes: Vec<f64> = summary["planes"]
+            .as_array()
+            .expect("planes")
+            .iter()
+            .map(|z| z.as_f64().expect("z"))
+            .collect();
+        for e in board.elements.iter().filter(|e| e.rotation.mirror) {
+            if let Some(p) = placed.get(&e.name) {
+                assert_eq!(planes.len(), 2, "{name}");
+                assert!((p[2] - planes[1]).abs() < 1e-9, "{name}: {} at {}", e.name, p[2]);
+            }
+        }
+        // And it slices: the placement matches the circuit and the block. (A coarse, short
+        // search: how well the boards route is the business of `electronics_corpus`.)
+        let gcode = d.join(format!("{name}.gcode"));
+        let o = conduit([
+            "slice".as_ref(),
+            model.as_os_str(),
+            "--circuit".as_ref(),
+            brd.as_os_str(),
+            "--placement".as_ref(),
+            out.as_os_str(),
+            "-o".as_ref(),
+            gcode.as_os_str(),
+            "--allow-unrouted".as_ref(),
+            "--set".as_ref(),
+            "route.rip_up_rounds=0".as_ref(),
+            "--set".as_ref(),
+            "route.conductive_width=0.4".as_ref(),
+            "--set".as_ref(),
+            "route.grid_step=3".as_ref(),
+            "--set".as_ref(),
+            "route.max_detour=1.5".as_ref(),
+            "--set".as_ref(),
+            "route.detour_slack=5".as_ref(),
+            "-q".as_ref(),
+        ]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        assert!(gcode.exists(), "{name}");
+        println!(
+            "{name}: {} parts at scale {scale}, {:.0} × {:.0} mm, planes {planes:?}",
+            placed.len(),
+            span[0],
+            span[1]
+        );
+    }
+}
