@@ -23,6 +23,7 @@ mod jet;
 mod outputs;
 mod postprocess;
 mod postprocess_e2e;
+mod postprocess_octopnp;
 mod preview;
 mod regressions_conform;
 mod regressions_route;
