@@ -7,9 +7,9 @@
 //! on the host's layers ([`crate::postprocess::plan_circuit`], the electronics stage of
 //! `conduit slice`) → **rewrite** the file for the plan ([`crate::postprocess::rewrite()`],
 //! with OctoPNP's part description and the summary lines of [`edit_circuit`]) → **report**
-//! ([`HostPrint::report`]). [`edit`]
-//! and [`edit_circuit`] run plan and rewrite with the parameters of one [`Config`]; the stages
-//! themselves live in [`crate::postprocess`] and never see the config.
+//! ([`HostPrint::report`]). [`edit`] and [`edit_circuit`] run plan and rewrite with the
+//! parameters of one [`Config`]; the stages themselves live in [`crate::postprocess`] and never
+//! see the config.
 
 use conduit_gcode::Gcode;
 
