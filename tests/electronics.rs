@@ -2,7 +2,7 @@
 
 use conduit_gcode::{Firmware, Machine};
 
-use crate::support::{conduit, sample, stderr, temp_dir, xyz};
+use crate::support::{conduit, octopnp_description, sample, stderr, temp_dir, xyz};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -545,28 +545,12 @@ fn the_gcode_carries_octopnps_part_description_for_every_machine_placed_part() {
     let text = std::fs::read_to_string(&out).expect("G-code");
     // OctoPNP's reader: from every line, the text from its first `<` to its last `>`, joined;
     // wrapped in an <object> unless the first such line opens one.
-    let mut xml = String::new();
-    for line in text.lines() {
-        if let (Some(a), Some(b)) = (line.find('<'), line.rfind('>')) {
-            if a < b {
-                xml.push_str(&line[a..=b]);
-                xml.push('\n');
-            }
-        }
-    }
+    let (xml, root) = octopnp_description(&text);
     assert!(
         xml.lines().next().is_some_and(|l| l.starts_with("<object")),
         "{xml}"
     );
-    let options = conduit_xml::Options {
-        names: conduit_xml::Names::Qualified,
-        entities: conduit_xml::Entities::Strict,
-        depth_check: conduit_xml::DepthCheck::BeforeAttributes,
-        max_depth: 16,
-    };
-    let root = conduit_xml::parse(xml.as_bytes(), &options)
-        .expect("well-formed XML")
-        .expect("a root element");
+    let root = root.expect("well-formed XML with a root element");
     assert_eq!(root.name, "object");
     // Every M361 P<id> has its part, with OctoPNP's required fields as numbers.
     let ids: Vec<String> = text

@@ -547,6 +547,9 @@ fn circuit_is_built_into_every_peer_cube() {
         parts.sort_unstable();
         assert_eq!(parts, vec!["J1", "LED1", "R1"], "{name}");
         assert_eq!(report.blocks, 4, "{name}");
+        // OctoPNP's part description: the one part placed by the machine.
+        assert_eq!(report.described_parts, ["LED1"], "{name}");
+        assert_eq!(report.description_lines, 19, "{name}");
         assert_eq!(report.summary_lines, 5, "{name}");
         assert!(report.replaced_lines.len() >= 15, "{name}: {report:?}");
         assert!(report.moves_tested > 100, "{name}: {report:?}");

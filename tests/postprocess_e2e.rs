@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use crate::postprocess::check_postprocessed;
-use crate::support::{conduit, root, sample, stderr, temp_dir};
+use crate::support::{conduit, octopnp_description, root, sample, stderr, temp_dir};
 
 /// PrusaSlicer settings for the tests: 0.2 mm layers, 0.4 mm nozzle, 0.45 mm lines, two
 /// perimeters, 20 % infill, no skirt; everything else is PrusaSlicer's default.
@@ -128,6 +128,13 @@ fn prusaslicer_runs_conduit_as_its_post_processing_script() {
     );
     let check = conduit(["check".as_ref(), edited.as_os_str()]);
     assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
+    // OctoPNP's part description names the print by its output name, not by the temporary
+    // file PrusaSlicer hands the script, and describes the part placed by the machine.
+    assert_eq!(report.described_parts, ["LED1"]);
+    let text = std::fs::read_to_string(&edited).expect("text");
+    let (xml, root) = octopnp_description(&text);
+    let root = root.unwrap_or_else(|| panic!("OctoPNP cannot parse {xml}"));
+    assert_eq!(root.attr("name"), Some("edited"));
 }
 
 #[test]

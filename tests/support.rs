@@ -102,3 +102,35 @@ pub fn write_stl(path: &Path, tris: &[[conduit::geom::Point3; 3]]) {
 pub fn xyz(p: conduit_gcode::Position) -> [f64; 3] {
     p.map(|c| c.unwrap_or(0.0))
 }
+
+/// OctoPNP's part description read from a G-code text the way OctoPNP reads it: from every line,
+/// the text from its first `<` to its last `>`, joined with newlines, parsed as XML. Returns the
+/// collected text and its root element, or `None` when the text is not well-formed XML with a
+/// root.
+pub fn octopnp_description(gcode: &str) -> (String, Option<conduit_xml::Node>) {
+    let mut xml = String::new();
+    for line in gcode.lines() {
+        if let (Some(a), Some(b)) = (line.find('<'), line.rfind('>')) {
+            if a < b {
+                xml.push_str(&line[a..=b]);
+                xml.push('\n');
+            }
+        }
+    }
+    let options = conduit_xml::Options {
+        names: conduit_xml::Names::Qualified,
+        entities: conduit_xml::Entities::Strict,
+        depth_check: conduit_xml::DepthCheck::BeforeAttributes,
+        max_depth: 16,
+    };
+    let root = conduit_xml::parse(xml.as_bytes(), &options).ok().flatten();
+    (xml, root)
+}
+
+/// A numeric attribute of an XML element, panicking with `what` when it is missing or not a
+/// number.
+pub fn xml_number(node: &conduit_xml::Node, key: &str, what: &str) -> f64 {
+    node.attr(key)
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{what}: {key} is not a number"))
+}

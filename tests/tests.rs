@@ -24,6 +24,7 @@ mod outputs;
 mod place;
 mod postprocess;
 mod postprocess_e2e;
+mod postprocess_octopnp;
 mod preview;
 mod regressions_conform;
 mod regressions_route;

@@ -2,11 +2,15 @@
 //! lines of a G-code file to answer `M361 P<id>` (which tray box to pick from, how tall the
 //! part is, its outline and pads for the camera alignment, and where it goes).
 //!
-//! Place in the pipeline: written by the slice walk after the G-code, from the placed parts
-//! (bed coordinates) and the circuit's packages. OctoPNP collects the text between the first
-//! `<` and the last `>` of *every* line of the file, so the block is the only text of the file
-//! in angle brackets; it starts with the `<object>` root, as OctoPNP expects on the first line
-//! it collects.
+//! Place in the pipeline: written from the placed parts (bed coordinates) and the circuit's
+//! packages by the slice walk, after the G-code, and by the post-processing walk inside the
+//! host's rewritten file, after the last layer's last extrusion and before the host's end
+//! G-code (`crate::postprocess::rewrite`), so that every line of the host stays where it was.
+//! OctoPNP collects the text between the first `<` and the last `>` of *every* line of the file
+//! ([`collected`]), so the block must be the only text of the file in angle brackets; it starts
+//! with the `<object>` root, as OctoPNP expects on the first line it collects. conduit writes no
+//! other such text; a host's own lines may (PrusaSlicer's settings at the end of its file hold
+//! the custom G-code templates), and post-processing warns when they do.
 //!
 //! Per part the machine places (`method = "auto"`), in placement order:
 //! `<part id name>` with `id` the number its `M361 P<id>` event carries, `<position box>` the
@@ -87,6 +91,20 @@ fn package_outline(part: &PlacedPart) -> Vec<[f64; 2]> {
             [mirror * (dx * c - dy * s), dx * s + dy * c]
         })
         .collect()
+}
+
+/// What OctoPNP collects from one line of a G-code file: the text from its first `<` to its
+/// last `>`, or `None` when the line has no `>` after a `<`.
+///
+/// ```
+/// use conduit::circuit::octopnp::collected;
+/// assert_eq!(collected(b";<size height=\"1\"/>"), Some(&b"<size height=\"1\"/>"[..]));
+/// assert_eq!(collected(b"; end_gcode = {if max_layer_z < max_print_height}G1 Z5{endif}"), None);
+/// ```
+pub fn collected(line: &[u8]) -> Option<&[u8]> {
+    let first = line.iter().position(|&b| b == b'<')?;
+    let last = line.iter().rposition(|&b| b == b'>')?;
+    line.get(first..=last).filter(|_| first < last)
 }
 
 /// A number with up to 4 decimals (trailing zeros dropped), `-0` as `0`.

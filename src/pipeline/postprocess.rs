@@ -6,13 +6,15 @@
 //! one — and its layers rebuilt with the config's flavour and filament) → **plan** the circuit
 //! on the host's layers ([`crate::postprocess::plan_circuit`], the electronics stage of
 //! `conduit slice`) → **rewrite** the file for the plan ([`crate::postprocess::rewrite()`],
-//! with the summary lines of [`edit_circuit`]) → **report** ([`HostPrint::report`]). [`edit`]
-//! and [`edit_circuit`] run plan and rewrite with the parameters of one [`Config`]; the stages
-//! themselves live in [`crate::postprocess`] and never see the config.
+//! with OctoPNP's part description and the summary lines of [`edit_circuit`]) → **report**
+//! ([`HostPrint::report`]). [`edit`] and [`edit_circuit`] run plan and rewrite with the
+//! parameters of one [`Config`]; the stages themselves live in [`crate::postprocess`] and never
+//! see the config.
 
 use conduit_gcode::Gcode;
 
 use crate::circuit::Electronics;
+use crate::circuit::octopnp::{collected, octopnp_block};
 use crate::config::{Config, ConfigError, HostSettings, SettingSource};
 use crate::postprocess::{
     CircuitPlan, HostInfo, HostLayers, LayerParams, PostprocessError, PostprocessReport,
@@ -125,8 +127,10 @@ pub struct CircuitEdit {
 
 /// Builds `electronics` into `gcode`: plans the circuit on the host's layers
 /// ([`plan_circuit`], with [`Config::electronics_params`]) and rewrites the file for it
-/// ([`rewrite()`], with [`Config::gcode_params`]). The result is the same for the same inputs,
-/// byte for byte.
+/// ([`rewrite()`], with [`Config::gcode_params`]), OctoPNP's part description of the parts
+/// placed by the machine included (named by [`object_name`]; with a warning in the plan's
+/// report when host lines hold text OctoPNP would read with it). The result is the same for
+/// the same inputs, byte for byte.
 ///
 /// # Errors
 /// [`PostprocessError::Electronics`] when the placement does not fit the circuit or the config
@@ -139,19 +143,68 @@ pub fn edit_circuit(
     electronics: &Electronics,
     config: &Config,
 ) -> Result<CircuitEdit, PostprocessError> {
-    let plan = plan_circuit(&print.layers, electronics, &config.electronics_params())?;
+    let mut plan = plan_circuit(&print.layers, electronics, &config.electronics_params())?;
+    let description = octopnp_block(&electronics.circuit, &plan.parts, &object_name(print));
+    if !description.is_empty() {
+        plan.report.warnings.extend(angle_bracket_warning(gcode));
+    }
     let mut summary = Vec::new();
     let writer = config.gcode_params();
-    let (gcode, stats) = rewrite(gcode, &print.layers, &plan, &writer, |stats| {
-        summary = summary_lines(&plan, stats, electronics, config);
-        summary.clone()
-    })?;
+    let (gcode, stats) = rewrite(
+        gcode,
+        &print.layers,
+        &plan,
+        &writer,
+        &description,
+        |stats| {
+            summary = summary_lines(&plan, stats, electronics, config);
+            summary.clone()
+        },
+    )?;
     Ok(CircuitEdit {
         gcode,
         plan,
         stats,
         summary,
     })
+}
+
+/// The name of the `<object>` of OctoPNP's part description: the file stem of the name the
+/// host gives its output (PrusaSlicer's and its descendants' `SLIC3R_PP_OUTPUT_NAME`, such as
+/// `cube_0.2mm_PLA_1h` for `/home/user/cube_0.2mm_PLA_1h.gcode`), else `object`. Never the
+/// name of the file being edited: PrusaSlicer hands the script a temporary file
+/// (`*.gcode.pp`), so the description would change with every export.
+pub fn object_name(print: &HostPrint) -> String {
+    print
+        .settings
+        .output_name()
+        .and_then(|name| std::path::Path::new(name).file_stem())
+        .map(|stem| stem.to_string_lossy().into_owned())
+        .filter(|stem| !stem.trim().is_empty())
+        .unwrap_or_else(|| "object".to_owned())
+}
+
+/// The warning for host lines that OctoPNP would collect with its part description (text
+/// between `<` and a later `>`; see [`collected`]), such as a custom G-code template with a
+/// comparison written into PrusaSlicer's settings at the end of its file: OctoPNP reads them
+/// into the description and cannot parse it. The host's lines are never changed, so the user
+/// is told which line to take out of the host's settings; `None` when there is none.
+fn angle_bracket_warning(gcode: &Gcode) -> Option<String> {
+    let mut lines = gcode
+        .lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| collected(&l.text).is_some())
+        .map(|(i, _)| i + 1);
+    let first = lines.next()?;
+    let which = match lines.count() {
+        0 => format!("the host's line {first} holds"),
+        n => format!("the host's lines {first} and {n} more hold"),
+    };
+    Some(format!(
+        "{which} text in angle brackets, which OctoPNP reads with its part description and \
+         then cannot parse it; take it out of the host's custom G-code or settings"
+    ))
 }
 
 /// The summary block: one `; conduit postprocess: ...` line per item. No line holds ` = `, so

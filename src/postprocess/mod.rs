@@ -23,10 +23,12 @@
 //!    host layer.
 //! 7. [`rewrite`] (with [`cut`]): the file edited for the plan — extrusion removed from
 //!    cavities and channels with E kept exact, traces and part events inserted at layer ends in
-//!    the host's own retraction style, a summary at the top; every other line untouched.
+//!    the host's own retraction style, OctoPNP's part description of the parts placed by the
+//!    machine after the last layer's last extrusion (before the host's end G-code), a summary at
+//!    the top; every other line untouched.
 //! 8. [`verify`]: an independent check of an edited file against the host's original (lines
 //!    kept in order, no plastic left in a cavity, traces on the conductive tool, parts placed
-//!    after their cavities are done, `conduit check` clean).
+//!    after their cavities are done, OctoPNP's part description right, `conduit check` clean).
 //! 9. [`report`]: what was found and done, for `--report` and the one-line summary.
 //!
 //! The post-processing walk (`crate::pipeline::postprocess`: the host's print read with its

@@ -34,6 +34,15 @@
 //! happened. The host's latest feature and width comments are repeated before `; conduit: end`
 //! so that viewers and readers keep attributing the host's next moves correctly.
 //!
+//! # OctoPNP's part description
+//!
+//! With parts placed by the machine, OctoPNP's part description (`crate::circuit::octopnp`, the
+//! same block `conduit slice` writes, built by the walk from the plan's parts in bed
+//! coordinates) goes between `; conduit: OctoPNP part description` and `; conduit: end` right
+//! after the last layer's last extrusion — after that layer's own block when it has one — so
+//! before the host's end G-code and the settings some hosts append: the edited file ends with
+//! the host's own lines, as every other edit keeps it.
+//!
 //! # Summary
 //!
 //! The summary block (`; conduit postprocess: ...`, one item per line) goes after the host's
@@ -68,6 +77,10 @@ pub const PARTS_MARK: &str = "; conduit: parts after layer ";
 /// The last line of every inserted block.
 pub const END_MARK: &str = "; conduit: end";
 
+/// The first line of the block that holds OctoPNP's part description (it ends with
+/// [`END_MARK`]).
+pub const DESCRIPTION_MARK: &str = "; conduit: OctoPNP part description";
+
 /// What the rewrite changed.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct RewriteStats {
@@ -79,7 +92,10 @@ pub struct RewriteStats {
     pub removed_e: f64,
     /// Blocks inserted (layers with traces or part events).
     pub blocks: usize,
-    /// Lines added in all (pieces, blocks, summary), less the lines replaced.
+    /// Lines of OctoPNP's part description, its marks included (0 without parts placed by
+    /// the machine).
+    pub description_lines: usize,
+    /// Lines added in all (pieces, blocks, description, summary), less the lines replaced.
     pub added_lines: isize,
 }
 
@@ -190,9 +206,22 @@ impl State {
     }
 }
 
+/// Where OctoPNP's part description goes: after the last extrusion of the print (the last
+/// layer's), else after the last layer's last line.
+fn description_index(layers: &HostLayers) -> Option<usize> {
+    layers
+        .layers
+        .iter()
+        .filter_map(|l| l.last_extrusion_line)
+        .max()
+        .or_else(|| layers.layers.last()?.lines.end.checked_sub(1))
+}
+
 /// Writes the edited file: `gcode`, read as `layers`, with `plan` built in and the blocks
-/// written by the G-code writer with `params` (see the [module docs](self)). `summary` gets
-/// the statistics and returns the summary lines (without line endings).
+/// written by the G-code writer with `params` (see the [module docs](self)). `description` is
+/// OctoPNP's part description as `crate::circuit::octopnp::octopnp_block` writes it (empty
+/// when no part is placed by the machine). `summary` gets the statistics and returns the
+/// summary lines (without line endings).
 ///
 /// # Errors
 /// [`PostprocessError::MachineState`] when a layer end where a block goes is in relative
@@ -203,6 +232,7 @@ pub fn rewrite(
     layers: &HostLayers,
     plan: &CircuitPlan,
     params: &GcodeParams,
+    description: &str,
     summary: impl FnOnce(&RewriteStats) -> Vec<String>,
 ) -> Result<(Gcode, RewriteStats), PostprocessError> {
     let ending = gcode.line_ending();
@@ -220,6 +250,11 @@ pub fn rewrite(
             blocks.insert(at, layer.index);
         }
     }
+    let description_at = if description.is_empty() {
+        None
+    } else {
+        description_index(layers)
+    };
     let mut state = State {
         machine: Machine::new(params.printer.flavor, 25.0),
         temps: BTreeMap::new(),
@@ -271,12 +306,22 @@ pub fn rewrite(
             }
             _ => out.push(line.clone()),
         }
-        if let Some(&index) = blocks.get(&i) {
-            let (Some(layer), Some(p)) = (layers.layers.get(index), plan.layers.get(index)) else {
-                continue;
-            };
+        let layer_plan = blocks
+            .get(&i)
+            .and_then(|&index| Some((layers.layers.get(index)?, plan.layers.get(index)?)));
+        if let Some((layer, p)) = layer_plan {
             let lines = block(gcode, layer, p, &state, params, fallback_style)?;
             stats.blocks += 1;
+            stats.added_lines += lines.len() as isize;
+            out.extend(lines.into_iter().map(new_line));
+        }
+        if description_at == Some(i) {
+            let lines: Vec<String> = std::iter::once(DESCRIPTION_MARK)
+                .chain(description.lines())
+                .chain(std::iter::once(END_MARK))
+                .map(str::to_owned)
+                .collect();
+            stats.description_lines = lines.len();
             stats.added_lines += lines.len() as isize;
             out.extend(lines.into_iter().map(new_line));
         }
@@ -538,11 +583,12 @@ mod tests {
                 max: [0.0; 3],
             },
         };
-        let (edited, stats) =
-            match rewrite(&g, &layers, &plan, &params, |_| vec!["; summary".into()]) {
-                Ok(r) => r,
-                Err(e) => panic!("{e}"),
-            };
+        let (edited, stats) = match rewrite(&g, &layers, &plan, &params, "", |_| {
+            vec!["; summary".into()]
+        }) {
+            Ok(r) => r,
+            Err(e) => panic!("{e}"),
+        };
         assert_eq!(stats.cut_moves, 1);
         edited
             .lines

@@ -7,8 +7,10 @@
 //!
 //! 1. **Lines**: every line of the original appears in the edited file unchanged and in order,
 //!    except extruding moves replaced by cut pieces (motion lines, `G92`, `G10`/`G11` only); the
-//!    other added lines are the summary (`; conduit postprocess: ...`) and the inserted blocks
-//!    (`; conduit: traces layer ...` / `; conduit: parts after layer ...` to `; conduit: end`).
+//!    other added lines are the summary (`; conduit postprocess: ...`), the inserted blocks
+//!    (`; conduit: traces layer ...` / `; conduit: parts after layer ...` to `; conduit: end`)
+//!    and OctoPNP's part description (`; conduit: OctoPNP part description` to
+//!    `; conduit: end`, comment lines only).
 //! 2. **Cavities**: replaying the edited file, no extruding move of a tool other than the
 //!    conductive one has a point inside a layer's cuts (cavities and channels, shrunk by
 //!    [`VerifyParams::tolerance`]), sampled every [`VerifyParams::sample_step`] along the move.
@@ -16,16 +18,19 @@
 //!    tool inside a block (tool offsets undone), and nothing else extrudes inside a block.
 //! 4. **Events**: every part's event is in the file, after the host has printed a layer whose
 //!    top reaches the top of the part's cavity.
-//! 5. **`conduit check`**: the edited file has no error-level finding.
+//! 5. **OctoPNP**: with parts placed by the machine, one part description lists them all, in
+//!    placement order, each with the id of its `M361 P<id>` and its destination at the part's
+//!    position; without such parts there is none.
+//! 6. **`conduit check`**: the edited file has no error-level finding.
 
 use conduit_gcode::{Gcode, Line, LineEnding, Machine, Position};
 
 use super::cut::CutRegion;
 use super::plan::{CircuitPlan, plan_circuit};
-use super::rewrite::{END_MARK, PARTS_MARK, SUMMARY_PREFIX, TRACES_MARK};
+use super::rewrite::{DESCRIPTION_MARK, END_MARK, PARTS_MARK, SUMMARY_PREFIX, TRACES_MARK};
 use super::{PostprocessError, PostprocessParams, detect_host, read_layers};
 use crate::check::check;
-use crate::circuit::Electronics;
+use crate::circuit::{Electronics, PlacingMethod};
 use crate::geom::{Join, offset};
 use crate::program::machine::Flavor;
 
@@ -69,6 +74,10 @@ pub struct VerifyReport {
     pub block_lines: usize,
     /// Summary lines.
     pub summary_lines: usize,
+    /// Lines of OctoPNP's part description, marks included.
+    pub description_lines: usize,
+    /// Parts listed in OctoPNP's part description, by name.
+    pub described_parts: Vec<String>,
     /// Extruding moves of the host's tools that were tested against a layer's cuts.
     pub moves_tested: usize,
     /// Sampled points of host extrusion inside a cut (0 when the edit is right).
@@ -132,7 +141,7 @@ pub fn verify_with(
     let flavor = run.gcode.printer.flavor;
     let mut report = VerifyReport::default();
     let mut problems = Problems::new(params.max_listed);
-    let blocks = match_lines(original, edited, flavor, &mut report, &mut problems);
+    let (blocks, descriptions) = match_lines(original, edited, flavor, &mut report, &mut problems);
 
     // Replay the edited file once; classify every move.
     let (block_points, events) = replay_edited(
@@ -158,6 +167,9 @@ pub fn verify_with(
     // Events: each part once, after its cavity is complete.
     check_events(&plan, &events, &mut problems);
     report.events = events.into_iter().map(|(n, z, _)| (n, z)).collect();
+
+    // OctoPNP: the machine-placed parts described once, with their ids and destinations.
+    check_description(&plan, edited, &descriptions, &mut report, &mut problems);
 
     check_findings(edited, run, &mut report, &mut problems);
     report.problems = problems.finish();
@@ -316,6 +328,106 @@ fn check_events(plan: &CircuitPlan, events: &[Event], problems: &mut Problems) {
     }
 }
 
+/// Checks OctoPNP's part description: one block listing every part placed by the machine in
+/// placement order, `id` its 1-based placement number (the `{id}` of its `M361 P<id>`), the
+/// destination at the part's position (to the block's 4 decimals); none without such parts.
+fn check_description(
+    plan: &CircuitPlan,
+    edited: &Gcode,
+    descriptions: &[std::ops::Range<usize>],
+    report: &mut VerifyReport,
+    problems: &mut Problems,
+) {
+    let auto: Vec<(usize, &crate::circuit::PlacedPart)> = plan
+        .parts
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.method == PlacingMethod::Auto)
+        .map(|(i, p)| (i + 1, p))
+        .collect();
+    let block = match (descriptions, auto.is_empty()) {
+        ([], true) => return,
+        ([block], false) => block,
+        (found, _) => {
+            problems.push(
+                "description",
+                format!(
+                    "{} OctoPNP part descriptions where {} expected ({} parts placed by the \
+                     machine)",
+                    found.len(),
+                    if auto.is_empty() { "none is" } else { "one is" },
+                    auto.len()
+                ),
+            );
+            return;
+        }
+    };
+    // The block's `<part id name>` lines, each with the `<destination>` that follows it.
+    let mut described: Vec<(String, String, Option<[f64; 3]>)> = Vec::new();
+    for line in edited.lines.get(block.clone()).unwrap_or_default() {
+        let text = String::from_utf8_lossy(&line.text);
+        let text = text.trim_start_matches(';').trim();
+        if text.starts_with("<part ") {
+            let id = xml_attr(text, "id").unwrap_or_default();
+            let name = xml_attr(text, "name").unwrap_or_default();
+            described.push((id, name, None));
+        } else if text.starts_with("<destination ") {
+            let xyz = ["x", "y", "z"].map(|k| xml_attr(text, k).and_then(|v| v.parse().ok()));
+            if let (Some(last), [Some(x), Some(y), Some(z)]) = (described.last_mut(), xyz) {
+                last.2 = Some([x, y, z]);
+            }
+        }
+    }
+    report.described_parts = described.iter().map(|(_, n, _)| n.clone()).collect();
+    let want: Vec<(String, &str)> = auto
+        .iter()
+        .map(|(id, p)| (id.to_string(), p.name.as_str()))
+        .collect();
+    let got: Vec<(String, &str)> = described
+        .iter()
+        .map(|(id, n, _)| (id.clone(), n.as_str()))
+        .collect();
+    if want != got {
+        problems.push(
+            "description",
+            format!(
+                "OctoPNP's part description lists {got:?} (id, part), not the parts placed by \
+                 the machine {want:?}"
+            ),
+        );
+        return;
+    }
+    for ((_, part), (_, name, destination)) in auto.iter().zip(&described) {
+        let p = [part.position.x, part.position.y, part.position.z];
+        let off = destination.is_none_or(|d| d.iter().zip(p).any(|(a, b)| (a - b).abs() > 1e-3));
+        if off {
+            problems.push(
+                "description",
+                format!(
+                    "OctoPNP's destination of part {name} is {destination:?}, not its position \
+                     ({:.3}, {:.3}, {:.3})",
+                    p[0], p[1], p[2]
+                ),
+            );
+        }
+    }
+}
+
+/// The value of the attribute `key` in an XML tag written as conduit writes it
+/// (`key="value"`), unescaped.
+fn xml_attr(tag: &str, key: &str) -> Option<String> {
+    let start = tag.find(&format!(" {key}=\""))? + key.len() + 3;
+    let len = tag.get(start..)?.find('"')?;
+    let value = tag.get(start..start + len)?;
+    Some(
+        value
+            .replace("&lt;", "<")
+            .replace("&gt;", ">")
+            .replace("&quot;", "\"")
+            .replace("&amp;", "&"),
+    )
+}
+
 /// Runs `conduit check` on the edited file and lists its error-level findings.
 fn check_findings(
     edited: &Gcode,
@@ -433,15 +545,18 @@ fn same(original: &Line, edited: &Line) -> bool {
 /// How far ahead in the original a run of replaced moves may reach.
 const LOOKAHEAD: usize = 256;
 
-/// Matches the lines (step 1 of the [module docs](self)); returns the inserted blocks as line
-/// ranges of `edited`.
+/// Line ranges of `edited`.
+type Ranges = Vec<std::ops::Range<usize>>;
+
+/// Matches the lines (step 1 of the [module docs](self)); returns the inserted blocks and
+/// OctoPNP's part descriptions as line ranges of `edited`.
 fn match_lines(
     original: &Gcode,
     edited: &Gcode,
     flavor: Flavor,
     report: &mut VerifyReport,
     problems: &mut Problems,
-) -> Vec<std::ops::Range<usize>> {
+) -> (Ranges, Ranges) {
     let (orig, ed) = (&original.lines, &edited.lines);
     let mut machine = Machine::new(flavor, 25.0);
     let extruding: Vec<bool> = orig
@@ -453,6 +568,7 @@ fn match_lines(
         t.starts_with(TRACES_MARK) || t.starts_with(PARTS_MARK)
     };
     let mut blocks = Vec::new();
+    let mut descriptions = Vec::new();
     let (mut i, mut j) = (0, 0);
     // The first original line at or after `i` (over extruding moves only) that `ed[j]` is.
     let ahead = |i: usize, j: usize| -> Option<usize> {
@@ -476,13 +592,34 @@ fn match_lines(
             j += 1;
             continue;
         }
+        if line.text == DESCRIPTION_MARK.as_bytes() {
+            // Comment lines only, up to the end mark.
+            let comment_only = |l: &Line| l.comment.is_some() && l.words.is_empty();
+            let end = (j + 1..ed.len())
+                .find(|&k| ed[k].text == END_MARK.as_bytes() || !comment_only(&ed[k]));
+            let Some(end) = end.filter(|&k| ed[k].text == END_MARK.as_bytes()) else {
+                problems.push(
+                    "lines",
+                    format!(
+                        "line {}: OctoPNP part description without `{END_MARK}` after its \
+                         comment lines",
+                        j + 1
+                    ),
+                );
+                return (blocks, descriptions);
+            };
+            report.description_lines += end + 1 - j;
+            descriptions.push(j..end + 1);
+            j = end + 1;
+            continue;
+        }
         if is_block_start(line) {
             let Some(end) = (j..ed.len()).find(|&k| ed[k].text == END_MARK.as_bytes()) else {
                 problems.push(
                     "lines",
                     format!("line {}: block without `{END_MARK}`", j + 1),
                 );
-                return blocks;
+                return (blocks, descriptions);
             };
             report.blocks += 1;
             report.block_lines += end + 1 - j;
@@ -501,7 +638,7 @@ fn match_lines(
                 "lines",
                 format!("line {}: added after the end of the original", j + 1),
             );
-            return blocks;
+            return (blocks, descriptions);
         }
         if !extruding[i] {
             problems.push(
@@ -513,7 +650,7 @@ fn match_lines(
                     j + 1
                 ),
             );
-            return blocks;
+            return (blocks, descriptions);
         }
         // orig[i] was cut: the pieces run until the file meets the original again.
         report.replaced_lines.push(i + 1);
@@ -528,7 +665,9 @@ fn match_lines(
                 report.replaced_lines.extend(i + 1..=k);
                 i = k;
             }
-            None if j >= ed.len() || is_block_start(&ed[j]) => {}
+            None if j >= ed.len()
+                || is_block_start(&ed[j])
+                || ed[j].text == DESCRIPTION_MARK.as_bytes() => {}
             None => {
                 problems.push(
                     "lines",
@@ -538,7 +677,7 @@ fn match_lines(
                         String::from_utf8_lossy(&ed[j].text)
                     ),
                 );
-                return blocks;
+                return (blocks, descriptions);
             }
         }
     }
@@ -552,5 +691,5 @@ fn match_lines(
             ),
         );
     }
-    blocks
+    (blocks, descriptions)
 }
