@@ -16,7 +16,11 @@ fn board_file(corpus: &Path, name: &str) -> PathBuf {
     let dir = corpus.join("eagle").join(name);
     let mut found: Vec<PathBuf> = std::fs::read_dir(&dir)
         .expect("board folder")
-        .flat_map(|e| std::fs::read_dir(e.expect("entry").path()).into_iter().flatten())
+        .flat_map(|e| {
+            std::fs::read_dir(e.expect("entry").path())
+                .into_iter()
+                .flatten()
+        })
         .map(|e| e.expect("entry").path())
         .filter(|p| p.extension().is_some_and(|e| e == "brd"))
         .collect();
@@ -109,7 +113,9 @@ fn every_corpus_board_is_placed_from_its_board_and_slices() {
             out.as_os_str(),
         ]);
         let span = [
-            sized["span_mm"][0].as_f64().unwrap_or_else(|| panic!("{name}: {sized} {err}")),
+            sized["span_mm"][0]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{name}: {sized} {err}")),
             sized["span_mm"][1].as_f64().expect("span"),
         ];
         let model = block(d, name, [span[0] + 12.0, span[1] + 12.0, 8.0]);
@@ -155,7 +161,12 @@ fn every_corpus_board_is_placed_from_its_board_and_slices() {
         for e in board.elements.iter().filter(|e| e.rotation.mirror) {
             if let Some(p) = placed.get(&e.name) {
                 assert_eq!(planes.len(), 2, "{name}");
-                assert!((p[2] - planes[1]).abs() < 1e-9, "{name}: {} at {}", e.name, p[2]);
+                assert!(
+                    (p[2] - planes[1]).abs() < 1e-9,
+                    "{name}: {} at {}",
+                    e.name,
+                    p[2]
+                );
             }
         }
         // And it slices: the placement matches the circuit and the block. (A coarse, short
@@ -192,4 +203,204 @@ fn every_corpus_board_is_placed_from_its_board_and_slices() {
             span[1]
         );
     }
+}
+
+/// The layout is the board's, moved, turned and spread as asked: between any two parts the
+/// offset is the board's offset turned by `--rotate` and multiplied by `--scale`, each part
+/// turns by `--rotate`, and `--at` moves every part by the same amount.
+#[test]
+fn a_board_layout_is_moved_turned_and_spread_as_asked() {
+    let Some(corpus) = corpus() else {
+        return;
+    };
+    let dir = temp_dir();
+    let d = dir.path();
+    let brd = board_file(&corpus, "LilyPad_Tri-Color_LED");
+    let board = conduit_eagle::read_board(&std::fs::read(&brd).expect("brd")).expect("brd");
+    let model = block(d, "big", [200.0, 200.0, 8.0]);
+    let run = |at: &str, out: &Path| {
+        let (code, summary, err) = place(&[
+            "--model".as_ref(),
+            model.as_os_str(),
+            "--from-brd".as_ref(),
+            brd.as_os_str(),
+            "--rotate".as_ref(),
+            "90".as_ref(),
+            "--scale".as_ref(),
+            "1.5".as_ref(),
+            format!("--at={at}").as_ref(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ]);
+        assert_eq!(code, Some(0), "{summary} {err}");
+        parts(out)
+    };
+    let (a, b) = (
+        run("5,7", &d.join("a.toml")),
+        run("-20,3.5", &d.join("b.toml")),
+    );
+    assert_eq!(a.len(), 8);
+    let names: Vec<&String> = a.keys().collect();
+    for (i, p) in names.iter().enumerate() {
+        let ep = board.element(p).expect("on the board");
+        // `--at` moves every part by the difference.
+        assert!((a[*p][0] - b[*p][0] - 25.0).abs() < 1e-3, "{p}");
+        assert!((a[*p][1] - b[*p][1] - 3.5).abs() < 1e-3, "{p}");
+        assert!(
+            ((a[*p][3] - ep.rotation.degrees - 90.0).rem_euclid(360.0)).abs() < 1e-3,
+            "{p}: {} vs {}",
+            a[*p][3],
+            ep.rotation.degrees
+        );
+        for q in &names[i + 1..] {
+            let eq = board.element(q).expect("on the board");
+            let (bx, by) = (ep.x - eq.x, ep.y - eq.y);
+            // Turned a quarter counter-clockwise: (x, y) → (−y, x), then times 1.5.
+            let (wx, wy) = (-by * 1.5, bx * 1.5);
+            let (gx, gy) = (a[*p][0] - a[*q][0], a[*p][1] - a[*q][1]);
+            assert!((gx - wx).abs() < 1e-3 && (gy - wy).abs() < 1e-3, "{p}-{q}");
+        }
+    }
+}
+
+/// A layout that cannot be printed is refused with each problem naming the parts and a
+/// distance, and nothing is written; `--force` writes it with the problems as warnings.
+#[test]
+fn a_layout_with_parts_in_each_others_cavities_or_outside_is_refused() {
+    let Some(corpus) = corpus() else {
+        return;
+    };
+    let dir = temp_dir();
+    let d = dir.path();
+    let brd = board_file(&corpus, "OpenLog");
+    let model = block(d, "big", [200.0, 200.0, 8.0]);
+    let out = d.join("p.toml");
+    let args = |model: &Path, scale: &'static str, force: bool| {
+        let mut v: Vec<std::ffi::OsString> = vec![
+            "--model".into(),
+            model.into(),
+            "--from-brd".into(),
+            brd.clone().into(),
+            "--scale".into(),
+            scale.into(),
+            "-o".into(),
+            out.clone().into(),
+        ];
+        if force {
+            v.push("--force".into());
+        }
+        v
+    };
+    let call = |v: Vec<std::ffi::OsString>| {
+        let refs: Vec<&std::ffi::OsStr> = v.iter().map(|s| s.as_os_str()).collect();
+        place(&refs)
+    };
+    // At the board's own scale the parts crowd into each other's cavities.
+    let (code, summary, err) = call(args(&model, "1", false));
+    assert_eq!(code, Some(1), "{summary}");
+    assert!(!out.exists(), "nothing written");
+    assert!(
+        err.lines().any(|l| l.starts_with("error: parts ")
+            && (l.contains(" collide: their footprints share ")
+                || l.contains(" mm apart: each reaches into the other's cavity"))),
+        "{err}"
+    );
+    assert!(
+        err.contains("nothing written (--force writes the placement anyway)"),
+        "{err}"
+    );
+    let (code, _, err) = call(args(&model, "1", true));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.exists());
+    assert!(
+        err.lines().any(|l| l.starts_with("warning: parts ")),
+        "{err}"
+    );
+    std::fs::remove_file(&out).expect("removed");
+    // A block smaller than the layout: parts outside, each with how far.
+    let small = block(d, "small", [10.0, 10.0, 8.0]);
+    let (code, _, err) = call(args(&small, "2.15", false));
+    assert_eq!(code, Some(1));
+    let outside = err
+        .lines()
+        .filter(|l| l.contains(" is not inside the object: ") && l.contains(" mm beyond its edge"))
+        .count();
+    assert!(outside >= 4, "{err}");
+    assert!(!out.exists());
+}
+
+/// Bottom-side parts are refused with `--bottom refuse`, naming them; a plane outside the
+/// model and a binary (pre-6) EAGLE board are refused in one line naming what is wrong.
+#[test]
+fn refusals_name_the_parts_the_plane_and_the_file() {
+    let Some(corpus) = corpus() else {
+        return;
+    };
+    let dir = temp_dir();
+    let d = dir.path();
+    let model = block(d, "big", [200.0, 200.0, 8.0]);
+    let out = d.join("p.toml");
+    let openlog = board_file(&corpus, "OpenLog");
+    let board = conduit_eagle::read_board(&std::fs::read(&openlog).expect("brd")).expect("brd");
+    let (code, _, err) = place(&[
+        "--model".as_ref(),
+        model.as_os_str(),
+        "--from-brd".as_ref(),
+        openlog.as_os_str(),
+        "--bottom".as_ref(),
+        "refuse".as_ref(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("bottom-side part(s) ("), "{err}");
+    // The bottom-side elements that are parts with a pad on a net (fiducials are left out).
+    let circuit = conduit::circuit::Circuit::load(&openlog).expect("circuit");
+    let on_a_net = |name: &str| {
+        circuit
+            .nets
+            .iter()
+            .flat_map(|n| &n.pins)
+            .any(|p| p.part == name)
+    };
+    let bottom: Vec<&str> = board
+        .elements
+        .iter()
+        .filter(|e| e.rotation.mirror && on_a_net(&e.name))
+        .map(|e| e.name.as_str())
+        .collect();
+    assert!(!bottom.is_empty());
+    for name in bottom {
+        assert!(err.contains(name), "{name} in {err}");
+    }
+    let (code, _, err) = place(&[
+        "--model".as_ref(),
+        model.as_os_str(),
+        "--from-brd".as_ref(),
+        openlog.as_os_str(),
+        "--z".as_ref(),
+        "12".as_ref(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains(
+            "the seating plane z 12.000 mm is outside the model, which spans z 0.000 to 8.000 mm"
+        ),
+        "{err}"
+    );
+    let wifly = board_file(&corpus, "WiFly-Shield");
+    let (code, _, err) = place(&[
+        "--model".as_ref(),
+        model.as_os_str(),
+        "--from-brd".as_ref(),
+        wifly.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, Some(1));
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains(&*wifly.display().to_string()), "{err}");
+    assert!(!out.exists());
 }

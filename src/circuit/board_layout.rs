@@ -166,7 +166,9 @@ fn covering_parts(
         .iter()
         .filter(|e| !e.rotation.mirror)
         .filter_map(|e| {
-            let part = circuit.part(&e.name).filter(|p| has_connected_pads(circuit, p))?;
+            let part = circuit
+                .part(&e.name)
+                .filter(|p| has_connected_pads(circuit, p))?;
             let mut lo = [f64::INFINITY; 2];
             let mut hi = [f64::NEG_INFINITY; 2];
             for pad in &part.pads {
@@ -303,8 +305,10 @@ pub fn layout_board(
     }
     for part in &circuit.parts {
         if board.element(&part.name).is_none() && has_connected_pads(circuit, part) {
-            out.left_out
-                .push(format!("{}: in the circuit but not on the board", part.name));
+            out.left_out.push(format!(
+                "{}: in the circuit but not on the board",
+                part.name
+            ));
         }
     }
     if !refused.is_empty() {
@@ -493,4 +497,79 @@ pub fn suggest_scale(
                     .is_none_or(|(gap, _, _)| gap >= room.parts - 1e-9)
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::circuit::{Pad, PadShape};
+
+    fn part(pads: &[(f64, f64)]) -> Part {
+        Part {
+            name: "U1".into(),
+            value: None,
+            package: "P".into(),
+            pads: pads
+                .iter()
+                .enumerate()
+                .map(|(k, &(x, y))| Pad {
+                    name: format!("{}", k + 1),
+                    x,
+                    y,
+                    shape: PadShape::Round { diameter: 0.5 },
+                    rotation_deg: 0.0,
+                    smd: true,
+                })
+                .collect(),
+            pins: Default::default(),
+            route_any: Default::default(),
+        }
+    }
+
+    /// The squared distance from each pad turned face up by `turn` to where `MR<degrees>`
+    /// puts it.
+    fn misfit(p: &Part, degrees: f64, turn: f64) -> f64 {
+        let (s, c) = degrees.to_radians().sin_cos();
+        let (st, ct) = turn.to_radians().sin_cos();
+        p.pads
+            .iter()
+            .map(|pad| {
+                let (qx, qy) = (-(pad.x * c - pad.y * s), pad.x * s + pad.y * c);
+                let (tx, ty) = (pad.x * ct - pad.y * st, pad.x * st + pad.y * ct);
+                (qx - tx).powi(2) + (qy - ty).powi(2)
+            })
+            .sum()
+    }
+
+    #[test]
+    fn a_bottom_part_turns_to_the_quarter_turn_nearest_its_mirrored_pads() {
+        let packages = [
+            part(&[(-1.0, 0.0), (1.0, 0.0)]),
+            part(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0)]),
+            part(&[
+                (-3.0, 1.0),
+                (-1.0, 1.0),
+                (1.0, 1.0),
+                (3.0, -1.0),
+                (0.5, -2.0),
+            ]),
+        ];
+        for p in &packages {
+            for degrees in [0.0, 90.0, 180.0, 270.0, 45.0] {
+                let turn = face_up_rotation(p, degrees);
+                assert_eq!(turn % 90.0, 0.0);
+                let best = [0.0, 90.0, 180.0, 270.0]
+                    .into_iter()
+                    .map(|t| misfit(p, degrees, t))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    misfit(p, degrees, turn) <= best + 1e-9,
+                    "MR{degrees}: turned {turn}"
+                );
+            }
+        }
+        // A two-pad part along x mirrored without a turn: a half turn puts pad 1 where the
+        // mirror has it.
+        assert_eq!(face_up_rotation(&packages[0], 0.0), 180.0);
+    }
 }

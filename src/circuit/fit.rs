@@ -33,7 +33,11 @@ fn seat_layer(zs: &[LayerZ], z: f64) -> usize {
 /// the first layer for a part on the bed), two parts whose footprints overlap at heights both
 /// bodies take up (cavities merely touching are one pocket, which is fine). `islands` are the
 /// object's layers at `zs`, in the parts' frame.
-pub fn part_problems(parts: &[&PlacedPart], islands: &[Vec<ExPolygon>], zs: &[LayerZ]) -> Vec<String> {
+pub fn part_problems(
+    parts: &[&PlacedPart],
+    islands: &[Vec<ExPolygon>],
+    zs: &[LayerZ],
+) -> Vec<String> {
     let mut problems = Vec::new();
     let Some(last) = zs.last() else {
         return problems;
@@ -66,10 +70,11 @@ pub fn part_problems(parts: &[&PlacedPart], islands: &[Vec<ExPolygon>], zs: &[La
             let Some((low, high)) = shared_heights(a, b) else {
                 continue;
             };
-            let shared: f64 = crate::geom::intersection(&region(&a.footprint), &region(&b.footprint))
-                .iter()
-                .map(ExPolygon::area_mm2)
-                .sum();
+            let shared: f64 =
+                crate::geom::intersection(&region(&a.footprint), &region(&b.footprint))
+                    .iter()
+                    .map(ExPolygon::area_mm2)
+                    .sum();
             if shared > PROBLEM_AREA_MM2 {
                 problems.push(format!(
                     "parts {} and {} collide: their footprints share {shared:.1} mm² between z \
@@ -243,10 +248,11 @@ pub fn placement_problems(
             if shared_heights(a, b).is_none() {
                 continue;
             }
-            let shared: f64 = crate::geom::intersection(&region(&a.footprint), &region(&b.footprint))
-                .iter()
-                .map(ExPolygon::area_mm2)
-                .sum();
+            let shared: f64 =
+                crate::geom::intersection(&region(&a.footprint), &region(&b.footprint))
+                    .iter()
+                    .map(ExPolygon::area_mm2)
+                    .sum();
             if shared > PROBLEM_AREA_MM2 {
                 continue; // a collision part_problems names
             }

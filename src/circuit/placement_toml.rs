@@ -202,7 +202,10 @@ mod tests {
         let text = placement_toml(&placement, &["made by a test".into()], |n| {
             Some(format!("{n}: a part"))
         });
-        assert!(text.starts_with("# made by a test\n\norigin = \"bbox_center\"\n"), "{text}");
+        assert!(
+            text.starts_with("# made by a test\n\norigin = \"bbox_center\"\n"),
+            "{text}"
+        );
         assert!(text.contains("# LED\\2: a part\n[[part]]\n"), "{text}");
         let back = Placement::from_toml(&text).expect("reads back");
         assert_eq!(back, placement);

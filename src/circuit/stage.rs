@@ -359,13 +359,11 @@ pub fn object_stage(
         .enumerate()
         .filter(|(_, p)| p.object == object)
         .collect();
-    report
-        .part_problems
-        .extend(super::fit::part_problems(
-            &mine.iter().map(|(_, p)| *p).collect::<Vec<_>>(),
-            islands,
-            zs,
-        ));
+    report.part_problems.extend(super::fit::part_problems(
+        &mine.iter().map(|(_, p)| *p).collect::<Vec<_>>(),
+        islands,
+        zs,
+    ));
     let cavities = carve_part_cavities(&mine, islands, zs, params.cavity_offset);
     let (mine_wires, between): (Vec<&CircuitWire>, Vec<&CircuitWire>) = circuit
         .wires

@@ -136,17 +136,28 @@ pub struct PlaceArgs {
     pub force: bool,
     /// Seating plane of the (top) parts, model z in mm; by default under the model's top by the
     /// body height and `route.wall_clearance`.
-    #[arg(long, value_name = "Z", conflicts_with_all = ["z_from_top", "z_range"])]
+    #[arg(long, value_name = "Z", conflicts_with_all = ["z_from_top", "z_range"], allow_hyphen_values = true)]
     pub z: Option<f64>,
     /// Seating plane this far below the model's top, mm.
-    #[arg(long, value_name = "D", conflicts_with = "z_range")]
+    #[arg(
+        long,
+        value_name = "D",
+        conflicts_with = "z_range",
+        allow_hyphen_values = true
+    )]
     pub z_from_top: Option<f64>,
     /// With --from-brd: where the board's centre goes, `X,Y` in model mm (default: the middle
     /// of the model's bounding box).
-    #[arg(long, value_name = "X,Y", value_parser = parse_xy, requires = "from_brd")]
+    #[arg(long, value_name = "X,Y", value_parser = parse_xy, requires = "from_brd", allow_hyphen_values = true)]
     pub at: Option<[f64; 2]>,
     /// With --from-brd: turn the layout about the board's centre, degrees counter-clockwise.
-    #[arg(long, value_name = "DEG", default_value_t = 0.0, requires = "from_brd")]
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        requires = "from_brd",
+        allow_hyphen_values = true
+    )]
     pub rotate: f64,
     /// With --from-brd: spread the layout (distances between parts times S; parts keep their
     /// size). The summary suggests the smallest scale that leaves traces room between pads.
@@ -154,7 +165,13 @@ pub struct PlaceArgs {
     pub scale: f64,
     /// With --from-brd: seating plane of the bottom-side parts (face up); by default under
     /// the top plane by the body height and `route.wall_clearance`.
-    #[arg(long, value_name = "Z", requires = "from_brd", conflicts_with = "bottom")]
+    #[arg(
+        long,
+        value_name = "Z",
+        requires = "from_brd",
+        conflicts_with = "bottom",
+        allow_hyphen_values = true
+    )]
     pub bottom_z: Option<f64>,
     /// With --from-brd: `refuse` fails on a board with bottom-side parts instead of placing
     /// them face up below the top parts.
@@ -166,7 +183,7 @@ pub struct PlaceArgs {
     /// With --auto: the seating plane is chosen in this range of model z, `A..B` mm (default:
     /// from `route.wall_clearance` above the bottom to under the top by the body height and
     /// `route.wall_clearance`).
-    #[arg(long, value_name = "A..B", value_parser = parse_range, requires = "auto")]
+    #[arg(long, value_name = "A..B", value_parser = parse_range, requires = "auto", allow_hyphen_values = true)]
     pub z_range: Option<[f64; 2]>,
     /// With --auto: smallest distance between two parts' footprints, mm (default: both
     /// cavities, `route.wall_clearance` and two traces with their channels).

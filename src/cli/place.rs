@@ -36,8 +36,7 @@ pub(crate) fn run(args: PlaceArgs) -> Result<(), Failure> {
     let (outcome, from) = if let Some(brd) = &args.from_brd {
         let bytes =
             std::fs::read(brd).with_context(|| format!("{}: cannot read", brd.display()))?;
-        let board = conduit_eagle::read_board(&bytes)
-            .with_context(|| brd.display().to_string())?;
+        let board = conduit_eagle::read_board(&bytes).with_context(|| brd.display().to_string())?;
         let how = FromBoard {
             at: args.at,
             rotate_deg: args.rotate,
@@ -100,9 +99,10 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
         }
     }
     if args.json {
-        let closest = o.closest_pads.as_ref().map(|(gap, a, b)| {
-            serde_json::json!({ "gap_mm": gap, "pins": [a, b] })
-        });
+        let closest = o
+            .closest_pads
+            .as_ref()
+            .map(|(gap, a, b)| serde_json::json!({ "gap_mm": gap, "pins": [a, b] }));
         return super::print_json(&serde_json::json!({
             "outputs": if o.problems.is_empty() || args.force {
                 super::paths([args.output.as_path()])
@@ -131,7 +131,11 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
     )?;
     if let Some((gap, a, b)) = &o.closest_pads {
         let need = o.room.trace;
-        let verdict = if *gap >= need - 1e-9 { "room for a trace" } else { "too close for a trace" };
+        let verdict = if *gap >= need - 1e-9 {
+            "room for a trace"
+        } else {
+            "too close for a trace"
+        };
         outln!("closest pads of different nets: {gap:.2} mm ({a}, {b}), {verdict} ({need:.2} mm)")?;
     }
     if args.from_brd.is_some() {

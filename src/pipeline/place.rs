@@ -271,7 +271,11 @@ fn describe_part(part: &crate::circuit::Part, side: &str) -> String {
     if let Some(v) = part.value.as_deref().filter(|v| !v.is_empty()) {
         s.push_str(&format!(" {v},"));
     }
-    s.push_str(&format!(" package {}, {} pads, {side}", part.package, part.pads.len()));
+    s.push_str(&format!(
+        " package {}, {} pads, {side}",
+        part.package,
+        part.pads.len()
+    ));
     s
 }
 
