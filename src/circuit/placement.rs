@@ -418,7 +418,10 @@ pub enum PlacementError {
         error: std::io::Error,
     },
     /// The file name ends in neither `.toml` nor `.3de`.
-    #[error("{path}: unknown placement format; expected a .toml or .3de file")]
+    #[error(
+        "{path}: unknown placement format; expected a .toml or .3de file{}",
+        board_hint(path)
+    )]
     UnknownFormat {
         /// The file.
         path: PathBuf,
@@ -468,6 +471,19 @@ pub enum PlacementError {
         /// Net name.
         net: String,
     },
+}
+
+/// For a board given as a placement: how to make one from it.
+fn board_hint(path: &Path) -> &'static str {
+    let brd = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("brd"));
+    if brd {
+        " (an EAGLE board is a circuit, not a placement: `conduit place --from-brd X.brd \
+         --model MODEL -o P.toml` writes its layout as a placement)"
+    } else {
+        ""
+    }
 }
 
 impl Placement {
