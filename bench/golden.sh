@@ -128,6 +128,13 @@ run compensate_gaps compensate out/circle.csv --gaps out/gaps.csv -o out/circle.
     --program out/circle.src --dialect krl --report out/gaps.json
 
 # --- route, preview, convert ------------------------------------------------------------------
+# README and guide: a board's layout placed, sliced, checked.
+run place_led_coin place --model samples/circuit_demo/block.stl \
+    --from-brd samples/circuit_demo/led_coin.brd -o out/led_coin.toml
+run slice_led_coin slice samples/circuit_demo/block.stl --circuit samples/circuit_demo/led_coin.sch \
+    --placement out/led_coin.toml -o out/led_coin.gcode
+run check_led_coin check out/led_coin.gcode --circuit samples/circuit_demo/led_coin.sch \
+    --placement out/led_coin.toml --model samples/circuit_demo/block.stl
 run route_demo route samples/circuit_demo/block.stl --circuit samples/circuit_demo/led_coin.sch \
     --placement samples/circuit_demo/placement.toml --out-dir out/route --report out/route.json
 run preview_demo preview out/demo.gcode -o out/preview_demo
