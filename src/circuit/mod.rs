@@ -16,6 +16,7 @@ mod placed;
 mod placement;
 mod rubberband;
 pub mod octopnp;
+pub mod pack;
 pub mod settings;
 pub mod stage;
 mod three_de;
