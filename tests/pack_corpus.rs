@@ -55,7 +55,12 @@ fn footprint(c: &Circuit, p: &Packed) -> [f64; 4] {
     let part = c.part(&p.name).expect("packed part in the circuit");
     let e = pad_extent(part).expect("a part with pads");
     let (s, co) = p.rotation.to_radians().sin_cos();
-    let mut f = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    let mut f = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
     for (x, y) in [(e[0], e[1]), (e[2], e[1]), (e[2], e[3]), (e[0], e[3])] {
         let (u, v) = (p.x + co * x - s * y, p.y + s * x + co * y);
         f = [f[0].min(u), f[1].min(v), f[2].max(u), f[3].max(v)];

@@ -222,7 +222,8 @@ pub fn rubberband_length(circuit: &Circuit, packed: &[Packed]) -> f64 {
             let mut keys: Vec<(String, String)> = Vec::new();
             let mut groups: Vec<usize> = Vec::new();
             for pin in &net.pins {
-                let (Some(placed), Some(part)) = (at.get(pin.part.as_str()), circuit.part(&pin.part))
+                let (Some(placed), Some(part)) =
+                    (at.get(pin.part.as_str()), circuit.part(&pin.part))
                 else {
                     continue;
                 };
@@ -274,7 +275,8 @@ fn mst_length(points: &[[f64; 2]], groups: &[usize]) -> f64 {
         for m in (0..n).filter(|&m| groups[m] == groups[j]) {
             in_tree[m] = true;
             for k in 0..n {
-                let d = (points[k][0] - points[m][0]).powi(2) + (points[k][1] - points[m][1]).powi(2);
+                let d =
+                    (points[k][0] - points[m][0]).powi(2) + (points[k][1] - points[m][1]).powi(2);
                 if !in_tree[k] && d < best[k] {
                     best[k] = d;
                 }
@@ -399,10 +401,7 @@ fn items<'a>(
         let turns = quarters
             .iter()
             .map(|&q| {
-                let corners = [
-                    turn([ext[0], ext[1]], q),
-                    turn([ext[2], ext[3]], q),
-                ];
+                let corners = [turn([ext[0], ext[1]], q), turn([ext[2], ext[3]], q)];
                 let lo = [
                     corners[0][0].min(corners[1][0]),
                     corners[0][1].min(corners[1][1]),
@@ -582,7 +581,8 @@ impl Grid {
                 for i in 0..nx {
                     let v = u32::from(class[j * nx + i] == want);
                     t[(j + 1) * (nx + 1) + i + 1] =
-                        v + t[j * (nx + 1) + i + 1] + t[(j + 1) * (nx + 1) + i] - t[j * (nx + 1) + i];
+                        v + t[j * (nx + 1) + i + 1] + t[(j + 1) * (nx + 1) + i]
+                            - t[j * (nx + 1) + i];
                 }
             }
             t
@@ -641,7 +641,9 @@ impl Grid {
     /// Cells counted by `table` in columns `i..i + w`, rows `j..j + h`.
     fn box_sum(&self, table: &[u32], i: usize, j: usize, w: usize, h: usize) -> u32 {
         let r = self.nx + 1;
-        table[(j + h) * r + i + w] + table[j * r + i] - table[j * r + i + w] - table[(j + h) * r + i]
+        table[(j + h) * r + i + w] + table[j * r + i]
+            - table[j * r + i + w]
+            - table[(j + h) * r + i]
     }
 
     /// The footprint of `size` with its lower-left corner on grid point `(i, j)`.
@@ -692,8 +694,8 @@ impl Grid {
             let to = cells.partition_point(|&c| (c as usize) < i + cw);
             let base = self.row_start[row] as usize;
             for k in base + from..base + to {
-                let es = &self.cell_edges
-                    [self.edge_start[k] as usize..self.edge_start[k + 1] as usize];
+                let es =
+                    &self.cell_edges[self.edge_start[k] as usize..self.edge_start[k + 1] as usize];
                 if es.iter().any(|&e| {
                     let (a, b) = self.edges[e as usize];
                     segment_meets(a, b, r, true)
@@ -774,8 +776,11 @@ impl<'a> Packer<'a> {
                 });
             }
         }
-        let index: BTreeMap<&str, usize> =
-            items.iter().enumerate().map(|(k, it)| (it.name, k)).collect();
+        let index: BTreeMap<&str, usize> = items
+            .iter()
+            .enumerate()
+            .map(|(k, it)| (it.name, k))
+            .collect();
         let n = items.len();
         let mut nets = Vec::new();
         let mut item_nets = vec![Vec::new(); n];

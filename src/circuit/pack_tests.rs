@@ -90,7 +90,12 @@ fn packed(c: &Circuit, region: &[ExPolygon], p: &PackParams) -> Vec<Packed> {
 fn footprint(c: &Circuit, p: &Packed) -> [f64; 4] {
     let part = c.part(&p.name).expect("packed part in the circuit");
     let (s, co) = p.rotation.to_radians().sin_cos();
-    let mut fp = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    let mut fp = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
     for pad in &part.pads {
         let [hx, hy] = pad.half_extent();
         for (dx, dy) in [(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)] {
@@ -129,8 +134,10 @@ fn check(
 ) -> BTreeMap<String, [f64; 4]> {
     let got: Vec<&str> = out.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(got, names(c), "every part, in order");
-    let fps: BTreeMap<String, [f64; 4]> =
-        out.iter().map(|p| (p.name.clone(), footprint(c, p))).collect();
+    let fps: BTreeMap<String, [f64; 4]> = out
+        .iter()
+        .map(|p| (p.name.clone(), footprint(c, p)))
+        .collect();
     for p in out {
         assert!(
             [0.0, 90.0, 180.0, 270.0].contains(&p.rotation),
@@ -216,8 +223,12 @@ fn rubberband_length_is_the_spanning_tree_of_the_pads() {
 
 #[test]
 fn joined_pads_of_one_pin_count_as_one_point() {
-    let mut u = part("U", &[("1", 0.0, 0.0, 1.0, 1.0), ("2", 10.0, 0.0, 1.0, 1.0)]);
-    u.pins.insert("G$1.GND".into(), vec!["1".into(), "2".into()]);
+    let mut u = part(
+        "U",
+        &[("1", 0.0, 0.0, 1.0, 1.0), ("2", 10.0, 0.0, 1.0, 1.0)],
+    );
+    u.pins
+        .insert("G$1.GND".into(), vec!["1".into(), "2".into()]);
     u.route_any.insert("G$1.GND".into());
     let c = circuit(
         vec![u, part("R", &[("1", 0.0, 0.0, 1.0, 1.0)])],
@@ -339,7 +350,10 @@ fn parts_spread_over_several_islands() {
     let out = packed(&c, &region, &params(1.0));
     let fps = check(&c, &out, &region, 1.0);
     let xs: Vec<f64> = fps.values().map(|f| centre(*f)[0]).collect();
-    assert!(xs.iter().any(|&x| x < 10.0) && xs.iter().any(|&x| x > 30.0), "{xs:?}");
+    assert!(
+        xs.iter().any(|&x| x < 10.0) && xs.iter().any(|&x| x > 30.0),
+        "{xs:?}"
+    );
 }
 
 #[test]
@@ -357,7 +371,10 @@ fn a_region_too_small_names_the_parts_that_do_not_fit() {
         }) => {
             assert_eq!(parts, ["MID", "SMALL"]);
             assert!((free_mm2 - 100.0).abs() < 1e-9, "{free_mm2}");
-            assert!((needed_mm2 - (81.0 + 49.0 + 9.0)).abs() < 1e-9, "{needed_mm2}");
+            assert!(
+                (needed_mm2 - (81.0 + 49.0 + 9.0)).abs() < 1e-9,
+                "{needed_mm2}"
+            );
         }
         other => panic!("{other:?}"),
     }
@@ -456,12 +473,15 @@ fn improvement_shortens_the_greedy_rubberbands() {
     let mut row = out.clone();
     let mut x = 0.0;
     for p in &mut row {
-        let f = footprint(&c, &Packed {
-            rotation: 0.0,
-            x: 0.0,
-            y: 0.0,
-            ..p.clone()
-        });
+        let f = footprint(
+            &c,
+            &Packed {
+                rotation: 0.0,
+                x: 0.0,
+                y: 0.0,
+                ..p.clone()
+            },
+        );
         (p.x, p.y, p.rotation) = (x - f[0], 20.0, 0.0);
         x += f[2] - f[0] + 1.0;
     }
@@ -497,9 +517,18 @@ fn bad_input_is_an_error_not_a_panic() {
         err(&c, &["A"], fine),
         "pack: a step of 0.001 mm makes 100020001 grid positions over the region (at most 4000000); use a larger step"
     );
-    assert_eq!(err(&c, &["B"], params(1.0)), "pack: the circuit has no part B");
-    assert_eq!(err(&c, &["A", "A"], params(1.0)), "pack: part A is listed twice");
-    assert_eq!(err(&c, &["EMPTY"], params(1.0)), "pack: part EMPTY has no pads");
+    assert_eq!(
+        err(&c, &["B"], params(1.0)),
+        "pack: the circuit has no part B"
+    );
+    assert_eq!(
+        err(&c, &["A", "A"], params(1.0)),
+        "pack: part A is listed twice"
+    );
+    assert_eq!(
+        err(&c, &["EMPTY"], params(1.0)),
+        "pack: part EMPTY has no pads"
+    );
     c.parts[0].pads[0].x = f64::INFINITY;
     assert_eq!(
         err(&c, &["A"], params(1.0)),
