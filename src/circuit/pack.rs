@@ -41,6 +41,8 @@ const MAX_ROUNDS: usize = 10;
 const PULL: f64 = 0.05;
 /// Positions per part whose exact rubberband is compared when it is put back.
 const TOP_K: usize = 4;
+/// Rounding allowance of the lower bounds that prune the search, mm.
+const SLACK: f64 = 1e-9;
 /// An improvement counts when it shortens the rubberbands by more than this, mm.
 const EPS: f64 = 1e-9;
 
@@ -919,7 +921,8 @@ impl<'a> Packer<'a> {
         k: usize,
     ) -> Vec<(f64, Pose)> {
         let g = &self.grid;
-        let mut best: Vec<(f64, Pose)> = Vec::with_capacity(k + 1);
+        // The k best as (cost, turn, grid index), in that order.
+        let mut best: Vec<(f64, usize, usize)> = Vec::with_capacity(k + 1);
         for (ti, t) in self.items[p].turns.iter().enumerate() {
             let mut free = self.fits[t.fit].clone();
             // Clear the positions too close to a placed part.
@@ -968,45 +971,147 @@ impl<'a> Packer<'a> {
                     }
                 }
             }
+            let bit = |i: usize, j: usize| {
+                let idx = j * g.nx + i;
+                free[idx / 64] & (1 << (idx % 64)) != 0
+            };
+            if goal == Goal::BottomLeft {
+                // Row by row from the bottom, left to right: the first free positions.
+                'scan: for (w, &word) in free.iter().enumerate() {
+                    let mut bits = word;
+                    while bits != 0 {
+                        let idx = w * 64 + bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        if best.len() == k && best.last().is_some_and(|l| idx as f64 > l.0) {
+                            break 'scan;
+                        }
+                        offer(&mut best, k, idx as f64, ti, idx);
+                    }
+                }
+                continue;
+            }
             let half = [unscaled(t.size[0]) / 2.0, unscaled(t.size[1]) / 2.0];
             let origin = self.corner(0, 0);
-            for (w, &word) in free.iter().enumerate() {
-                let mut bits = word;
-                while bits != 0 {
-                    let idx = w * 64 + bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    let (i, j) = (idx % g.nx, idx / g.nx);
-                    let cost = match goal {
-                        Goal::BottomLeft => idx as f64,
-                        Goal::Rubberband => {
-                            let c = [
-                                origin[0] + i as f64 * self.step,
-                                origin[1] + j as f64 * self.step,
-                            ];
-                            let pull = PULL
-                                * (c[0] + half[0] - self.centre[0])
-                                    .hypot(c[1] + half[1] - self.centre[1]);
-                            targets
-                                .iter()
-                                .map(|ts| {
-                                    ts.iter()
-                                        .map(|t| (c[0] - t[0]).powi(2) + (c[1] - t[1]).powi(2))
-                                        .fold(f64::INFINITY, f64::min)
-                                        .sqrt()
-                                })
-                                .sum::<f64>()
-                                + pull
-                        }
-                    };
-                    if best.len() < k || cost < best[best.len() - 1].0 {
-                        let at = best.partition_point(|b| b.0 <= cost);
-                        best.insert(at, (cost, Pose { turn: ti, i, j }));
-                        best.truncate(k);
+            let x_at = |i: usize| origin[0] + i as f64 * self.step;
+            let y_at = |j: usize| origin[1] + j as f64 * self.step;
+            // Per net, the bounding box of its targets: the distance to it bounds the distance
+            // to the nearest target from below.
+            let boxes: Vec<[f64; 4]> = targets
+                .iter()
+                .map(|ts| {
+                    ts.iter().fold(
+                        [
+                            f64::INFINITY,
+                            f64::INFINITY,
+                            f64::NEG_INFINITY,
+                            f64::NEG_INFINITY,
+                        ],
+                        |b, t| {
+                            [
+                                b[0].min(t[0]),
+                                b[1].min(t[1]),
+                                b[2].max(t[0]),
+                                b[3].max(t[1]),
+                            ]
+                        },
+                    )
+                })
+                .collect();
+            let outside = |v: f64, lo: f64, hi: f64| (lo - v).max(v - hi).max(0.0);
+            // A lower bound of the cost at (x, y), convex in x; with `x = None`, of every
+            // position in row y.
+            let lower = |x: Option<f64>, y: f64| -> f64 {
+                let pull_y = y + half[1] - self.centre[1];
+                let pull = match x {
+                    Some(x) => (x + half[0] - self.centre[0]).hypot(pull_y),
+                    None => pull_y.abs(),
+                };
+                PULL * pull
+                    + boxes
+                        .iter()
+                        .map(|b| {
+                            let dy = outside(y, b[1], b[3]);
+                            x.map_or(dy, |x| outside(x, b[0], b[2]).hypot(dy))
+                        })
+                        .sum::<f64>()
+            };
+            let bound = |best: &Vec<(f64, usize, usize)>| {
+                if best.len() < k {
+                    f64::INFINITY
+                } else {
+                    best[best.len() - 1].0 + SLACK
+                }
+            };
+            // Rows by their bound, most promising first.
+            let mut rows: Vec<(f64, usize)> =
+                (0..g.ny).map(|j| (lower(None, y_at(j)), j)).collect();
+            rows.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for (row_bound, j) in rows {
+                if row_bound > bound(&best) {
+                    break;
+                }
+                let y = y_at(j);
+                let f = |i: usize| lower(Some(x_at(i)), y);
+                // The minimum of the convex bound along the row, then where it stays within
+                // the k-th best.
+                let (mut lo, mut hi) = (0, g.nx - 1);
+                while hi - lo > 2 {
+                    let (m1, m2) = (lo + (hi - lo) / 3, hi - (hi - lo) / 3);
+                    if f(m1) < f(m2) {
+                        hi = m2;
+                    } else {
+                        lo = m1;
                     }
+                }
+                let Some(mid) = (lo..=hi).min_by(|&a, &b| f(a).total_cmp(&f(b))) else {
+                    continue;
+                };
+                let limit = bound(&best);
+                if f(mid) > limit {
+                    continue;
+                }
+                let (mut a, mut b) = (0, mid);
+                while a < b {
+                    let m = (a + b) / 2;
+                    if f(m) <= limit { b = m } else { a = m + 1 }
+                }
+                let first = a;
+                let (mut a, mut b) = (mid, g.nx - 1);
+                while a < b {
+                    let m = (a + b).div_ceil(2);
+                    if f(m) <= limit { a = m } else { b = m - 1 }
+                }
+                for i in (first..=a).filter(|&i| bit(i, j)) {
+                    let limit = bound(&best);
+                    let c = [x_at(i), y];
+                    let mut cost = PULL
+                        * (c[0] + half[0] - self.centre[0]).hypot(c[1] + half[1] - self.centre[1]);
+                    for ts in &targets {
+                        if cost > limit {
+                            break;
+                        }
+                        cost += ts
+                            .iter()
+                            .map(|t| (c[0] - t[0]).powi(2) + (c[1] - t[1]).powi(2))
+                            .fold(f64::INFINITY, f64::min)
+                            .sqrt();
+                    }
+                    offer(&mut best, k, cost, ti, j * g.nx + i);
                 }
             }
         }
-        best
+        best.into_iter()
+            .map(|(cost, turn, idx)| {
+                (
+                    cost,
+                    Pose {
+                        turn,
+                        i: idx % g.nx,
+                        j: idx / g.nx,
+                    },
+                )
+            })
+            .collect()
     }
 
     /// Places every item it can, in `order`, each at its best position by `goal`; returns the
@@ -1157,6 +1262,23 @@ impl<'a> Packer<'a> {
                 })
             })
             .collect()
+    }
+}
+
+/// Keeps `(cost, turn, idx)` among the `k` best of `best` (sorted by cost, then turn, then
+/// index, so the result does not depend on the order positions are offered in).
+fn offer(best: &mut Vec<(f64, usize, usize)>, k: usize, cost: f64, turn: usize, idx: usize) {
+    let key = (cost, turn, idx);
+    let less = |a: &(f64, usize, usize), b: &(f64, usize, usize)| {
+        a.0.total_cmp(&b.0)
+            .then(a.1.cmp(&b.1))
+            .then(a.2.cmp(&b.2))
+            .is_lt()
+    };
+    if best.len() < k || best.last().is_some_and(|last| less(&key, last)) {
+        let at = best.partition_point(|b| less(b, &key));
+        best.insert(at, key);
+        best.truncate(k);
     }
 }
 
