@@ -19,8 +19,11 @@
 //! are placed greedily, most connected first, each where it adds the least rubberband to the
 //! parts already placed; then parts are taken out and put back where they do best, and pairs
 //! swap places, while the total rubberband shrinks (a bounded number of rounds). When the
-//! greedy pass leaves parts out, it is retried largest part first, then packed bottom-left.
-//! Everything is deterministic: fixed orders, ties broken by index and name.
+//! greedy pass leaves parts out, it is retried with those parts placed first (a few times),
+//! then largest part first, then packed bottom-left. The search for a position skips rows and
+//! columns where a lower bound of the added rubberband (the distance to each net's bounding box)
+//! cannot beat the best found, so a large region costs little more than a tight one.
+//! Everything is deterministic: fixed orders, ties broken by cost, turn and grid index.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -34,6 +37,8 @@ pub const MAX_GRID_POINTS: u64 = 4_000_000;
 const MAX_PARAM_MM: f64 = 10_000.0;
 /// The smallest step accepted, mm.
 const MIN_STEP_MM: f64 = 0.001;
+/// Greedy passes, most connected first, that put the parts left out before first.
+const RETRIES: usize = 3;
 /// Improvement rounds (re-insertions and swaps) at most.
 const MAX_ROUNDS: usize = 10;
 /// Weight of the pull towards the region's centroid, per mm, in the search for a position: it
@@ -178,23 +183,40 @@ pub fn pack(
         });
     };
     let packer = Packer::new(circuit, items, grid, &region, params);
-    let attempts = [
-        (Order::Connected, Goal::Rubberband),
+    // Most connected first; the parts that found no place go first in the next try (largest
+    // first), a few times; then largest first, and at last packed bottom-left.
+    let mut attempts: Vec<(Order, Goal)> = vec![(Order::Connected, Goal::Rubberband); RETRIES + 1];
+    attempts.extend([
         (Order::Largest, Goal::Rubberband),
         (Order::Largest, Goal::BottomLeft),
-    ];
+    ]);
     let mut best_failure: Option<(f64, Vec<usize>)> = None;
+    let mut first: Vec<usize> = Vec::new();
     for (order, goal) in attempts {
         let mut state = vec![None; packer.items.len()];
-        let left = packer.greedy(&mut state, order, goal);
+        let ahead = if matches!(order, Order::Connected) {
+            first.as_slice()
+        } else {
+            &[]
+        };
+        let left = packer.greedy(&mut state, ahead, order, goal);
         if left.is_empty() {
             packer.improve(&mut state);
             return Ok(packer.output(&state));
         }
         let lost: f64 = left.iter().map(|&p| packer.items[p].need).sum();
         if best_failure.as_ref().is_none_or(|(l, _)| lost < *l) {
-            best_failure = Some((lost, left));
+            best_failure = Some((lost, left.clone()));
         }
+        first.extend(
+            left.into_iter()
+                .filter(|p| !first.contains(p))
+                .collect::<Vec<_>>(),
+        );
+        first.sort_by(|&a, &b| {
+            let (a, b) = (&packer.items[a], &packer.items[b]);
+            b.area.total_cmp(&a.area).then(a.name.cmp(b.name))
+        });
     }
     let mut left = best_failure.map(|(_, l)| l).unwrap_or_default();
     left.sort_by(|&a, &b| {
@@ -1114,9 +1136,15 @@ impl<'a> Packer<'a> {
             .collect()
     }
 
-    /// Places every item it can, in `order`, each at its best position by `goal`; returns the
-    /// items that found no place.
-    fn greedy(&self, state: &mut [Option<Pose>], order: Order, goal: Goal) -> Vec<usize> {
+    /// Places every item it can, those in `ahead` first, then in `order`, each at its best
+    /// position by `goal`; returns the items that found no place.
+    fn greedy(
+        &self,
+        state: &mut [Option<Pose>],
+        ahead: &[usize],
+        order: Order,
+        goal: Goal,
+    ) -> Vec<usize> {
         let n = self.items.len();
         let mut done = vec![false; n];
         let mut left = Vec::new();
@@ -1126,20 +1154,23 @@ impl<'a> Packer<'a> {
             y.area.total_cmp(&x.area).then(x.name.cmp(y.name))
         };
         for _ in 0..n {
-            let next = (0..n).filter(|&p| !done[p]).min_by(|&a, &b| match order {
-                Order::Largest => by_area(a, b),
-                Order::Connected => {
-                    let to_placed = |p: usize| -> f64 {
-                        (0..n)
-                            .filter(|&q| state[q].is_some())
-                            .map(|q| self.strength[p][q])
-                            .sum()
-                    };
-                    to_placed(b)
-                        .total_cmp(&to_placed(a))
-                        .then(total[b].total_cmp(&total[a]))
-                        .then(by_area(a, b))
-                }
+            let next = ahead.iter().copied().find(|&p| !done[p]);
+            let next = next.or_else(|| {
+                (0..n).filter(|&p| !done[p]).min_by(|&a, &b| match order {
+                    Order::Largest => by_area(a, b),
+                    Order::Connected => {
+                        let to_placed = |p: usize| -> f64 {
+                            (0..n)
+                                .filter(|&q| state[q].is_some())
+                                .map(|q| self.strength[p][q])
+                                .sum()
+                        };
+                        to_placed(b)
+                            .total_cmp(&to_placed(a))
+                            .then(total[b].total_cmp(&total[a]))
+                            .then(by_area(a, b))
+                    }
+                })
             });
             let Some(p) = next else { break };
             done[p] = true;
