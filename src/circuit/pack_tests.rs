@@ -552,3 +552,28 @@ fn a_slanted_boundary_is_tested_exactly() {
     let out = packed(&c, &region, &params(0.7));
     check(&c, &out, &region, 0.7);
 }
+
+#[test]
+fn a_crowded_region_is_packed_when_the_connected_order_leaves_a_part_out() {
+    // Four connected 2 mm blocks go to the middle first and leave no 7 mm square free; the
+    // large unconnected block only fits in a corner, with the small ones along its sides.
+    let mut parts = vec![block("BIG", 7.0)];
+    parts.extend((0..4).map(|k| block(&format!("S{k}"), 2.0)));
+    let c = circuit(
+        parts,
+        &[
+            ("N1", &[("S0", "1"), ("S1", "1")]),
+            ("N2", &[("S1", "1"), ("S2", "1")]),
+            ("N3", &[("S2", "1"), ("S3", "1")]),
+        ],
+    );
+    let region = rect_region(0.0, 0.0, 12.0, 12.0);
+    let out = packed(&c, &region, &params(1.0));
+    let fps = check(&c, &out, &region, 1.0);
+    // BIG in a corner: 7 mm plus the gap plus a 2 mm block is 10 mm of the 12.
+    let big = fps["BIG"];
+    assert!(
+        (big[0] <= 0.5 || big[2] >= 11.5) && (big[1] <= 0.5 || big[3] >= 11.5),
+        "{big:?}"
+    );
+}
