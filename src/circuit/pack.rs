@@ -575,17 +575,19 @@ impl Grid {
                 }
             }
         }
-        // The other cells: inside or outside by their centre (even-odd along the row).
-        let mut xs: Vec<f64> = Vec::new();
-        for j in 0..ny {
-            let yc = y0 + j as Coord * s + s / 2;
-            xs.clear();
-            for &(a, b) in &edges {
+        // The other cells: inside or outside by their centre (even-odd along the row). Each
+        // edge adds its crossing to the rows whose centre line it spans.
+        let mut crossings: Vec<Vec<f64>> = vec![Vec::new(); ny];
+        for &(a, b) in &edges {
+            for j in range(a.y.min(b.y) - s, a.y.max(b.y), y0, ny) {
+                let yc = y0 + j as Coord * s + s / 2;
                 if (a.y > yc) != (b.y > yc) {
                     let t = (yc - a.y) as f64 / (b.y - a.y) as f64;
-                    xs.push(a.x as f64 + t * (b.x - a.x) as f64);
+                    crossings[j].push(a.x as f64 + t * (b.x - a.x) as f64);
                 }
             }
+        }
+        for (j, xs) in crossings.iter_mut().enumerate() {
             xs.sort_by(f64::total_cmp);
             let mut k = 0;
             for i in 0..nx {

@@ -577,3 +577,27 @@ fn a_crowded_region_is_packed_when_the_connected_order_leaves_a_part_out() {
         "{big:?}"
     );
 }
+
+#[test]
+fn a_round_region_of_many_edges() {
+    // A disc of radius 15 mm as a 720-gon: every boundary cell is crossed by slanted edges.
+    let disc: Vec<(f64, f64)> = (0..720)
+        .map(|k| {
+            let a = (k as f64 / 2.0).to_radians();
+            (15.0 * a.cos(), 15.0 * a.sin())
+        })
+        .collect();
+    let region = vec![ExPolygon {
+        contour: ring(&disc),
+        holes: vec![],
+    }];
+    let c = chain(20);
+    let out = packed(&c, &region, &params(1.0));
+    let fps = check(&c, &out, &region, 1.0);
+    // Footprint corners stay within the circle.
+    for (name, f) in &fps {
+        for (x, y) in [(f[0], f[1]), (f[2], f[1]), (f[2], f[3]), (f[0], f[3])] {
+            assert!(x.hypot(y) <= 15.0 + 1e-6, "{name} at {f:?}");
+        }
+    }
+}
