@@ -21,6 +21,7 @@ mod golden;
 mod grammar;
 mod jet;
 mod outputs;
+mod pack_corpus;
 mod place;
 mod postprocess;
 mod postprocess_e2e;

@@ -19,6 +19,7 @@ mod placement;
 pub mod placement_toml;
 mod rubberband;
 pub mod octopnp;
+pub mod pack;
 pub mod settings;
 pub mod stage;
 mod three_de;
