@@ -404,3 +404,113 @@ fn refusals_name_the_parts_the_plane_and_the_file() {
     assert!(err.contains(&*wifly.display().to_string()), "{err}");
     assert!(!out.exists());
 }
+
+/// `--auto` packs LilyPad Vibe, Tri-Color LED and OpenLog into a block; the placement passes
+/// its checks, every part sits inside the block `route.cavity_offset` + `route.wall_clearance`
+/// from its sides on one plane, the print routes every wire (no `--allow-unrouted`), and the
+/// circuit rebuilt from the G-code has every net connected and no short.
+#[test]
+fn auto_placed_boards_route_every_wire() {
+    let Some(corpus) = corpus() else {
+        return;
+    };
+    let dir = temp_dir();
+    let d = dir.path();
+    let model = block(d, "block", [70.0, 60.0, 6.0]);
+    for name in ["LilyPad_Vibe_Board", "LilyPad_Tri-Color_LED", "OpenLog"] {
+        let sch = board_file(&corpus, name).with_extension("sch");
+        let out = d.join(format!("{name}.toml"));
+        let (code, summary, err) = place(&[
+            "--model".as_ref(),
+            model.as_os_str(),
+            "--auto".as_ref(),
+            "--circuit".as_ref(),
+            sch.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ]);
+        assert_eq!(code, Some(0), "{name}: {summary} {err}");
+        assert_eq!(summary["problems"], Value::Array(Vec::new()), "{name}");
+        let planes = summary["planes"].as_array().expect("planes");
+        assert_eq!(planes.len(), 1, "{name}");
+        // The default plane: under the 6 mm top by the 1 mm body and 1 mm of cover.
+        assert_eq!(planes[0].as_f64(), Some(4.0), "{name}");
+        let placed = parts(&out);
+        assert!(placed.len() >= 5, "{name}");
+        for (part, [x, y, z, rotation]) in &placed {
+            assert!(
+                x.abs() < 35.0 - 1.3 && y.abs() < 30.0 - 1.3,
+                "{name}: {part} at {x}, {y}"
+            );
+            assert_eq!(*z, 4.0);
+            assert_eq!(rotation % 90.0, 0.0, "{name}: {part}");
+        }
+        let gcode = d.join(format!("{name}.gcode"));
+        let o = conduit([
+            "slice".as_ref(),
+            model.as_os_str(),
+            "--circuit".as_ref(),
+            sch.as_os_str(),
+            "--placement".as_ref(),
+            out.as_os_str(),
+            "-o".as_ref(),
+            gcode.as_os_str(),
+            // OpenLog's TQFP-32 at 0.8 mm pitch needs traces narrower than the default.
+            "--set".as_ref(),
+            "route.conductive_width=0.4".as_ref(),
+        ]);
+        let said = format!("{}{}", stdout(&o), stderr(&o));
+        assert!(o.status.success(), "{name}: {said}");
+        assert!(said.contains(" wires routed ("), "{name}: {said}");
+        let o = conduit([
+            "check".as_ref(),
+            gcode.as_os_str(),
+            "--circuit".as_ref(),
+            sch.as_os_str(),
+            "--placement".as_ref(),
+            out.as_os_str(),
+            "--model".as_ref(),
+            model.as_os_str(),
+        ]);
+        let said = stdout(&o);
+        assert_eq!(o.status.code(), Some(0), "{name}: {said}{}", stderr(&o));
+        assert!(
+            said.contains(" 0 shorts, 0 runs outside the solid"),
+            "{name}: {said}"
+        );
+        println!(
+            "{name}: {} parts packed; {}",
+            placed.len(),
+            said.lines()
+                .find(|l| l.starts_with("circuit:"))
+                .unwrap_or("")
+        );
+    }
+}
+
+/// Parts that do not fit are named, with the room there is and the room they need.
+#[test]
+fn auto_placement_names_the_parts_that_find_no_room() {
+    let Some(corpus) = corpus() else {
+        return;
+    };
+    let dir = temp_dir();
+    let d = dir.path();
+    let model = block(d, "small", [14.0, 12.0, 6.0]);
+    let sch = board_file(&corpus, "OpenLog").with_extension("sch");
+    let out = d.join("p.toml");
+    let (code, _, err) = place(&[
+        "--model".as_ref(),
+        model.as_os_str(),
+        "--auto".as_ref(),
+        "--circuit".as_ref(),
+        sch.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, Some(1));
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("no room for "), "{err}");
+    assert!(err.contains(" mm², the parts need about "), "{err}");
+    assert!(!out.exists());
+}

@@ -210,7 +210,7 @@ fn covering_parts(
 }
 
 /// Whether a circuit part takes part in the layout: it has pads, one of them on a net.
-fn has_connected_pads(circuit: &Circuit, part: &Part) -> bool {
+pub(crate) fn has_connected_pads(circuit: &Circuit, part: &Part) -> bool {
     circuit
         .nets
         .iter()

@@ -186,7 +186,7 @@ pub struct PlaceArgs {
     #[arg(long, value_name = "A..B", value_parser = parse_range, requires = "auto", allow_hyphen_values = true)]
     pub z_range: Option<[f64; 2]>,
     /// With --auto: smallest distance between two parts' footprints, mm (default: both
-    /// cavities, `route.wall_clearance` and two traces with their channels).
+    /// cavities, `route.wall_clearance` and four traces with their channels).
     #[arg(long, value_name = "MM", requires = "auto")]
     pub spacing: Option<f64>,
     /// Print the summary as JSON.

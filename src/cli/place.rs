@@ -6,7 +6,7 @@ use anyhow::Context;
 use super::{Failure, args::PlaceArgs, config::resolve};
 use conduit::circuit::Circuit;
 use conduit::pipeline::place::{
-    BottomChoice, FromBoard, PlaceOutcome, PlaneChoice, place_from_board,
+    Auto, BottomChoice, FromBoard, PlaceOutcome, PlaneChoice, place_auto, place_from_board,
 };
 use conduit::scene::OutputSet;
 
@@ -52,7 +52,20 @@ pub(crate) fn run(args: PlaceArgs) -> Result<(), Failure> {
             .with_context(|| format!("placing {} in {}", brd.display(), args.model.display()))?;
         (outcome, format!("from {}", brd.display()))
     } else {
-        return Err(Failure::Work(anyhow::anyhow!("--auto is not available")));
+        let how = Auto {
+            z_range: args.z_range.or(args.z.map(|z| [z; 2])),
+            from_top: args.z_from_top,
+            spacing: args.spacing,
+            body_height: args.body_height,
+        };
+        let outcome = place_auto(&scene, &cfg, &circuit, &how, source).with_context(|| {
+            format!(
+                "packing {} in {}",
+                circuit_path.display(),
+                args.model.display()
+            )
+        })?;
+        (outcome, "packed".to_owned())
     };
     report(&args, &outcome, &from)?;
     let problems = outcome.problems.len();

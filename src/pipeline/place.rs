@@ -102,6 +102,27 @@ pub enum PlaceError {
     /// match).
     #[error(transparent)]
     Placement(#[from] PlacementError),
+    /// No part could be packed (the parts that found no room are named).
+    #[error(transparent)]
+    Pack(#[from] crate::circuit::pack::PackError),
+    /// No layer top in the range asked for the seating plane.
+    #[error(
+        "no seating plane between z {low:.3} and {high:.3} mm: the model spans z {bottom:.3} to \
+         {top:.3} mm, and a part {body:.3} mm tall needs route.wall_clearance of material under \
+         and over it"
+    )]
+    NoPlane {
+        /// The range's low end.
+        low: f64,
+        /// The range's high end.
+        high: f64,
+        /// The model's bottom.
+        bottom: f64,
+        /// The model's top.
+        top: f64,
+        /// The body height.
+        body: f64,
+    },
     /// A seating plane outside the model's height.
     #[error(
         "the seating plane z {z:.3} mm is outside the model, which spans z {low:.3} to {high:.3} mm"
@@ -168,6 +189,165 @@ impl Solid {
         }
         Ok(())
     }
+}
+
+/// How `conduit place --auto` packs the parts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Auto {
+    /// The range of model z the seating plane is chosen in; by default from
+    /// `route.wall_clearance` above the model's bottom to under its top by the body height and
+    /// `route.wall_clearance`.
+    pub z_range: Option<[f64; 2]>,
+    /// The seating plane this far under the model's top (instead of a range).
+    pub from_top: Option<f64>,
+    /// Smallest distance between two parts' footprints, mm; by default both cavities,
+    /// `route.wall_clearance` and four traces with their channels.
+    pub spacing: Option<f64>,
+    /// Every part's body height, mm.
+    pub body_height: f64,
+}
+
+/// Step of the packer's grid of candidate positions, mm: fine against the smallest parts
+/// (0402, 1 mm long) and coarse enough that a model of 100 mm packs in a second.
+const PACK_STEP_MM: f64 = 0.5;
+
+/// Packs the circuit's parts inside object 0 of `scene` ([`crate::circuit::pack`]): on the
+/// seating plane in the range where the solid, from the layer under the parts to the cover
+/// over their bodies, leaves the most room (the highest of equals: the most layers under the
+/// parts for the traces), every footprint `route.cavity_offset` and `route.wall_clearance`
+/// inside the solid and `spacing` from the others, turned by quarter turns.
+///
+/// # Errors
+/// [`PlaceError`] when the model cannot be sliced, no plane fits the range, or the parts do
+/// not fit ([`crate::circuit::pack::PackError::NoRoom`] names them).
+pub fn place_auto(
+    scene: &Scene,
+    cfg: &Config,
+    circuit: &Circuit,
+    how: &Auto,
+    source: Option<String>,
+) -> Result<PlaceOutcome, PlaceError> {
+    use crate::circuit::pack::{PackError, PackParams, pack};
+    let solid = Solid::of(scene, cfg)?;
+    let r = &cfg.route;
+    let (bottom, top) = (solid.bbox.min[2], solid.bbox.max[2]);
+    let body = how.body_height;
+    if !(body.is_finite() && body > 0.0) {
+        return Err(BoardLayoutError::BadNumber {
+            what: "--body-height",
+            rule: "a number of mm > 0",
+            value: body,
+        }
+        .into());
+    }
+    let [low, high] = match (how.z_range, how.from_top) {
+        (Some(range), _) => range,
+        (None, Some(d)) => [top - d; 2],
+        (None, None) => [bottom + r.wall_clearance, top - body - r.wall_clearance],
+    };
+    // Candidate planes: the layer tops in the range (model z), highest first.
+    let dz = solid.offset[2];
+    let candidates: Vec<(usize, f64)> = solid
+        .zs
+        .iter()
+        .enumerate()
+        .map(|(k, l)| (k, ((l.top - dz) * 1e6).round() / 1e6))
+        .filter(|&(_, z)| z >= low - 1e-9 && z <= high + 1e-9)
+        .rev()
+        .collect();
+    let inset = -(r.cavity_offset + r.wall_clearance);
+    let mut best: Option<(f64, f64, Vec<ExPolygon>)> = None;
+    for &(seat, z) in &candidates {
+        // The solid from the layer the parts stand on up to the cover over their bodies.
+        let cover_top = z + dz + body + r.wall_clearance;
+        let mut region = solid.islands[seat].clone();
+        for (k, l) in solid.zs.iter().enumerate().skip(seat + 1) {
+            if l.bottom >= cover_top - 1e-6 {
+                break;
+            }
+            region = crate::geom::intersection(&region, &solid.islands[k]);
+        }
+        let region = crate::geom::offset(&region, inset, crate::geom::Join::Miter(2.0));
+        let area: f64 = region.iter().map(ExPolygon::area_mm2).sum();
+        if best.as_ref().is_none_or(|(a, _, _)| area > a * 1.01) {
+            best = Some((area, z, region));
+        }
+    }
+    let Some((_, z, region)) = best else {
+        return Err(PlaceError::NoPlane {
+            low,
+            high,
+            bottom,
+            top,
+            body,
+        });
+    };
+    let mut left_out = Vec::new();
+    let mut names: Vec<&str> = Vec::new();
+    for part in &circuit.parts {
+        if part.pads.is_empty() {
+            left_out.push(format!("{}: no pads", part.name));
+        } else if !crate::circuit::board_layout::has_connected_pads(circuit, part) {
+            left_out.push(format!("{}: none of its pads is on a net", part.name));
+        } else {
+            names.push(&part.name);
+        }
+    }
+    // Room for the traces that fan out of a side of pins between two parts: four traces with
+    // their channels (a TQFP-32 at 0.4 mm traces routes completely with four, not always with
+    // three), besides both cavities and the wall between them.
+    let gap = how.spacing.unwrap_or(
+        2.0 * r.cavity_offset + r.wall_clearance + 4.0 * (r.conductive_width + r.channel_extra),
+    );
+    let mut step = PACK_STEP_MM;
+    let packed = loop {
+        let params = PackParams {
+            gap,
+            rotate: true,
+            step,
+        };
+        match pack(circuit, &names, &region, &params) {
+            Err(PackError::GridTooFine { .. }) => step *= 2.0,
+            other => break other?,
+        }
+    };
+    let mut placement = Placement {
+        origin: crate::circuit::Origin::Model,
+        source,
+        ..Placement::default()
+    };
+    for p in &packed {
+        placement.parts.push(crate::circuit::PartPlacement {
+            name: p.name.clone(),
+            x: p.x - solid.offset[0],
+            y: p.y - solid.offset[1],
+            z,
+            rotation: p.rotation,
+            tilt: [0.0; 2],
+            mirror: false,
+            method: crate::circuit::PlacingMethod::Auto,
+            connection: crate::circuit::Connection::None,
+            body_height: body,
+            footprint_height: 0.0,
+            body_size: None,
+            object: 0,
+        });
+    }
+    let header = vec![
+        format!(
+            "Packed automatically on the plane z {z:.3} mm, parts {} mm apart; edit freely.",
+            crate::circuit::placement_toml::toml_number(gap)
+        ),
+        "z is the seating plane (the bottom of the part, where its pads are); rotation is \
+         degrees counter-clockwise seen from above."
+            .to_owned(),
+        "body_height is a guess: measure your parts.".to_owned(),
+    ];
+    let describe = |name: &str| Some(describe_part(circuit.part(name)?, "packed"));
+    let toml = placement_toml(&placement, &header, describe);
+    let mut outcome = check(&solid, cfg, circuit, toml, vec![z])?;
+    outcome.left_out = left_out;
+    Ok(outcome)
 }
 
 /// Lays `board` out in object 0 of `scene` for `circuit` (see
