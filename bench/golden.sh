@@ -135,6 +135,11 @@ run slice_led_coin slice samples/circuit_demo/block.stl --circuit samples/circui
     --placement out/led_coin.toml -o out/led_coin.gcode
 run check_led_coin check out/led_coin.gcode --circuit samples/circuit_demo/led_coin.sch \
     --placement out/led_coin.toml --model samples/circuit_demo/block.stl
+run place_led_coin_auto place --model samples/circuit_demo/block.stl --auto \
+    --circuit samples/circuit_demo/led_coin.sch -o out/led_coin_auto.toml
+run slice_led_coin_auto slice samples/circuit_demo/block.stl \
+    --circuit samples/circuit_demo/led_coin.sch --placement out/led_coin_auto.toml \
+    -o out/led_coin_auto.gcode
 run route_demo route samples/circuit_demo/block.stl --circuit samples/circuit_demo/led_coin.sch \
     --placement samples/circuit_demo/placement.toml --out-dir out/route --report out/route.json
 run preview_demo preview out/demo.gcode -o out/preview_demo
