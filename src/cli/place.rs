@@ -101,8 +101,17 @@ fn relative_to(path: &std::path::Path, output: &std::path::Path) -> String {
 /// The summary (text or `--json`), the notes as warnings and the problems as errors (warnings
 /// with `--force`).
 fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure> {
-    for line in &o.notes {
+    // Thin material is worth a look, not a screenful: the first few, the rest with -v.
+    const SHOWN_NOTES: usize = 8;
+    let shown = if super::verbose() { o.notes.len() } else { SHOWN_NOTES };
+    for line in o.notes.iter().take(shown) {
         warnln!("{line}");
+    }
+    if o.notes.len() > shown {
+        warnln!(
+            "{} more cavities with less material than route.wall_clearance (-v lists them)",
+            o.notes.len() - shown
+        );
     }
     for line in &o.problems {
         if args.force {
