@@ -1,27 +1,52 @@
-//! Router benchmark: `cargo run --release --example route_bench` (or `bench/route.sh`).
+//! Router benchmark: `cargo run --release --example route_bench [small|board]` (or
+//! `bench/route.sh`).
 //!
 //! Routes a synthetic circuit with [`conduit::route::route`] and [`RouteParams::default`]: a
-//! solid 40 × 40 × 10 mm block (50 layers of 0.2 mm, each layer's island the 40 mm square) and
-//! 20 wires, one net each, between pad pairs drawn from a fixed-seed generator. Pads lie at
+//! solid block 10 mm tall (50 layers of 0.2 mm, each layer's island the block's square) and
+//! wires, one net each — `small`: 20 wires in a 40 mm block, 5 runs; `board`: 100 wires in a
+//! 60 mm block, the size of a real board's circuit, 1 run — between pad pairs drawn from a fixed-seed generator. Pads lie at
 //! least [`EDGE_MM`] inside the block, on layer tops between 1 and 9 mm; the two pads of a wire
 //! are at most [`MAX_LAYER_STEP`] layers apart (so some wires change layer) and pads of different
-//! nets on nearby layers keep [`PAD_SPACING_MM`] apart. The same input is routed [`RUNS`] times;
-//! the program prints the median wall time, the routed count and the total length against the
-//! sum of the straight-line lower bounds, and fails (exit 1) if the runs disagree.
+//! nets on nearby layers keep [`PAD_SPACING_MM`] apart. The same input is routed the case's
+//! `runs` times; the program prints the median wall time, the routed count and the total length
+//! against the sum of the straight-line lower bounds, and fails (exit 1) if the runs disagree.
 
 use std::time::{Duration, Instant};
 
 use conduit::geom::{ExPolygon, Point2, Point3, Polygon};
 use conduit::route::{PadCopper, RouteLayer, RouteParams, RouteResult, Wire, route};
 
-/// Side of the square block, mm.
-const SIDE_MM: f64 = 40.0;
+/// One benchmark case.
+#[derive(Clone, Copy)]
+struct Case {
+    /// Side of the square block, mm.
+    side: f64,
+    /// Number of wires (= nets).
+    wires: usize,
+    /// Timed runs; the median is reported.
+    runs: usize,
+}
+
+/// The cases by name.
+fn case(name: &str) -> Option<Case> {
+    match name {
+        "small" => Some(Case {
+            side: 40.0,
+            wires: 20,
+            runs: 5,
+        }),
+        "board" => Some(Case {
+            side: 60.0,
+            wires: 100,
+            runs: 1,
+        }),
+        _ => None,
+    }
+}
 /// Layer height, mm.
 const LAYER_MM: f64 = 0.2;
 /// Number of layers (10 mm).
 const LAYERS: usize = 50;
-/// Number of wires (= nets).
-const WIRES: usize = 20;
 /// Distance of every pad from the block's sides, mm.
 const EDGE_MM: f64 = 4.0;
 /// Smallest xy distance between pads of different nets within [`NEAR_LAYERS`] layers, mm.
@@ -30,8 +55,6 @@ const PAD_SPACING_MM: f64 = 3.0;
 const NEAR_LAYERS: i64 = 2;
 /// Largest layer difference between the two pads of a wire.
 const MAX_LAYER_STEP: i64 = 5;
-/// Timed runs; the median is reported.
-const RUNS: usize = 5;
 /// Generator seed.
 const SEED: u64 = 0x00c0_ffee_d00d_2024;
 
@@ -59,12 +82,12 @@ impl Rng {
 }
 
 /// The 50 layers of the block.
-fn layers() -> Vec<RouteLayer> {
+fn layers(c: Case) -> Vec<RouteLayer> {
     let square = Polygon::new(vec![
         Point2::from_mm(0.0, 0.0),
-        Point2::from_mm(SIDE_MM, 0.0),
-        Point2::from_mm(SIDE_MM, SIDE_MM),
-        Point2::from_mm(0.0, SIDE_MM),
+        Point2::from_mm(c.side, 0.0),
+        Point2::from_mm(c.side, c.side),
+        Point2::from_mm(0.0, c.side),
     ]);
     let island = ExPolygon {
         contour: square,
@@ -80,7 +103,7 @@ fn layers() -> Vec<RouteLayer> {
 }
 
 /// The wires: pad pairs from the generator (see the module documentation).
-fn wires() -> Vec<Wire> {
+fn wires(c: Case) -> Vec<Wire> {
     let mut rng = Rng(SEED);
     // (layer, x, y) of every pad so far.
     let mut pads: Vec<(i64, f64, f64)> = Vec::new();
@@ -88,8 +111,8 @@ fn wires() -> Vec<Wire> {
     let highest = LAYERS as i64 - lowest; // 9 mm
     let pad = |rng: &mut Rng, pads: &[(i64, f64, f64)], layer: i64| loop {
         let (x, y) = (
-            rng.range(EDGE_MM, SIDE_MM - EDGE_MM),
-            rng.range(EDGE_MM, SIDE_MM - EDGE_MM),
+            rng.range(EDGE_MM, c.side - EDGE_MM),
+            rng.range(EDGE_MM, c.side - EDGE_MM),
         );
         let clear = pads.iter().all(|&(l, px, py)| {
             (l - layer).abs() > NEAR_LAYERS || (px - x).hypot(py - y) >= PAD_SPACING_MM
@@ -99,7 +122,7 @@ fn wires() -> Vec<Wire> {
         }
     };
     let at = |(layer, x, y): (i64, f64, f64)| Point3::new(x, y, LAYER_MM * layer as f64);
-    (0..WIRES)
+    (0..c.wires)
         .map(|k| {
             let a_layer = rng.int(lowest, highest);
             let b_layer =
@@ -126,17 +149,24 @@ fn totals(r: &RouteResult) -> (usize, f64, f64, usize) {
 }
 
 fn main() {
-    let layers = layers();
-    let wires = wires();
+    let name = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "small".to_owned());
+    let Some(c) = case(&name) else {
+        eprintln!("route_bench: unknown case {name:?}; use small or board");
+        std::process::exit(2);
+    };
+    let layers = layers(c);
+    let wires = wires(c);
     let params = RouteParams::default();
     // A round pad of twice the trace width on each end of every wire.
     let pads: Vec<PadCopper> = wires
         .iter()
         .flat_map(|w| [w.from, w.to].map(|p| PadCopper::round(Some(&w.net), p, 1.2)))
         .collect();
-    let mut times: Vec<Duration> = Vec::with_capacity(RUNS);
+    let mut times: Vec<Duration> = Vec::with_capacity(c.runs);
     let mut first: Option<RouteResult> = None;
-    for run in 0..RUNS {
+    for run in 0..c.runs {
         let started = Instant::now();
         let result = route(&layers, &wires, &pads, &params);
         times.push(started.elapsed());
@@ -154,19 +184,22 @@ fn main() {
         std::process::exit(1);
     };
     times.sort();
-    let median = times[RUNS / 2];
+    let median = times[c.runs / 2];
     let (routed, length, bound, changes) = totals(&result);
     println!(
-        "route_bench: {} wires in a {SIDE_MM:.0} × {SIDE_MM:.0} × {:.0} mm block ({LAYERS} layers)",
+        "route_bench {name}: {} wires in a {:.0} × {:.0} × {:.0} mm block ({LAYERS} layers)",
         wires.len(),
+        c.side,
+        c.side,
         LAYERS as f64 * LAYER_MM
     );
     let ms = |d: &Duration| format!("{:.1}", d.as_secs_f64() * 1e3);
     println!(
-        "time: median {} ms of {RUNS} runs (min {} ms, max {} ms)",
+        "time: median {} ms of {} runs (min {} ms, max {} ms)",
         ms(&median),
+        c.runs,
         ms(&times[0]),
-        ms(&times[RUNS - 1])
+        ms(&times[c.runs - 1])
     );
     println!(
         "routed: {routed} of {} wires, {changes} layer changes",

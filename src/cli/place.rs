@@ -103,7 +103,11 @@ fn relative_to(path: &std::path::Path, output: &std::path::Path) -> String {
 fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure> {
     // Thin material is worth a look, not a screenful: the first few, the rest with -v.
     const SHOWN_NOTES: usize = 8;
-    let shown = if super::verbose() { o.notes.len() } else { SHOWN_NOTES };
+    let shown = if super::verbose() {
+        o.notes.len()
+    } else {
+        SHOWN_NOTES
+    };
     for line in o.notes.iter().take(shown) {
         warnln!("{line}");
     }
