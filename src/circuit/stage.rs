@@ -148,23 +148,18 @@ impl ElectronicsReport {
             out.push("the placement places no part of the circuit".to_owned());
         }
         out.extend(self.part_problems.iter().cloned());
-        out.extend(
-            self.wires
-                .iter()
-                .filter(|w| !w.routed)
-                .map(|w| {
-                    let why = w
-                        .reason
-                        .as_deref()
-                        .filter(|r| r.starts_with(TIME_LIMIT_REASON))
-                        .map(|r| format!(": {r}"))
-                        .unwrap_or_default();
-                    format!(
-                        "net {} could not be routed ({} to {}){why}",
-                        w.net, w.from, w.to
-                    )
-                }),
-        );
+        out.extend(self.wires.iter().filter(|w| !w.routed).map(|w| {
+            let why = w
+                .reason
+                .as_deref()
+                .filter(|r| r.starts_with(TIME_LIMIT_REASON))
+                .map(|r| format!(": {r}"))
+                .unwrap_or_default();
+            format!(
+                "net {} could not be routed ({} to {}){why}",
+                w.net, w.from, w.to
+            )
+        }));
         out
     }
 }

@@ -249,10 +249,7 @@ impl<'a> Board<'a> {
     /// their own. Kept only if more wires are routed than before (a failed wire routed at the
     /// cost of another is undone); returns whether it was kept.
     fn attempt(&mut self, f: usize, depth: usize) -> bool {
-        if depth == 0
-            || self.routes[f].as_ref().is_some_and(|r| r.routed)
-            || self.past_deadline()
-        {
+        if depth == 0 || self.routes[f].as_ref().is_some_and(|r| r.routed) || self.past_deadline() {
             return false;
         }
         let probe = self.search(f, false);
