@@ -40,11 +40,18 @@ pub fn routing_bar() -> (ProgressBar, ProgressFn) {
 pub fn routing_callback(bar: &ProgressBar) -> ProgressFn {
     let bar = bar.clone();
     Arc::new(move |p: RouteProgress| {
-        if let Ok(style) = ProgressStyle::with_template(ROUTING_TEMPLATE) {
-            bar.set_style(style.progress_chars("=> "));
-        }
-        bar.set_length(p.total as u64);
-        bar.set_position(p.done as u64);
+        routing_style(&bar);
+        bar.update(|state| {
+            state.set_len(p.total as u64);
+            state.set_pos(p.done as u64);
+        });
         bar.set_message(format!(", round {}, {} unrouted", p.round, p.unrouted));
     })
+}
+
+/// Styles `bar` as the routing bar, with no wire counted yet.
+pub fn routing_style(bar: &ProgressBar) {
+    if let Ok(style) = ProgressStyle::with_template(ROUTING_TEMPLATE) {
+        bar.set_style(style.progress_chars("=> "));
+    }
 }

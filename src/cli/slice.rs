@@ -376,8 +376,18 @@ fn stage_style(bar: &ProgressBar) {
     }
 }
 
-/// Shows `stage` on the stage bar.
+/// Shows `stage` on the stage bar (routing shows the router's bar).
 fn show_stage(bar: &ProgressBar, stage: Stage) {
+    if stage == Stage::Route {
+        // The router's callback moves the bar from here on.
+        bar.set_message("");
+        super::progress::routing_style(bar);
+        bar.update(|state| {
+            state.set_len(0);
+            state.set_pos(0);
+        });
+        return;
+    }
     stage_style(bar);
     bar.set_length(Stage::ALL.len() as u64);
     bar.set_position(stage as u64);
