@@ -65,6 +65,16 @@ fn a_tiny_time_limit_fails_the_job_naming_the_limit() {
     }
     assert!(!out.exists() && !report.exists(), "nothing is written");
     assert_eq!(files_in(dir.path()), Vec::<PathBuf>::new());
+    // Standard error is a pipe here: no progress bar.
+    assert!(!err.contains("routing ["), "{err}");
+}
+
+#[test]
+fn the_defaults_list_the_time_limit() {
+    let o = conduit(["config", "--defaults"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = crate::support::stdout(&o);
+    assert!(text.contains("\ntime_limit = 180.0\n"), "{text}");
 }
 
 #[test]
