@@ -9,9 +9,9 @@
 #
 # A refactor proves itself by printing the same lines as bench/golden.txt (the test
 # `golden_outputs_are_unchanged` runs this script and compares). Reports are hashed with their
-# wall-clock fields (`stage_seconds`) removed; everything else is hashed as written. Commands
-# whose input is the shared corpus (a peer slicer's G-code for postprocess) run only when
-# ../shared/corpus exists, and their lines are marked `corpus:`.
+# wall-clock fields (`stage_seconds`, `wall_seconds`) removed; everything else is hashed as
+# written. Commands whose input is the shared corpus (a peer slicer's G-code for postprocess)
+# run only when ../shared/corpus exists, and their lines are marked `corpus:`.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 bin="${CONDUIT:-$root/target/release/conduit}"
@@ -168,7 +168,7 @@ find . -type f | LC_ALL=C sort | while read -r f; do
 import json, sys
 def strip(v):
     if isinstance(v, dict):
-        return {k: strip(x) for k, x in v.items() if k != "stage_seconds"}
+        return {k: strip(x) for k, x in v.items() if k not in ("stage_seconds", "wall_seconds")}
     if isinstance(v, list):
         return [strip(x) for x in v]
     return v

@@ -56,6 +56,11 @@ pub struct RouteSettings {
     /// (plus `detour_slack`): a trace's resistance grows with its length, so a wire that needs a
     /// longer route is reported unrouted. Default 3.
     pub max_detour: f64,
+    /// Longest time the routing of a job (every object) may take, seconds; 0 = no limit. At
+    /// the limit the router starts no new search and gives up the one running: what is routed
+    /// stays routed, and the other wires are reported unrouted with the reason "time limit
+    /// reached". A job that finishes in time is not changed by it. Default 180.
+    pub time_limit: f64,
     /// Allowance added to the detour limit, mm: room for layer changes and a way round a part on
     /// short wires. Default 30.
     pub detour_slack: f64,
@@ -93,6 +98,7 @@ impl Default for RouteSettings {
             layer_span: r.layer_span,
             rip_up_rounds: r.rip_up_rounds,
             max_detour: r.max_detour,
+            time_limit: r.time_limit,
             detour_slack: r.detour_slack,
             pad_drops: false,
             terminal_pad: 2.0,
@@ -122,6 +128,7 @@ impl RouteSettings {
             rip_up_rounds: self.rip_up_rounds,
             max_detour: self.max_detour,
             detour_slack: self.detour_slack,
+            time_limit: self.time_limit,
             ..RouteParams::default()
         }
     }
@@ -149,6 +156,7 @@ impl RouteSettings {
             ("layer_change_penalty", self.layer_change_penalty),
             ("detour_slack", self.detour_slack),
             ("wall_clearance", self.wall_clearance),
+            ("time_limit", self.time_limit),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 out.push(format!("route.{key} must be ≥ 0, got {v}"));

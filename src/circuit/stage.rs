@@ -42,6 +42,9 @@ pub struct ElectronicsParams {
     pub terminal_pad: f64,
 }
 
+/// How the reason of a wire stopped by the time limit starts (see [`crate::route::Unrouted::TimeLimit`]).
+const TIME_LIMIT_REASON: &str = "time limit reached";
+
 /// A circuit and where its parts go: what `--circuit` and `--placement` give.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Electronics {
@@ -75,6 +78,20 @@ pub struct NetRoute {
     /// (`FROM-TO` pins), as a T joint, since that trace already reaches the pin. `None` when
     /// it runs pin to pin.
     pub joins: Option<String>,
+    /// Why the wire was not routed ("no path within the detour limit (route.max_detour)",
+    /// "time limit reached (route.time_limit = 180 s)", ...); `None` when it was.
+    pub reason: Option<String>,
+}
+
+/// How the routing of a job went, for the report.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct RoutingSummary {
+    /// Rip-up and reroute rounds run (the most of any object).
+    pub rounds: usize,
+    /// Wall time spent routing, seconds (every object).
+    pub wall_seconds: f64,
+    /// Whether `route.time_limit` stopped routing before it was done.
+    pub time_limit_reached: bool,
 }
 
 /// What the electronics stage did, for the report.
@@ -103,6 +120,8 @@ pub struct ElectronicsReport {
     pub part_problems: Vec<String>,
     /// The terminals: waypoints only one wire of their net reaches, each with a contact pad.
     pub terminals: Vec<TerminalReport>,
+    /// Rounds, time and whether the time limit was reached.
+    pub routing: RoutingSummary,
 }
 
 /// A terminal in the report: where a battery, a connector or a wire is attached.
@@ -121,20 +140,26 @@ pub struct TerminalReport {
 
 impl ElectronicsReport {
     /// Why the circuit was not built as asked, one line each: the placement places no part,
-    /// a part problem, a wire not routed. Empty when every part sits inside the solid and
-    /// every wire is routed.
+    /// a part problem, a wire not routed (with the reason when it is the time limit). Empty
+    /// when every part sits inside the solid and every wire is routed.
     pub fn failures(&self) -> Vec<String> {
         let mut out = Vec::new();
         if self.parts.is_empty() {
             out.push("the placement places no part of the circuit".to_owned());
         }
         out.extend(self.part_problems.iter().cloned());
-        out.extend(
-            self.wires
-                .iter()
-                .filter(|w| !w.routed)
-                .map(|w| format!("net {} could not be routed ({} to {})", w.net, w.from, w.to)),
-        );
+        out.extend(self.wires.iter().filter(|w| !w.routed).map(|w| {
+            let why = w
+                .reason
+                .as_deref()
+                .filter(|r| r.starts_with(TIME_LIMIT_REASON))
+                .map(|r| format!(": {r}"))
+                .unwrap_or_default();
+            format!(
+                "net {} could not be routed ({} to {}){why}",
+                w.net, w.from, w.to
+            )
+        }));
         out
     }
 }
@@ -483,6 +508,7 @@ fn report_between_objects(between: &[&CircuitWire], object: usize, report: &mut 
             layer_changes: 0,
             perimeter_crossings: 0,
             joins: None,
+            reason: Some("a trace cannot leave its object".to_owned()),
         });
     }
 }
@@ -522,7 +548,12 @@ fn route_object(
     report
         .warnings
         .extend(mine.iter().filter_map(|(_, p)| pitch_warning(p, params)));
+    let clock = std::time::Instant::now();
     let result = route(&layers, &wires, &pads, params);
+    let summary = &mut report.routing;
+    summary.rounds = summary.rounds.max(result.rounds);
+    summary.wall_seconds += clock.elapsed().as_secs_f64();
+    summary.time_limit_reached |= result.time_limit_reached;
     carve_channels(islands, &result.channels);
     result
 }
@@ -551,6 +582,7 @@ fn trace_paths(
                 .ends_on_wire
                 .and_then(|k| mine_wires.get(k))
                 .map(|j| format!("{}-{}", j.from, j.to)),
+            reason: w.reason.map(|r| r.to_string()),
         });
         if !w.routed {
             continue;

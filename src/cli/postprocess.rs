@@ -7,7 +7,7 @@ use super::{Failure, args::ConfigSource, args::PostprocessArgs, config::resolve}
 use anyhow::Context;
 use conduit::circuit::Electronics;
 use conduit::config::{Config, HostSettings};
-use conduit::pipeline::postprocess::{Edit, HostPrint, edit, edit_circuit};
+use conduit::pipeline::postprocess::{Edit, HostPrint, edit, edit_circuit_watched};
 use conduit::postprocess::rewrite::SUMMARY_PREFIX;
 use conduit::postprocess::{detect_host, output_name_file, read_gcode};
 use conduit::scene::OutputSet;
@@ -45,8 +45,10 @@ pub(crate) fn run(args: PostprocessArgs) -> Result<(), Failure> {
             }
         }
         Some(e) => {
-            let done = edit_circuit(&gcode, &print, e, &config)
+            let (bar, routing) = super::progress::routing_bar();
+            let done = edit_circuit_watched(&gcode, &print, e, &config, Some(&routing))
                 .with_context(|| path.display().to_string())?;
+            bar.finish_and_clear();
             super::slice::refuse_unbuilt_circuit(
                 &done.plan.report,
                 args.allow_unrouted,

@@ -21,8 +21,10 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
     let cfg = resolve(&args.config)?;
     let scene = super::slice::load_models(&args.models)?;
     let electronics = super::slice::load_electronics(&args.circuit, &args.placement)?;
-    let view = route_scene(&scene, &cfg, &electronics, |_| {})
+    let (bar, routing) = super::progress::routing_bar();
+    let view = route_scene(&scene, &cfg, &electronics, |_| {}, Some(&routing))
         .with_context(|| format!("routing {}", args.circuit.display()))?;
+    bar.finish_and_clear();
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("{}: cannot create the folder", args.out_dir.display()))?;
     let mut written = Vec::new();

@@ -5,7 +5,7 @@ use anyhow::Context;
 use conduit::circuit::Electronics;
 use conduit::circuit::stage::pnp_records;
 use conduit::circuit::{Circuit, Placement};
-use conduit::pipeline::{Stage, slice_clfff, slice_scene_with};
+use conduit::pipeline::{Stage, slice_clfff, slice_scene_watched};
 use conduit::scene::{OutputSet, Scene, load_scene};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -41,12 +41,15 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
         _ => None,
     };
     let bar = stage_bar();
-    let (gcode, _program, summary) =
-        slice_scene_with(&scene, &cfg, electronics.as_ref(), |stage| {
-            bar.set_position(stage as u64);
-            bar.set_message(stage.name());
-        })
-        .with_context(|| format!("slicing {}", args.models[0].display()))?;
+    let routing = super::progress::routing_callback(&bar);
+    let (gcode, _program, summary) = slice_scene_watched(
+        &scene,
+        &cfg,
+        electronics.as_ref(),
+        |stage| show_stage(&bar, stage),
+        Some(&routing),
+    )
+    .with_context(|| format!("slicing {}", args.models[0].display()))?;
     bar.finish_and_clear();
     outputs.add(&args.output, &gcode)?;
     let mut written = vec![args.output.clone()];
@@ -362,8 +365,31 @@ fn stage_bar() -> ProgressBar {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(Stage::ALL.len() as u64);
+    stage_style(&bar);
+    bar
+}
+
+/// Styles `bar` as the stage bar (the router restyles it while it routes).
+fn stage_style(bar: &ProgressBar) {
     if let Ok(style) = ProgressStyle::with_template("slicing [{bar:20}] {msg}") {
         bar.set_style(style.progress_chars("=> "));
     }
-    bar
+}
+
+/// Shows `stage` on the stage bar (routing shows the router's bar).
+fn show_stage(bar: &ProgressBar, stage: Stage) {
+    if stage == Stage::Route {
+        // The router's callback moves the bar from here on.
+        bar.set_message("");
+        super::progress::routing_style(bar);
+        bar.update(|state| {
+            state.set_len(0);
+            state.set_pos(0);
+        });
+        return;
+    }
+    stage_style(bar);
+    bar.set_length(Stage::ALL.len() as u64);
+    bar.set_position(stage as u64);
+    bar.set_message(stage.name());
 }

@@ -5,6 +5,11 @@
 //! returns the G-code bytes with a [`SliceSummary`] for the report; [`slice_scene_with`] adds a
 //! circuit ([`electronics`]). The other walks are its submodules: [`conform`], [`jet`],
 //! [`compensate`] and [`postprocess`] (another slicer's G-code with a circuit built in).
+//!
+//! The walks that route a circuit ([`slice_scene_watched`], [`route_scene`],
+//! [`postprocess::edit_circuit_watched`]) start the job's routing clock when routing starts:
+//! `route.time_limit` bounds the routing of every object together. They hand the router a
+//! callback ([`ProgressFn`]) told how far it got, in wires of the whole job.
 
 pub mod compensate;
 pub mod conform;
@@ -14,6 +19,7 @@ pub mod postprocess;
 
 pub use crate::circuit::stage::{self as electronics, Electronics, ElectronicsReport};
 pub use crate::emit::route_svg::RouteViewLayer;
+pub use crate::route::{ProgressFn, RouteProgress};
 
 use crate::config::{Config, CurvedMode};
 use crate::emit::gcode::{GcodeStats, write_gcode};
@@ -287,11 +293,43 @@ struct Front {
     meshes: Vec<Mesh>,
 }
 
+/// The electronics stage's parameters for one job: the config's, with the job's routing
+/// deadline (`route.time_limit` from now) and the progress callback. Routing starts now.
+pub(crate) fn watched_params(
+    cfg: &Config,
+    routing: Option<&ProgressFn>,
+) -> electronics::ElectronicsParams {
+    let mut params = cfg.electronics_params();
+    params.route.watch.deadline = crate::route::RouteWatch::deadline_in(params.route.time_limit);
+    params.route.watch.progress = routing.cloned();
+    params
+}
+
+/// `routing` for the wires of one object: its counts moved by the wires of the objects before
+/// (`done_before` wires, `unrouted_before` of them unrouted) out of the job's `total`.
+fn offset_progress(
+    routing: Option<&ProgressFn>,
+    done_before: usize,
+    unrouted_before: usize,
+    total: usize,
+) -> Option<ProgressFn> {
+    let outer = routing?.clone();
+    Some(std::sync::Arc::new(move |p: RouteProgress| {
+        outer(RouteProgress {
+            done: done_before + p.done,
+            total,
+            round: p.round,
+            unrouted: unrouted_before + p.unrouted,
+        })
+    }))
+}
+
 fn front(
     scene: &Scene,
     cfg: &Config,
     circuit: Option<&Electronics>,
     progress: &mut impl FnMut(Stage),
+    routing: Option<&ProgressFn>,
     laps: &mut Laps,
 ) -> Result<Front, PipelineError> {
     if scene.triangle_count() == 0 {
@@ -331,10 +369,23 @@ fn front(
     };
     if let Some(e) = circuit {
         progress(Stage::Route);
-        let params = cfg.electronics_params();
+        let mut params = watched_params(cfg, routing);
         let circuit = electronics::place_circuit(e, &model_boxes, &offsets, &params)?;
         let mut r = ElectronicsReport::default();
+        let routed_here = |i: usize| {
+            circuit
+                .wires
+                .iter()
+                .filter(|w| w.object == i && w.other_object.is_none())
+                .count()
+        };
+        let total = (0..sliced.len()).map(routed_here).sum();
+        let mut done_before = 0;
         for (i, (layers, _)) in sliced.iter_mut().enumerate() {
+            let unrouted_before = r.wires.iter().filter(|w| !w.routed).count();
+            params.route.watch.progress =
+                offset_progress(routing, done_before, unrouted_before, total);
+            done_before += routed_here(i);
             let zs: Vec<LayerZ> = layers.iter().map(|l| l.z).collect();
             let mut islands: Vec<Vec<ExPolygon>> = layers
                 .iter_mut()
@@ -373,15 +424,17 @@ pub struct RouteView {
     pub parts: Vec<crate::circuit::PlacedPart>,
 }
 
-/// The pipeline up to routing, without regions or G-code: for `conduit route`.
+/// The pipeline up to routing, without regions or G-code: for `conduit route`. `routing` is
+/// told how far the router got.
 pub fn route_scene(
     scene: &Scene,
     cfg: &Config,
     circuit: &Electronics,
     mut progress: impl FnMut(Stage),
+    routing: Option<&ProgressFn>,
 ) -> Result<RouteView, PipelineError> {
     let mut laps = Laps::new();
-    let f = front(scene, cfg, Some(circuit), &mut progress, &mut laps)?;
+    let f = front(scene, cfg, Some(circuit), &mut progress, routing, &mut laps)?;
     let mut by_z: BTreeMap<i64, RouteViewLayer> = BTreeMap::new();
     for ((layers, _), cuts) in f.sliced.into_iter().zip(&f.cuts) {
         for (i, l) in layers.into_iter().enumerate() {
@@ -446,7 +499,18 @@ pub fn slice_scene_with(
     scene: &Scene,
     cfg: &Config,
     circuit: Option<&Electronics>,
+    progress: impl FnMut(Stage),
+) -> Result<(Vec<u8>, Program, SliceSummary), PipelineError> {
+    slice_scene_watched(scene, cfg, circuit, progress, None)
+}
+
+/// [`slice_scene_with`], with `routing` told how far the router got.
+pub fn slice_scene_watched(
+    scene: &Scene,
+    cfg: &Config,
+    circuit: Option<&Electronics>,
     mut progress: impl FnMut(Stage),
+    routing: Option<&ProgressFn>,
 ) -> Result<(Vec<u8>, Program, SliceSummary), PipelineError> {
     let mut laps = Laps::new();
     let Front {
@@ -457,7 +521,7 @@ pub fn slice_scene_with(
         parts,
         cuts: _,
         meshes,
-    } = front(scene, cfg, circuit, &mut progress, &mut laps)?;
+    } = front(scene, cfg, circuit, &mut progress, routing, &mut laps)?;
     let mut extras = extras;
     let curved = (cfg.curved.mode == CurvedMode::Tops).then(|| {
         let (inserts, report) = curved_tops(&mut sliced, &meshes, cfg);

@@ -143,7 +143,23 @@ pub fn edit_circuit(
     electronics: &Electronics,
     config: &Config,
 ) -> Result<CircuitEdit, PostprocessError> {
-    let mut plan = plan_circuit(&print.layers, electronics, &config.electronics_params())?;
+    edit_circuit_watched(gcode, print, electronics, config, None)
+}
+
+/// [`edit_circuit`], with `routing` told how far the router got. Routing is bounded by
+/// `route.time_limit` from the start of the plan.
+///
+/// # Errors
+/// Those of [`edit_circuit`].
+pub fn edit_circuit_watched(
+    gcode: &Gcode,
+    print: &HostPrint,
+    electronics: &Electronics,
+    config: &Config,
+    routing: Option<&super::ProgressFn>,
+) -> Result<CircuitEdit, PostprocessError> {
+    let params = super::watched_params(config, routing);
+    let mut plan = plan_circuit(&print.layers, electronics, &params)?;
     let description = octopnp_block(&electronics.circuit, &plan.parts, &object_name(print));
     if !description.is_empty() {
         plan.report.warnings.extend(angle_bracket_warning(gcode));

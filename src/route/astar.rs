@@ -26,7 +26,7 @@
 use super::graph::{self, Ends, Graph, LayerInput, PENALTY_FACTOR, PreparedLayer, VertexId, Zone};
 use super::index::{dist, lerp};
 use super::interlayer::{Parent, piece_fits, polyline_length, walk_back};
-use super::{RouteLayer, RouteParams, Wire, WireRoute, layer_of, trace};
+use super::{RouteLayer, RouteParams, Unrouted, Wire, WireRoute, layer_of, trace};
 use crate::geom::{Point2, scaled, segment_distance, segment_param, unscaled};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -179,6 +179,8 @@ pub struct Search {
     closed: Vec<bool>,
     open: BinaryHeap<Open>,
     state: SearchState,
+    /// Why the search failed (meaningful once it has).
+    failure: Unrouted,
     expansions: usize,
     /// Smallest cost per mm of any edge.
     min_weight: f64,
@@ -255,6 +257,7 @@ impl Search {
             closed: Vec::new(),
             open: BinaryHeap::new(),
             state,
+            failure: Unrouted::NoLayer,
             expansions: 0,
             min_weight,
             change_cost,
@@ -306,6 +309,7 @@ impl Search {
         }
         let Some(top) = self.open.pop() else {
             self.state = SearchState::Failed;
+            self.failure = Unrouted::NoPath;
             return self.state;
         };
         let u = top.v;
@@ -315,6 +319,7 @@ impl Search {
         if top.f > self.cost_limit {
             // Every route left costs more than the detour limit allows.
             self.state = SearchState::Failed;
+            self.failure = Unrouted::Detour;
             return self.state;
         }
         self.closed[u as usize] = true;
@@ -325,6 +330,7 @@ impl Search {
         self.expansions += 1;
         if self.expansions > self.params.max_expansions {
             self.state = SearchState::Failed;
+            self.failure = Unrouted::SearchLimit;
             return self.state;
         }
         self.explore_grid(u);
@@ -348,7 +354,7 @@ impl Search {
     /// The route: assembled if the target was found, else an unrouted report.
     pub fn result(&self) -> WireRoute {
         if self.state != SearchState::Found {
-            return trace::unrouted(&self.wire);
+            return trace::unrouted(&self.wire, self.failure);
         }
         let mut path = Vec::new();
         // A route that ends on a trace stops at the point of the trace, on the layer of the

@@ -16,15 +16,24 @@
 //! wires routed than before it is undone. Rounds stop at the first one that keeps no attempt,
 //! or after `rip_up_rounds`.
 //!
+//! Routing stops at the deadline: no search starts once it has passed, a running search looks
+//! at the clock every `CLOCK_EVERY` steps and gives up, and no rip-up round or attempt starts.
+//! The wires this leaves without a route are reported [`Unrouted::TimeLimit`]; an attempt cut
+//! short is undone like any other that routes no more wires.
+//!
 //! Each search may end on the traces already connected to the wire's far pad ([`Tap`]s): the
 //! board follows the routed wires of the net from each pad and starts the search at the pad
 //! whose side has less copper, so the target has the most.
 
 use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
 use super::graph::LayerInput;
-use super::{PadCopper, wire_order};
+use super::{PadCopper, RouteProgress, Unrouted, wire_order};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
 use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, union};
+use std::time::Instant;
+
+/// Steps of one A* search between two looks at the clock.
+const CLOCK_EVERY: usize = 256;
 
 /// A channel area (mm²) below which two channels count as not touching: polygon noise.
 const TOUCH_MM2: f64 = 1e-6;
@@ -89,6 +98,10 @@ pub(crate) struct Board<'a> {
     pads: Vec<PadObstacle<'a>>,
     placed: Vec<Vec<Placed>>,
     routes: Vec<Option<WireRoute>>,
+    /// When routing must stop.
+    deadline: Option<Instant>,
+    /// Whether the deadline stopped any work.
+    stopped: bool,
 }
 
 impl<'a> Board<'a> {
@@ -98,6 +111,7 @@ impl<'a> Board<'a> {
         wires: &'a [Wire],
         pads: &'a [PadCopper],
         params: &'a RouteParams,
+        deadline: Option<Instant>,
     ) -> Self {
         let pads = pads
             .iter()
@@ -119,19 +133,65 @@ impl<'a> Board<'a> {
             pads,
             placed: vec![Vec::new(); layers.len()],
             routes: vec![None; wires.len()],
+            deadline,
+            stopped: false,
         }
     }
 
-    /// Routes every wire in [`wire_order`], then runs the rip-up and reroute rounds.
-    pub(crate) fn route_all(&mut self) {
-        for i in wire_order(self.wires, self.params) {
+    /// Routes every wire in [`wire_order`], then runs the rip-up and reroute rounds, telling
+    /// the progress callback after each wire and attempt; returns the rounds run.
+    pub(crate) fn route_all(&mut self) -> usize {
+        let total = self.wires.len();
+        for (k, i) in wire_order(self.wires, self.params).into_iter().enumerate() {
             self.route_one(i);
+            self.tell(k + 1, 0);
         }
-        for _ in 0..self.params.rip_up_rounds {
-            if self.routed_count() == self.wires.len() || !self.rip_up_round() {
+        let mut rounds = 0;
+        for round in 1..=self.params.rip_up_rounds {
+            if self.routed_count() == total || self.past_deadline() {
+                break;
+            }
+            rounds = round;
+            self.tell(total, round);
+            if !self.rip_up_round(round) {
                 break;
             }
         }
+        rounds
+    }
+
+    /// Whether the deadline has passed; if so, routing stops (and says so).
+    fn past_deadline(&mut self) -> bool {
+        let past = self.deadline.is_some_and(|d| Instant::now() >= d);
+        self.stopped |= past;
+        past
+    }
+
+    /// Whether the deadline stopped any work: a search not started or cut short, a round or
+    /// attempt not run.
+    pub(crate) fn stopped_by_deadline(&self) -> bool {
+        self.stopped
+    }
+
+    /// Tells the progress callback, if any, where routing stands.
+    fn tell(&self, done: usize, round: usize) {
+        if let Some(progress) = &self.params.watch.progress {
+            progress(RouteProgress {
+                done,
+                total: self.wires.len(),
+                round,
+                unrouted: self
+                    .routes
+                    .iter()
+                    .filter(|r| r.as_ref().is_some_and(|r| !r.routed))
+                    .count(),
+            });
+        }
+    }
+
+    /// A wire stopped by the deadline.
+    fn out_of_time(&self, i: usize) -> WireRoute {
+        trace::unrouted(&self.wires[i], Unrouted::TimeLimit(self.params.time_limit))
     }
 
     /// Number of wires with a route.
@@ -157,17 +217,21 @@ impl<'a> Board<'a> {
             .routes
             .into_iter()
             .zip(self.wires)
-            .map(|(r, w)| r.unwrap_or_else(|| trace::unrouted(w)))
+            .map(|(r, w)| r.unwrap_or_else(|| trace::unrouted(w, Unrouted::NoPath)))
             .collect();
         (routes, channels)
     }
 
     /// One rip-up and reroute round over the wires that failed, in wire order (see
     /// [`Board::attempt`]); returns whether any attempt was kept.
-    fn rip_up_round(&mut self) -> bool {
+    fn rip_up_round(&mut self, round: usize) -> bool {
         let mut improved = false;
         for f in self.failed() {
+            if self.past_deadline() {
+                break;
+            }
             improved |= self.attempt(f, RIP_UP_DEPTH);
+            self.tell(self.wires.len(), round);
         }
         improved
     }
@@ -185,7 +249,7 @@ impl<'a> Board<'a> {
     /// their own. Kept only if more wires are routed than before (a failed wire routed at the
     /// cost of another is undone); returns whether it was kept.
     fn attempt(&mut self, f: usize, depth: usize) -> bool {
-        if depth == 0 || self.routes[f].as_ref().is_some_and(|r| r.routed) {
+        if depth == 0 || self.routes[f].as_ref().is_some_and(|r| r.routed) || self.past_deadline() {
             return false;
         }
         let probe = self.search(f, false);
@@ -215,14 +279,21 @@ impl<'a> Board<'a> {
         if self.routed_count() > before {
             true
         } else {
+            let stopped = self.stopped;
             *self = saved;
+            self.stopped = stopped;
             false
         }
     }
 
-    /// Routes wire `i` on the board as it stands and places its channels.
+    /// Routes wire `i` on the board as it stands and places its channels (none, once the
+    /// deadline has passed).
     fn route_one(&mut self, i: usize) {
-        let result = self.search(i, true);
+        let result = if self.past_deadline() {
+            self.out_of_time(i)
+        } else {
+            self.search(i, true)
+        };
         let half = self.params.channel_half_width();
         let keep_out_radius = channels::keep_out_radius(self.params);
         for (l, points) in &result.segments {
@@ -351,10 +422,12 @@ impl<'a> Board<'a> {
     /// The route may end on the traces already connected to either pad (see [`Tap`]): it starts
     /// at the pad whose side has less trace and ends on the other side's pad or traces, so it
     /// has the most copper to aim at.
-    fn search(&self, i: usize, traces: bool) -> WireRoute {
+    ///
+    /// A search still running at the deadline gives up: the wire is out of time.
+    fn search(&mut self, i: usize, traces: bool) -> WireRoute {
         let wire = &self.wires[i];
         let Some(range) = layer_range(self.layers, wire, self.params) else {
-            return trace::unrouted(wire);
+            return trace::unrouted(wire, Unrouted::NoLayer);
         };
         let (from_pads, from_wires) = self.connected(&wire.net, wire.from);
         let (_, to_wires) = self.connected(&wire.net, wire.to);
@@ -379,7 +452,13 @@ impl<'a> Board<'a> {
             .map(|l| self.input(l, wire, traces, &window))
             .collect();
         let mut search = Search::with_layers(inputs, self.layers, &start, self.params, taps);
-        while search.step() == SearchState::Running {}
+        let mut steps = 0usize;
+        while search.step() == SearchState::Running {
+            steps += 1;
+            if steps % CLOCK_EVERY == 0 && self.past_deadline() {
+                return self.out_of_time(i);
+            }
+        }
         search.result()
     }
 

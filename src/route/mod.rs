@@ -41,6 +41,13 @@
 //!    rounds of rip-up and reroute: the wires in their way are routed again after them, and an
 //!    attempt is kept only if it leaves more wires routed.
 //!
+//! Routing is bounded in time: [`RouteParams::time_limit`] (or the job-wide
+//! [`RouteWatch::deadline`]) stops the router from starting new searches, and cuts a running
+//! search short, once it has passed; what is routed stays routed and the rest is reported
+//! [`Unrouted::TimeLimit`]. The deadline only ever stops work, so a run that finishes in time
+//! gives the same result with or without it. [`RouteWatch::progress`] hears how far routing got
+//! after every wire and rip-up attempt.
+//!
 //! Units: millimetres in the public types, nanometre integers ([`Point2`]) inside.
 
 mod astar;
@@ -61,6 +68,9 @@ pub use channels::trace_channel;
 pub use order::{collision_counts, wire_order};
 
 use crate::geom::{ExPolygon, Point2, Point3, Polygon};
+use std::fmt;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 /// One planar layer as the router sees it.
 #[derive(Debug, Clone, PartialEq)]
@@ -169,6 +179,102 @@ pub struct RouteParams {
     /// this close to a region's boundary count as on it (default 0.05 mm: a tenth of a trace
     /// width, far above the nanometre rounding of intersection points).
     pub align_tolerance: f64,
+    /// Longest time routing may take, seconds (default 180; 0 = no limit). Measured from the
+    /// start of [`route`] unless [`RouteWatch::deadline`] sets a deadline shared by several
+    /// calls (all objects of a job); also the figure named in [`Unrouted::TimeLimit`].
+    pub time_limit: f64,
+    /// The job's deadline and the progress callback, set by the caller (none by default).
+    pub watch: RouteWatch,
+}
+
+/// How far routing has got: told to [`RouteWatch::progress`] after every wire searched in the
+/// first pass and every rip-up and reroute attempt.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RouteProgress {
+    /// Wires searched in the first pass so far (all of them once the rip-up rounds run).
+    pub done: usize,
+    /// Wires to route.
+    pub total: usize,
+    /// Rip-up and reroute round running (0 during the first pass).
+    pub round: usize,
+    /// Wires without a route so far.
+    pub unrouted: usize,
+}
+
+/// A callback told how far routing has got; shared, so one callback serves every object of a
+/// job.
+pub type ProgressFn = Arc<dyn Fn(RouteProgress) + Send + Sync>;
+
+/// What the caller of [`route`] watches it with: a deadline and a progress callback.
+#[derive(Clone, Default)]
+pub struct RouteWatch {
+    /// When routing must stop; `None` takes [`RouteParams::time_limit`] from the start of the
+    /// call.
+    pub deadline: Option<Instant>,
+    /// Told how far routing has got.
+    pub progress: Option<ProgressFn>,
+}
+
+impl RouteWatch {
+    /// A deadline `seconds` from now (none for 0, a negative or a non-finite value).
+    pub fn deadline_in(seconds: f64) -> Option<Instant> {
+        if seconds > 0.0 && seconds.is_finite() {
+            Duration::try_from_secs_f64(seconds)
+                .ok()
+                .and_then(|d| Instant::now().checked_add(d))
+        } else {
+            None
+        }
+    }
+}
+
+impl fmt::Debug for RouteWatch {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("RouteWatch")
+            .field("deadline", &self.deadline)
+            .field("progress", &self.progress.as_ref().map(|_| "callback"))
+            .finish()
+    }
+}
+
+impl PartialEq for RouteWatch {
+    /// Same deadline and the same callback (or none).
+    fn eq(&self, other: &Self) -> bool {
+        self.deadline == other.deadline
+            && match (&self.progress, &other.progress) {
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (None, None) => true,
+                _ => false,
+            }
+    }
+}
+
+/// Why a wire has no route.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Unrouted {
+    /// A pad lies on no layer (there are none).
+    NoLayer,
+    /// The material (less other nets' traces and pads) holds no way between the pads.
+    NoPath,
+    /// Every way left is longer than [`RouteParams::max_detour`] allows.
+    Detour,
+    /// The search used up [`RouteParams::max_expansions`].
+    SearchLimit,
+    /// The deadline passed before the wire was routed (the figure is
+    /// [`RouteParams::time_limit`], seconds).
+    TimeLimit(f64),
+}
+
+impl fmt::Display for Unrouted {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Unrouted::NoLayer => write!(f, "no layer holds the pads"),
+            Unrouted::NoPath => write!(f, "no path through the material"),
+            Unrouted::Detour => write!(f, "no path within the detour limit (route.max_detour)"),
+            Unrouted::SearchLimit => write!(f, "search limit reached"),
+            Unrouted::TimeLimit(s) => write!(f, "time limit reached (route.time_limit = {s} s)"),
+        }
+    }
 }
 
 impl Default for RouteParams {
@@ -191,6 +297,8 @@ impl Default for RouteParams {
             detour_slack: 30.0,
             max_expansions: 2_000_000,
             align_tolerance: 0.05,
+            time_limit: 180.0,
+            watch: RouteWatch::default(),
         }
     }
 }
@@ -238,6 +346,8 @@ pub struct WireRoute {
     /// running to its `to` pad: that trace is already connected to the pad. `None` when the
     /// route ends at the pad.
     pub ends_on_wire: Option<usize>,
+    /// Why the wire has no route; `None` when it is routed.
+    pub reason: Option<Unrouted>,
 }
 
 /// Routes of all wires and the channels to carve.
@@ -248,6 +358,10 @@ pub struct RouteResult {
     /// Per layer (same indices as the input layers), the union of the channels of all routed
     /// wires: regions to carve from the plastic before the conductive material fills them.
     pub channels: Vec<Vec<ExPolygon>>,
+    /// Rip-up and reroute rounds run.
+    pub rounds: usize,
+    /// Whether the deadline stopped routing before it was done.
+    pub time_limit_reached: bool,
 }
 
 /// Heights closer than this (mm) count as equal when a pad is matched to a layer: float noise in
@@ -289,15 +403,27 @@ pub fn min_trace_spacing(params: &RouteParams) -> f64 {
 /// and the copper of other nets' pads and of unconnected pads (on the pad's layer and the two
 /// next to it). Wires that cannot be routed are reported with `routed = false`; routing goes on
 /// with the others, and failed wires get `rip_up_rounds` rounds of rip-up and reroute (see
-/// `board.rs`).
+/// `board.rs`). Once the deadline ([`RouteWatch::deadline`], else [`RouteParams::time_limit`]
+/// from now) has passed no search starts and a running one gives up: the wires left are
+/// reported [`Unrouted::TimeLimit`].
 pub fn route(
     layers: &[RouteLayer],
     wires: &[Wire],
     pads: &[PadCopper],
     params: &RouteParams,
 ) -> RouteResult {
-    let mut board = board::Board::new(layers, wires, pads, params);
-    board.route_all();
+    let deadline = params
+        .watch
+        .deadline
+        .or_else(|| RouteWatch::deadline_in(params.time_limit));
+    let mut board = board::Board::new(layers, wires, pads, params, deadline);
+    let rounds = board.route_all();
+    let time_limit_reached = board.stopped_by_deadline();
     let (wires, channels) = board.finish();
-    RouteResult { wires, channels }
+    RouteResult {
+        wires,
+        channels,
+        rounds,
+        time_limit_reached,
+    }
 }

@@ -309,8 +309,11 @@ fn pad_on_a_separate_island_is_unrouted_and_the_rest_goes_on() {
     assert!(gap.segments.is_empty());
     assert_eq!(gap.length, 0.0);
     assert_eq!(gap.lower_bound, 35.0);
+    assert_eq!(gap.reason, Some(Unrouted::NoPath));
     assert!(result.wires[1].routed);
+    assert_eq!(result.wires[1].reason, None);
     assert_eq!(result.wires[1].net, "ok");
+    assert!(!result.time_limit_reached);
 }
 
 #[test]
@@ -398,6 +401,12 @@ fn routes_longer_than_the_detour_limit_are_not_searched_for() {
     assert!(
         long.routed && long.length > 1.35 * long.lower_bound,
         "{long:?}"
+    );
+    let short = route_wire(&layers, &w, &with(1.2));
+    assert_eq!(short.reason, Some(Unrouted::Detour));
+    assert_eq!(
+        short.reason.map(|r| r.to_string()).as_deref(),
+        Some("no path within the detour limit (route.max_detour)")
     );
     let mut search = Search::new(&layers, &w, &with(1.2));
     while search.step() == SearchState::Running {}
@@ -547,4 +556,91 @@ fn a_gap_too_narrow_for_perimeter_traces_is_squeezed_through() {
     };
     let closed = route(&layers, std::slice::from_ref(&w), &pads, &params);
     assert!(!closed.wires[0].routed, "{:?}", closed.wires[0]);
+}
+
+/// Wires of the determinism test: four on a solid plate of six layers.
+fn four_wires() -> (Vec<RouteLayer>, Vec<Wire>) {
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 6);
+    let (z0, z5) = (layers[0].z, layers[5].z);
+    let wires = vec![
+        wire("a", (5.0, 5.0, z5), (35.0, 35.0, z5)),
+        wire("b", (5.0, 35.0, z5), (35.0, 5.0, z5)),
+        wire("c", (20.0, 3.0, z0), (20.0, 37.0, z5)),
+        wire("a", (35.0, 35.0, z5), (35.0, 20.0, z5)),
+    ];
+    (layers, wires)
+}
+
+#[test]
+fn a_passed_deadline_routes_nothing_and_says_why() {
+    let (layers, wires) = four_wires();
+    let params = RouteParams {
+        time_limit: 7.5,
+        watch: RouteWatch {
+            deadline: Some(std::time::Instant::now()),
+            progress: None,
+        },
+        ..RouteParams::default()
+    };
+    let result = route(&layers, &wires, &end_pads(&wires), &params);
+    assert!(result.time_limit_reached);
+    assert_eq!(result.rounds, 0);
+    assert!(result.channels.iter().all(Vec::is_empty));
+    for w in &result.wires {
+        assert!(!w.routed && w.segments.is_empty(), "{w:?}");
+        assert_eq!(w.reason, Some(Unrouted::TimeLimit(7.5)));
+    }
+    assert_eq!(
+        Unrouted::TimeLimit(7.5).to_string(),
+        "time limit reached (route.time_limit = 7.5 s)"
+    );
+}
+
+#[test]
+fn progress_and_a_far_deadline_change_nothing() {
+    let (layers, wires) = four_wires();
+    let pads = end_pads(&wires);
+    let plain = route(&layers, &wires, &pads, &RouteParams::default());
+    let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let sink = seen.clone();
+    let params = RouteParams {
+        time_limit: 0.0,
+        watch: RouteWatch {
+            deadline: RouteWatch::deadline_in(3600.0),
+            progress: Some(std::sync::Arc::new(move |p| {
+                sink.lock().expect("progress list").push(p)
+            })),
+        },
+        ..RouteParams::default()
+    };
+    let watched = route(&layers, &wires, &pads, &params);
+    assert_eq!(plain, watched);
+    assert!(!watched.time_limit_reached);
+    let seen = seen.lock().expect("progress list");
+    // One report per wire of the first pass, counting up, then one per round and attempt.
+    let first: Vec<usize> = seen
+        .iter()
+        .filter(|p| p.round == 0)
+        .map(|p| p.done)
+        .collect();
+    assert_eq!(first, vec![1, 2, 3, 4]);
+    assert!(seen.iter().all(|p| p.total == 4));
+    let last = seen.last().expect("progress told");
+    let unrouted = watched.wires.iter().filter(|w| !w.routed).count();
+    assert_eq!(last.unrouted, unrouted);
+    assert_eq!(
+        seen.iter().map(|p| p.round).max(),
+        Some(watched.rounds),
+        "{seen:?}"
+    );
+}
+
+#[test]
+fn deadline_in_takes_positive_finite_seconds() {
+    assert!(RouteWatch::deadline_in(0.0).is_none());
+    assert!(RouteWatch::deadline_in(-1.0).is_none());
+    assert!(RouteWatch::deadline_in(f64::NAN).is_none());
+    assert!(RouteWatch::deadline_in(f64::INFINITY).is_none());
+    let soon = RouteWatch::deadline_in(60.0).expect("a deadline");
+    assert!(soon > std::time::Instant::now());
 }

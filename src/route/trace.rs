@@ -7,11 +7,11 @@
 use super::graph::{Graph, PreparedLayer, VertexId};
 use super::index::RegionIndex;
 use super::smooth::pull_taut;
-use super::{Wire, WireRoute};
+use super::{Unrouted, Wire, WireRoute};
 use crate::geom::{Point2, Point3, unscaled};
 
 /// The report of a wire that could not be routed.
-pub(crate) fn unrouted(wire: &Wire) -> WireRoute {
+pub(crate) fn unrouted(wire: &Wire, reason: Unrouted) -> WireRoute {
     WireRoute {
         net: wire.net.clone(),
         routed: false,
@@ -21,6 +21,7 @@ pub(crate) fn unrouted(wire: &Wire) -> WireRoute {
         layer_changes: 0,
         perimeter_crossings: 0,
         ends_on_wire: None,
+        reason: Some(reason),
     }
 }
 
@@ -152,5 +153,6 @@ pub(crate) fn assemble(
         layer_changes,
         perimeter_crossings,
         ends_on_wire: end.map(|(_, w)| w),
+        reason: None,
     }
 }
