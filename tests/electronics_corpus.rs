@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use conduit::circuit::{Circuit, PadShape, Part, Placement};
+use conduit::circuit::{Circuit, Part, Placement};
 use conduit::config::Config;
 use conduit::geom::{Point3, Transform};
 use conduit::mesh::Mesh;
@@ -52,33 +52,6 @@ fn schematic(corpus: &Path, name: &str) -> PathBuf {
     }
     assert_eq!(found.len(), 1, "one .sch under {}", dir.display());
     found.remove(0)
-}
-
-/// The extent of a part's pads in its package frame, `[min x, min y, max x, max y]` mm, or
-/// `None` for a package without pads.
-fn pad_extent(part: &Part) -> Option<[f64; 4]> {
-    part.pads
-        .iter()
-        .map(|pad| {
-            let (w, h) = match pad.shape {
-                PadShape::Round { diameter } => (diameter, diameter),
-                PadShape::Rect { width, height } | PadShape::Oblong { width, height } => {
-                    (width, height)
-                }
-            };
-            let (s, c) = pad.rotation_deg.to_radians().sin_cos();
-            let hx = (c.abs() * w + s.abs() * h) / 2.0;
-            let hy = (s.abs() * w + c.abs() * h) / 2.0;
-            [pad.x - hx, pad.y - hy, pad.x + hx, pad.y + hy]
-        })
-        .reduce(|a, b| {
-            [
-                a[0].min(b[0]),
-                a[1].min(b[1]),
-                a[2].max(b[2]),
-                a[3].max(b[3]),
-            ]
-        })
 }
 
 /// Parts on a grid: the placement and the block it fits in.
@@ -215,7 +188,7 @@ fn grid_placement(circuit: &Circuit, positions: &BTreeMap<String, [f64; 2]>, mar
     let mut parts: Vec<(&Part, [f64; 4])> = circuit
         .parts
         .iter()
-        .filter_map(|p| pad_extent(p).map(|e| (p, e)))
+        .filter_map(|p| p.pad_extent().map(|e| (p, e)))
         .collect();
     parts.sort_by(|a, b| at(a.0)[1].total_cmp(&at(b.0)[1]));
     let cols = (parts.len() as f64).sqrt().ceil().max(1.0) as usize;

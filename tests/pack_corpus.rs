@@ -32,28 +32,10 @@ fn schematic(corpus: &Path, name: &str) -> PathBuf {
     found.remove(0)
 }
 
-/// The extent of a part's pads in its package frame, `[x0, y0, x1, y1]` mm.
-fn pad_extent(part: &Part) -> Option<[f64; 4]> {
-    part.pads
-        .iter()
-        .map(|pad| {
-            let [hx, hy] = pad.half_extent();
-            [pad.x - hx, pad.y - hy, pad.x + hx, pad.y + hy]
-        })
-        .reduce(|a, b| {
-            [
-                a[0].min(b[0]),
-                a[1].min(b[1]),
-                a[2].max(b[2]),
-                a[3].max(b[3]),
-            ]
-        })
-}
-
 /// A packed part's footprint in the region's frame, `[x0, y0, x1, y1]` mm.
 fn footprint(c: &Circuit, p: &Packed) -> [f64; 4] {
     let part = c.part(&p.name).expect("packed part in the circuit");
-    let e = pad_extent(part).expect("a part with pads");
+    let e = part.pad_extent().expect("a part with pads");
     let (s, co) = p.rotation.to_radians().sin_cos();
     let mut f = [
         f64::INFINITY,
@@ -149,7 +131,7 @@ fn packs(name: &str) {
     let parts: Vec<(&Part, [f64; 4])> = c
         .parts
         .iter()
-        .filter_map(|p| pad_extent(p).map(|e| (p, e)))
+        .filter_map(|p| p.pad_extent().map(|e| (p, e)))
         .collect();
     let names: Vec<&str> = parts.iter().map(|(p, _)| p.name.as_str()).collect();
     let need: f64 = parts

@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 
 use super::placed::place;
 use super::placement::{Connection, Origin, PartPlacement, Placement, PlacingMethod};
-use super::{Circuit, Part};
+use super::{Circuit, Part, PlacedPart};
 use crate::geom::BoundingBox;
 
 /// How a board's layout is moved into the object (model coordinates, mm and degrees).
@@ -109,18 +109,10 @@ pub fn board_centre(board: &conduit_eagle::Board, circuit: &Circuit) -> [f64; 2]
             .map(|e| [e.x, e.y])
             .collect();
     }
-    let mut lo = [f64::INFINITY; 2];
-    let mut hi = [f64::NEG_INFINITY; 2];
-    for p in &points {
-        for k in 0..2 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
+    match bounds(points) {
+        Some((lo, hi)) => [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0],
+        None => [0.0; 2],
     }
-    if points.is_empty() {
-        return [0.0; 2];
-    }
-    [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0]
 }
 
 /// The face-up rotation of a bottom-side part whose board rotation is `MR<degrees>`: the
@@ -169,13 +161,8 @@ fn covering_parts(
             let part = circuit
                 .part(&e.name)
                 .filter(|p| has_connected_pads(circuit, p))?;
-            let mut lo = [f64::INFINITY; 2];
-            let mut hi = [f64::NEG_INFINITY; 2];
-            for pad in &part.pads {
-                let [hx, hy] = pad.half_extent();
-                lo = [lo[0].min(pad.x - hx), lo[1].min(pad.y - hy)];
-                hi = [hi[0].max(pad.x + hx), hi[1].max(pad.y + hy)];
-            }
+            let [x0, y0, x1, y1] = part.pad_extent()?;
+            let (lo, hi) = ([x0, y0], [x1, y1]);
             let (s, c) = e.rotation.degrees.to_radians().sin_cos();
             let (mx, my) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
             Some(Extent {
@@ -320,18 +307,36 @@ pub fn layout_board(
     Ok(out)
 }
 
-/// The smallest gap between two pads of different nets on different parts seated on the same
-/// plane, mm, with the two pins (`PART.PAD`); `None` without such a pair. Pads that overlap
-/// count as 0.
-pub fn closest_foreign_pads(
-    circuit: &Circuit,
-    placement: &Placement,
-) -> Option<(f64, String, String)> {
+/// The bounding box of `points`, `(min, max)` mm; `None` without points.
+pub(crate) fn bounds(points: impl IntoIterator<Item = [f64; 2]>) -> Option<([f64; 2], [f64; 2])> {
+    points.into_iter().fold(None, |acc, p| {
+        let (lo, hi) = acc.unwrap_or((p, p));
+        Some((
+            [lo[0].min(p[0]), lo[1].min(p[1])],
+            [hi[0].max(p[0]), hi[1].max(p[1])],
+        ))
+    })
+}
+
+/// Whether two outlines overlap: a corner of one inside the other.
+fn overlap(a: &crate::geom::Polygon, b: &crate::geom::Polygon) -> bool {
+    a.points.iter().any(|&p| b.contains(p)) || b.points.iter().any(|&p| a.contains(p))
+}
+
+/// The parts of `placement` placed on their own (model coordinates, no object box needed: a
+/// layout made here is in model coordinates); `None` when it does not match `circuit`.
+pub fn placed_parts(circuit: &Circuit, placement: &Placement) -> Option<Vec<PlacedPart>> {
     let boxes = [BoundingBox {
         min: [0.0; 3],
         max: [0.0; 3],
     }];
-    let parts = place(circuit, placement, &boxes).ok()?;
+    place(circuit, placement, &boxes).ok()
+}
+
+/// The smallest gap between two pads of different nets on different `parts` seated on the
+/// same plane, mm, with the two pins (`PART.PAD`); `None` without such a pair. Pads that
+/// overlap count as 0.
+pub fn closest_foreign_pads(parts: &[&PlacedPart]) -> Option<(f64, String, String)> {
     struct Copper<'a> {
         pin: String,
         net: Option<&'a str>,
@@ -344,15 +349,9 @@ pub fn closest_foreign_pads(
     let mut pads: Vec<Copper> = Vec::new();
     for (k, part) in parts.iter().enumerate() {
         for pad in &part.pads {
-            let pts = pad.outline.points_mm();
-            let mut lo = [f64::INFINITY; 2];
-            let mut hi = [f64::NEG_INFINITY; 2];
-            for p in &pts {
-                for i in 0..2 {
-                    lo[i] = lo[i].min(p[i]);
-                    hi[i] = hi[i].max(p[i]);
-                }
-            }
+            let Some((lo, hi)) = bounds(pad.outline.points_mm()) else {
+                continue;
+            };
             pads.push(Copper {
                 pin: format!("{}.{}", part.name, pad.name),
                 net: pad.net.as_deref(),
@@ -383,9 +382,7 @@ pub fn closest_foreign_pads(
             if box_gap > limit {
                 continue;
             }
-            let overlap = a.outline.points.iter().any(|&p| b.outline.contains(p))
-                || b.outline.points.iter().any(|&p| a.outline.contains(p));
-            let gap = if overlap {
+            let gap = if overlap(a.outline, b.outline) {
                 0.0
             } else {
                 super::fit::ring_gap(a.outline, b.outline)
@@ -403,32 +400,13 @@ pub fn closest_foreign_pads(
     best
 }
 
-/// The smallest gap between the footprints of two parts whose bodies share heights, mm (0
+/// The smallest gap between the footprints of two `parts` whose bodies share heights, mm (0
 /// for footprints that overlap), with the two parts' names; `None` without such a pair. Pairs
 /// whose bounding boxes are `limit` or more apart are not measured.
-pub fn closest_parts(
-    circuit: &Circuit,
-    placement: &Placement,
-    limit: f64,
-) -> Option<(f64, String, String)> {
-    let boxes = [BoundingBox {
-        min: [0.0; 3],
-        max: [0.0; 3],
-    }];
-    let parts = place(circuit, placement, &boxes).ok()?;
-    let bounds: Vec<([f64; 2], [f64; 2])> = parts
+pub fn closest_parts(parts: &[&PlacedPart], limit: f64) -> Option<(f64, String, String)> {
+    let boxes: Vec<Option<([f64; 2], [f64; 2])>> = parts
         .iter()
-        .map(|p| {
-            let mut lo = [f64::INFINITY; 2];
-            let mut hi = [f64::NEG_INFINITY; 2];
-            for q in p.footprint.points_mm() {
-                for i in 0..2 {
-                    lo[i] = lo[i].min(q[i]);
-                    hi[i] = hi[i].max(q[i]);
-                }
-            }
-            (lo, hi)
-        })
+        .map(|p| bounds(p.footprint.points_mm()))
         .collect();
     let mut best: Option<(f64, String, String)> = None;
     for (i, a) in parts.iter().enumerate() {
@@ -438,8 +416,9 @@ pub fn closest_parts(
             if low >= high - 1e-6 {
                 continue;
             }
-            let (la, ha) = bounds[i];
-            let (lb, hb) = bounds[j];
+            let (Some((la, ha)), Some((lb, hb))) = (boxes[i], boxes[j]) else {
+                continue;
+            };
             let box_gap = (lb[0] - ha[0])
                 .max(la[0] - hb[0])
                 .max(lb[1] - ha[1])
@@ -448,9 +427,7 @@ pub fn closest_parts(
             if box_gap >= bound {
                 continue;
             }
-            let overlap = a.footprint.points.iter().any(|&p| b.footprint.contains(p))
-                || b.footprint.points.iter().any(|&p| a.footprint.contains(p));
-            let gap = if overlap {
+            let gap = if overlap(&a.footprint, &b.footprint) {
                 0.0
             } else {
                 super::fit::ring_gap(&a.footprint, &b.footprint)
@@ -490,12 +467,15 @@ pub fn suggest_scale(
     let steps = ((MAX_SUGGESTED_SCALE - 1.0) / 0.05).round() as usize;
     (0..=steps).map(|k| 1.0 + k as f64 * 0.05).find(|&scale| {
         let at = BoardLayoutParams { scale, ..*params };
-        layout_board(board, circuit, &at).is_ok_and(|l| {
-            closest_foreign_pads(circuit, &l.placement)
-                .is_none_or(|(gap, _, _)| gap >= room.trace - 1e-9)
-                && closest_parts(circuit, &l.placement, room.parts)
-                    .is_none_or(|(gap, _, _)| gap >= room.parts - 1e-9)
-        })
+        let Some(parts) = layout_board(board, circuit, &at)
+            .ok()
+            .and_then(|l| placed_parts(circuit, &l.placement))
+        else {
+            return false;
+        };
+        let parts: Vec<&PlacedPart> = parts.iter().collect();
+        closest_foreign_pads(&parts).is_none_or(|(gap, _, _)| gap >= room.trace - 1e-9)
+            && closest_parts(&parts, room.parts).is_none_or(|(gap, _, _)| gap >= room.parts - 1e-9)
     })
 }
 

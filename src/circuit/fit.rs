@@ -38,35 +38,46 @@ pub fn part_problems(
     islands: &[Vec<ExPolygon>],
     zs: &[LayerZ],
 ) -> Vec<String> {
-    let mut problems = Vec::new();
-    let Some(last) = zs.last() else {
-        return problems;
-    };
-    for part in parts {
-        let z = part.position.z;
-        if z > last.top + 1e-6 {
-            problems.push(format!(
-                "part {} is above the object: its seating plane z {z:.3} mm is {:.3} mm over \
-                 the object's top ({:.3} mm)",
-                part.name,
-                z - last.top,
-                last.top
-            ));
-            continue;
-        }
-        let layer = seat_layer(zs, z);
-        if let Some((beyond, reach)) = outside(&part.footprint, &islands[layer]) {
-            problems.push(format!(
-                "part {} is not inside the object: {beyond:.1} of its {:.1} mm² footprint lies \
-                 outside the solid at z {:.3} mm, up to {reach:.2} mm beyond its edge",
-                part.name,
-                part.footprint.area_mm2().abs(),
-                zs[layer].top
-            ));
-        }
+    let mut problems: Vec<String> = parts
+        .iter()
+        .filter_map(|p| seat_problem(p, islands, zs))
+        .collect();
+    if !zs.is_empty() {
+        problems.extend(collisions(parts).into_iter().map(|(_, _, m)| m));
     }
+    problems
+}
+
+/// A part above the object, or whose footprint reaches beyond the solid at its seating plane.
+fn seat_problem(part: &PlacedPart, islands: &[Vec<ExPolygon>], zs: &[LayerZ]) -> Option<String> {
+    let last = zs.last()?;
+    let z = part.position.z;
+    if z > last.top + 1e-6 {
+        return Some(format!(
+            "part {} is above the object: its seating plane z {z:.3} mm is {:.3} mm over the \
+             object's top ({:.3} mm)",
+            part.name,
+            z - last.top,
+            last.top
+        ));
+    }
+    let layer = seat_layer(zs, z);
+    let (beyond, reach) = outside(&part.footprint, &islands[layer])?;
+    Some(format!(
+        "part {} is not inside the object: {beyond:.1} of its {:.1} mm² footprint lies outside \
+         the solid at z {:.3} mm, up to {reach:.2} mm beyond its edge",
+        part.name,
+        part.footprint.area_mm2().abs(),
+        zs[layer].top
+    ))
+}
+
+/// The pairs of parts (indices into `parts`, the lower first) whose footprints overlap at
+/// heights both bodies take up, with the message naming them.
+fn collisions(parts: &[&PlacedPart]) -> Vec<(usize, usize, String)> {
+    let mut out = Vec::new();
     for (i, a) in parts.iter().enumerate() {
-        for b in &parts[i + 1..] {
+        for (j, b) in parts.iter().enumerate().skip(i + 1) {
             let Some((low, high)) = shared_heights(a, b) else {
                 continue;
             };
@@ -76,15 +87,16 @@ pub fn part_problems(
                     .map(ExPolygon::area_mm2)
                     .sum();
             if shared > PROBLEM_AREA_MM2 {
-                problems.push(format!(
+                let message = format!(
                     "parts {} and {} collide: their footprints share {shared:.1} mm² between z \
                      {low:.3} and {high:.3} mm",
                     a.name, b.name
-                ));
+                );
+                out.push((i, j, message));
             }
         }
     }
-    problems
+    out
 }
 
 /// The heights both parts' bodies take up, when they overlap.
@@ -181,50 +193,25 @@ pub fn placement_problems(
     zs: &[LayerZ],
     params: FitParams,
 ) -> FitFindings {
-    let mut found = FitFindings {
-        problems: part_problems(parts, islands, zs),
-        ..FitFindings::default()
-    };
+    let mut found = FitFindings::default();
     let Some(last) = zs.last() else {
         return found;
     };
-    let named_already = |found: &FitFindings, name: &str| {
-        let needle = format!("part {name} ");
-        found.problems.iter().any(|p| p.starts_with(&needle))
-    };
-    for part in parts {
-        if named_already(&found, &part.name) {
+    let seated: Vec<Option<String>> = parts.iter().map(|p| seat_problem(p, islands, zs)).collect();
+    let collided = collisions(parts);
+    found.problems.extend(seated.iter().flatten().cloned());
+    found
+        .problems
+        .extend(collided.iter().map(|(_, _, m)| m.clone()));
+    for (part, seat) in parts.iter().zip(&seated) {
+        if seat.is_some() {
             continue;
         }
-        let (z, top) = (part.position.z, part.position.z + part.body_height);
-        if top > last.top + 1e-6 {
-            found.problems.push(format!(
-                "part {} sticks out of the object: the top of its body (z {top:.3} mm) is \
-                 {:.3} mm above the object's top ({:.3} mm)",
-                part.name,
-                top - last.top,
-                last.top
-            ));
+        if let Some(problem) = body_problem(part, islands, zs, last) {
+            found.problems.push(problem);
             continue;
         }
-        let in_body = zs
-            .iter()
-            .enumerate()
-            .filter(|(_, l)| l.bottom < top - 1e-6 && l.top > z + 1e-6);
-        for (k, l) in in_body {
-            if let Some((beyond, reach)) = outside(&part.footprint, &islands[k]) {
-                found.problems.push(format!(
-                    "part {}'s body is not inside the object: at z {:.3} mm {beyond:.1} mm² of \
-                     it lies outside the solid, up to {reach:.2} mm beyond its edge",
-                    part.name, l.top
-                ));
-                break;
-            }
-        }
-        if named_already(&found, &part.name) {
-            continue;
-        }
-        let layer = seat_layer(zs, z);
+        let layer = seat_layer(zs, part.position.z);
         let wall = part
             .footprint
             .points
@@ -244,17 +231,10 @@ pub fn placement_problems(
         }
     }
     for (i, a) in parts.iter().enumerate() {
-        for b in &parts[i + 1..] {
-            if shared_heights(a, b).is_none() {
+        for (j, b) in parts.iter().enumerate().skip(i + 1) {
+            // A collision is named already.
+            if shared_heights(a, b).is_none() || collided.iter().any(|c| (c.0, c.1) == (i, j)) {
                 continue;
-            }
-            let shared: f64 =
-                crate::geom::intersection(&region(&a.footprint), &region(&b.footprint))
-                    .iter()
-                    .map(ExPolygon::area_mm2)
-                    .sum();
-            if shared > PROBLEM_AREA_MM2 {
-                continue; // a collision part_problems names
             }
             let gap = ring_gap(&a.footprint, &b.footprint);
             if gap < params.cavity_offset - 1e-6 {
@@ -276,4 +256,35 @@ pub fn placement_problems(
         }
     }
     found
+}
+
+/// A body that sticks out of the object, or that is not all solid from its seating plane to
+/// its top (the first layer where it is not).
+fn body_problem(
+    part: &PlacedPart,
+    islands: &[Vec<ExPolygon>],
+    zs: &[LayerZ],
+    last: &LayerZ,
+) -> Option<String> {
+    let (z, top) = (part.position.z, part.position.z + part.body_height);
+    if top > last.top + 1e-6 {
+        return Some(format!(
+            "part {} sticks out of the object: the top of its body (z {top:.3} mm) is {:.3} mm \
+             above the object's top ({:.3} mm)",
+            part.name,
+            top - last.top,
+            last.top
+        ));
+    }
+    zs.iter()
+        .enumerate()
+        .filter(|(_, l)| l.bottom < top - 1e-6 && l.top > z + 1e-6)
+        .find_map(|(k, l)| {
+            let (beyond, reach) = outside(&part.footprint, &islands[k])?;
+            Some(format!(
+                "part {}'s body is not inside the object: at z {:.3} mm {beyond:.1} mm² of it \
+                 lies outside the solid, up to {reach:.2} mm beyond its edge",
+                part.name, l.top
+            ))
+        })
 }

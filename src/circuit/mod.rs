@@ -142,6 +142,12 @@ impl Pad {
             ((w * s).abs() + (h * c).abs()) / 2.0,
         ]
     }
+
+    /// The pad's bounding box in the package frame, `[x0, y0, x1, y1]` mm.
+    pub fn extent(&self) -> [f64; 4] {
+        let [hx, hy] = self.half_extent();
+        [self.x - hx, self.y - hy, self.x + hx, self.y + hy]
+    }
 }
 
 /// A number for a message: plain below a million, in scientific notation above, so a value of
@@ -220,6 +226,19 @@ pub struct Part {
 }
 
 impl Part {
+    /// The extent of the part's pads in its package frame, `[x0, y0, x1, y1]` mm, or `None`
+    /// for a package without pads.
+    pub fn pad_extent(&self) -> Option<[f64; 4]> {
+        self.pads.iter().map(Pad::extent).reduce(|a, b| {
+            [
+                a[0].min(b[0]),
+                a[1].min(b[1]),
+                a[2].max(b[2]),
+                a[3].max(b[3]),
+            ]
+        })
+    }
+
     /// The `route="any"` pin that `pad` belongs to together with other pads, if any: the pads of
     /// that pin are one connection point.
     pub fn joined_pin(&self, pad: &str) -> Option<&str> {

@@ -52,14 +52,14 @@ pub fn octopnp_block(circuit: &Circuit, parts: &[PlacedPart], name: &str) -> Str
         out.push_str(";  </shape>\n;  <pads>\n");
         let pads = circuit.part(&part.name).map_or(&[][..], |c| &c.pads[..]);
         for pad in pads {
-            let half = pad.half_extent();
+            let [x1, y1, x2, y2] = pad.extent();
             let _ = writeln!(
                 out,
                 ";    <pad x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>",
-                num(pad.x - half[0]),
-                num(pad.y - half[1]),
-                num(pad.x + half[0]),
-                num(pad.y + half[1])
+                num(x1),
+                num(y1),
+                num(x2),
+                num(y2)
             );
         }
         out.push_str(";  </pads>\n");

@@ -27,7 +27,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::{Circuit, Part};
+use super::Circuit;
 use crate::geom::{Coord, ExPolygon, Point2, scaled, union, unscaled};
 
 /// The most candidate positions the grid may have (2000 × 2000).
@@ -361,24 +361,6 @@ struct Item<'a> {
     need: f64,
 }
 
-/// The extent of `part`'s pads in its package frame, `[x0, y0, x1, y1]` mm.
-fn pad_extent(part: &Part) -> Option<[f64; 4]> {
-    part.pads
-        .iter()
-        .map(|pad| {
-            let [hx, hy] = pad.half_extent();
-            [pad.x - hx, pad.y - hy, pad.x + hx, pad.y + hy]
-        })
-        .reduce(|a, b| {
-            [
-                a[0].min(b[0]),
-                a[1].min(b[1]),
-                a[2].max(b[2]),
-                a[3].max(b[3]),
-            ]
-        })
-}
-
 /// `p` turned by `quarter` quarter turns counter-clockwise (exact).
 fn turn(p: [f64; 2], quarter: u8) -> [f64; 2] {
     match quarter % 4 {
@@ -418,7 +400,7 @@ fn items<'a>(
                 value,
             });
         }
-        let ext = pad_extent(part).ok_or_else(|| PackError::NoPads {
+        let ext = part.pad_extent().ok_or_else(|| PackError::NoPads {
             part: name.to_owned(),
         })?;
         let quarters: &[u8] = if params.rotate { &[0, 1, 2, 3] } else { &[0] };

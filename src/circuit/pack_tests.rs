@@ -3,7 +3,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::*;
-use crate::circuit::{Net, Pad, PadShape, PinRef};
+use crate::circuit::{Net, Pad, PadShape, Part, PinRef};
 use crate::geom::{Point2, Polygon, difference, intersection};
 
 /// A part with rectangular pads `(name, x, y, width, height)`.

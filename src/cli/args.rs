@@ -194,19 +194,21 @@ pub struct PlaceArgs {
     pub json: bool,
 }
 
+/// A finite number, blanks around it allowed.
+fn finite_number(t: &str) -> Result<f64, String> {
+    t.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| format!("{t:?} is not a number"))
+}
+
 /// `X,Y` as two numbers.
 fn parse_xy(s: &str) -> Result<[f64; 2], String> {
     let (x, y) = s
         .split_once(',')
         .ok_or_else(|| format!("expected X,Y (two numbers in mm), got {s:?}"))?;
-    let num = |t: &str| {
-        t.trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("{t:?} is not a number"))
-    };
-    Ok([num(x)?, num(y)?])
+    Ok([finite_number(x)?, finite_number(y)?])
 }
 
 /// `A..B` as two numbers, A ≤ B.
@@ -214,14 +216,7 @@ fn parse_range(s: &str) -> Result<[f64; 2], String> {
     let (a, b) = s
         .split_once("..")
         .ok_or_else(|| format!("expected A..B (two heights in mm), got {s:?}"))?;
-    let num = |t: &str| {
-        t.trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("{t:?} is not a number"))
-    };
-    let (a, b) = (num(a)?, num(b)?);
+    let (a, b) = (finite_number(a)?, finite_number(b)?);
     if a > b {
         return Err(format!("{a} is above {b}: give the lower height first"));
     }

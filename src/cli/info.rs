@@ -254,18 +254,11 @@ fn describe_circuit(circuit: &conduit::circuit::Circuit) -> Value {
         .parts
         .iter()
         .map(|p| {
-            let mut lo = [f64::INFINITY; 2];
-            let mut hi = [f64::NEG_INFINITY; 2];
             let pads: Vec<Value> = p
                 .pads
                 .iter()
                 .map(|pad| {
                     let (w, h) = pad.shape.size();
-                    let half = pad.half_extent();
-                    for (k, v) in [pad.x, pad.y].into_iter().enumerate() {
-                        lo[k] = lo[k].min(v - half[k]);
-                        hi[k] = hi[k].max(v + half[k]);
-                    }
                     json!({
                         "name": pad.name,
                         "at": [round(pad.x), round(pad.y)],
@@ -275,11 +268,9 @@ fn describe_circuit(circuit: &conduit::circuit::Circuit) -> Value {
                     })
                 })
                 .collect();
-            let size = if p.pads.is_empty() {
-                Value::Null
-            } else {
-                json!([round(hi[0] - lo[0]), round(hi[1] - lo[1])])
-            };
+            let size = p.pad_extent().map_or(Value::Null, |[x0, y0, x1, y1]| {
+                json!([round(x1 - x0), round(y1 - y0)])
+            });
             json!({
                 "name": p.name,
                 "value": p.value,

@@ -493,20 +493,10 @@ fn check(
             wall_clearance: cfg.route.wall_clearance,
         },
     );
-    let closest_pads = closest_foreign_pads(circuit, &placement);
-    let mut lo = [f64::INFINITY; 2];
-    let mut hi = [f64::NEG_INFINITY; 2];
-    for p in mine.iter().flat_map(|p| p.footprint.points_mm()) {
-        for k in 0..2 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let span = if mine.is_empty() {
-        [0.0; 2]
-    } else {
-        [hi[0] - lo[0], hi[1] - lo[1]]
-    };
+    let closest_pads = closest_foreign_pads(&mine);
+    let span =
+        crate::circuit::board_layout::bounds(mine.iter().flat_map(|p| p.footprint.points_mm()))
+            .map_or([0.0; 2], |(lo, hi)| [hi[0] - lo[0], hi[1] - lo[1]]);
     Ok(PlaceOutcome {
         placement,
         toml,
