@@ -57,6 +57,18 @@ fn place(args: &[&std::ffi::OsStr]) -> (Option<i32>, Value, String) {
     (o.status.code(), summary, stderr(&o))
 }
 
+/// `conduit place --json --model MODEL -o OUT` with `rest`; the exit code and the summary.
+fn place_into(model: &Path, out: &Path, rest: &[&std::ffi::OsStr]) -> (Option<i32>, Value, String) {
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "--model".as_ref(),
+        model.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ];
+    args.extend_from_slice(rest);
+    place(&args)
+}
+
 /// The parts of a placement TOML by name: (x, y, z, rotation).
 fn parts(toml_path: &Path) -> BTreeMap<String, [f64; 4]> {
     let text = std::fs::read_to_string(toml_path).expect("placement written");
@@ -87,31 +99,24 @@ fn every_corpus_board_is_placed_from_its_board_and_slices() {
         let brd = board_file(&corpus, name);
         let probe = block(d, "probe", [400.0, 400.0, 8.0]);
         let out = d.join(format!("{name}.toml"));
-        let (_, first, err) = place(&[
-            "--model".as_ref(),
-            probe.as_os_str(),
-            "--from-brd".as_ref(),
-            brd.as_os_str(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ]);
+        let (_, first, err) = place_into(&probe, &out, &["--from-brd".as_ref(), brd.as_os_str()]);
         let scale = first["suggested_scale"]
             .as_f64()
             .unwrap_or_else(|| panic!("{name}: no scale suggested: {first} {err}"));
         // The layout at that scale, its span read from a probe run, in a block 6 mm larger.
         let s = format!("{scale}");
-        let (_, sized, err) = place(&[
-            "--model".as_ref(),
-            probe.as_os_str(),
-            "--from-brd".as_ref(),
-            brd.as_os_str(),
-            "--scale".as_ref(),
-            s.as_ref(),
-            "--at".as_ref(),
-            "0,0".as_ref(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ]);
+        let (_, sized, err) = place_into(
+            &probe,
+            &out,
+            &[
+                "--from-brd".as_ref(),
+                brd.as_os_str(),
+                "--scale".as_ref(),
+                s.as_ref(),
+                "--at".as_ref(),
+                "0,0".as_ref(),
+            ],
+        );
         let span = [
             sized["span_mm"][0]
                 .as_f64()
@@ -119,18 +124,18 @@ fn every_corpus_board_is_placed_from_its_board_and_slices() {
             sized["span_mm"][1].as_f64().expect("span"),
         ];
         let model = block(d, name, [span[0] + 12.0, span[1] + 12.0, 8.0]);
-        let (code, summary, err) = place(&[
-            "--model".as_ref(),
-            model.as_os_str(),
-            "--from-brd".as_ref(),
-            brd.as_os_str(),
-            "--scale".as_ref(),
-            s.as_ref(),
-            "--at".as_ref(),
-            "0,0".as_ref(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ]);
+        let (code, summary, err) = place_into(
+            &model,
+            &out,
+            &[
+                "--from-brd".as_ref(),
+                brd.as_os_str(),
+                "--scale".as_ref(),
+                s.as_ref(),
+                "--at".as_ref(),
+                "0,0".as_ref(),
+            ],
+        );
         assert_eq!(code, Some(0), "{name}: {summary} {err}");
         assert_eq!(summary["problems"], Value::Array(Vec::new()), "{name}");
         let placed = parts(&out);
@@ -219,19 +224,19 @@ fn a_board_layout_is_moved_turned_and_spread_as_asked() {
     let board = conduit_eagle::read_board(&std::fs::read(&brd).expect("brd")).expect("brd");
     let model = block(d, "big", [200.0, 200.0, 8.0]);
     let run = |at: &str, out: &Path| {
-        let (code, summary, err) = place(&[
-            "--model".as_ref(),
-            model.as_os_str(),
-            "--from-brd".as_ref(),
-            brd.as_os_str(),
-            "--rotate".as_ref(),
-            "90".as_ref(),
-            "--scale".as_ref(),
-            "1.5".as_ref(),
-            format!("--at={at}").as_ref(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ]);
+        let (code, summary, err) = place_into(
+            &model,
+            out,
+            &[
+                "--from-brd".as_ref(),
+                brd.as_os_str(),
+                "--rotate".as_ref(),
+                "90".as_ref(),
+                "--scale".as_ref(),
+                "1.5".as_ref(),
+                format!("--at={at}").as_ref(),
+            ],
+        );
         assert_eq!(code, Some(0), "{summary} {err}");
         parts(out)
     };
@@ -342,16 +347,16 @@ fn refusals_name_the_parts_the_plane_and_the_file() {
     let out = d.join("p.toml");
     let openlog = board_file(&corpus, "OpenLog");
     let board = conduit_eagle::read_board(&std::fs::read(&openlog).expect("brd")).expect("brd");
-    let (code, _, err) = place(&[
-        "--model".as_ref(),
-        model.as_os_str(),
-        "--from-brd".as_ref(),
-        openlog.as_os_str(),
-        "--bottom".as_ref(),
-        "refuse".as_ref(),
-        "-o".as_ref(),
-        out.as_os_str(),
-    ]);
+    let (code, _, err) = place_into(
+        &model,
+        &out,
+        &[
+            "--from-brd".as_ref(),
+            openlog.as_os_str(),
+            "--bottom".as_ref(),
+            "refuse".as_ref(),
+        ],
+    );
     assert_eq!(code, Some(1));
     assert!(err.contains("bottom-side part(s) ("), "{err}");
     // The bottom-side elements that are parts with a pad on a net (fiducials are left out).
@@ -373,16 +378,16 @@ fn refusals_name_the_parts_the_plane_and_the_file() {
     for name in bottom {
         assert!(err.contains(name), "{name} in {err}");
     }
-    let (code, _, err) = place(&[
-        "--model".as_ref(),
-        model.as_os_str(),
-        "--from-brd".as_ref(),
-        openlog.as_os_str(),
-        "--z".as_ref(),
-        "12".as_ref(),
-        "-o".as_ref(),
-        out.as_os_str(),
-    ]);
+    let (code, _, err) = place_into(
+        &model,
+        &out,
+        &[
+            "--from-brd".as_ref(),
+            openlog.as_os_str(),
+            "--z".as_ref(),
+            "12".as_ref(),
+        ],
+    );
     assert_eq!(code, Some(1));
     assert!(
         err.contains(
@@ -391,14 +396,7 @@ fn refusals_name_the_parts_the_plane_and_the_file() {
         "{err}"
     );
     let wifly = board_file(&corpus, "WiFly-Shield");
-    let (code, _, err) = place(&[
-        "--model".as_ref(),
-        model.as_os_str(),
-        "--from-brd".as_ref(),
-        wifly.as_os_str(),
-        "-o".as_ref(),
-        out.as_os_str(),
-    ]);
+    let (code, _, err) = place_into(&model, &out, &["--from-brd".as_ref(), wifly.as_os_str()]);
     assert_eq!(code, Some(1));
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains(&*wifly.display().to_string()), "{err}");
@@ -420,15 +418,11 @@ fn auto_placed_boards_route_every_wire() {
     for name in ["LilyPad_Vibe_Board", "LilyPad_Tri-Color_LED", "OpenLog"] {
         let sch = board_file(&corpus, name).with_extension("sch");
         let out = d.join(format!("{name}.toml"));
-        let (code, summary, err) = place(&[
-            "--model".as_ref(),
-            model.as_os_str(),
-            "--auto".as_ref(),
-            "--circuit".as_ref(),
-            sch.as_os_str(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ]);
+        let (code, summary, err) = place_into(
+            &model,
+            &out,
+            &["--auto".as_ref(), "--circuit".as_ref(), sch.as_os_str()],
+        );
         assert_eq!(code, Some(0), "{name}: {summary} {err}");
         assert_eq!(summary["problems"], Value::Array(Vec::new()), "{name}");
         let planes = summary["planes"].as_array().expect("planes");
@@ -499,15 +493,11 @@ fn auto_placement_names_the_parts_that_find_no_room() {
     let model = block(d, "small", [14.0, 12.0, 6.0]);
     let sch = board_file(&corpus, "OpenLog").with_extension("sch");
     let out = d.join("p.toml");
-    let (code, _, err) = place(&[
-        "--model".as_ref(),
-        model.as_os_str(),
-        "--auto".as_ref(),
-        "--circuit".as_ref(),
-        sch.as_os_str(),
-        "-o".as_ref(),
-        out.as_os_str(),
-    ]);
+    let (code, _, err) = place_into(
+        &model,
+        &out,
+        &["--auto".as_ref(), "--circuit".as_ref(), sch.as_os_str()],
+    );
     assert_eq!(code, Some(1));
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("no room for "), "{err}");
