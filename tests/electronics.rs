@@ -553,16 +553,7 @@ fn the_gcode_carries_octopnps_part_description_for_every_machine_placed_part() {
     let root = root.expect("well-formed XML with a root element");
     assert_eq!(root.name, "object");
     // Every M361 P<id> has its part, with OctoPNP's required fields as numbers.
-    let ids: Vec<String> = text
-        .lines()
-        .filter_map(|l| {
-            l.split(';')
-                .next()?
-                .trim()
-                .strip_prefix("M361 P")
-                .map(str::to_owned)
-        })
-        .collect();
+    let ids = crate::support::m361_ids(&text);
     assert_eq!(ids, ["2", "3"]);
     let v: Value =
         serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");

@@ -4,7 +4,9 @@
 //! temporary file a host passes, and a warning when host lines hold text OctoPNP would read too.
 
 use crate::postprocess::check_postprocessed;
-use crate::support::{conduit, corpus, octopnp_description, sample, stderr, temp_dir, xml_number};
+use crate::support::{
+    conduit, corpus, m361_ids, octopnp_description, sample, stderr, temp_dir, xml_number,
+};
 use conduit::pipeline::postprocess::{HostPrint, edit_circuit};
 use conduit::postprocess::rewrite::{DESCRIPTION_MARK, END_MARK};
 use serde_json::Value;
@@ -34,19 +36,6 @@ fn host_copy(dir: &Path, src: &Path, name: &str) -> PathBuf {
     let file = dir.join(name);
     std::fs::copy(src, &file).expect("copy");
     file
-}
-
-/// The numbers of the `M361 P<id>` lines.
-fn m361_ids(text: &str) -> Vec<String> {
-    text.lines()
-        .filter_map(|l| {
-            l.split(';')
-                .next()?
-                .trim()
-                .strip_prefix("M361 P")
-                .map(str::to_owned)
-        })
-        .collect()
 }
 
 /// X, Y and Z of the `;PICK_AND_PLACE PART=<part> X=.. Y=.. Z=..` comment of `part`.

@@ -134,3 +134,16 @@ pub fn xml_number(node: &conduit_xml::Node, key: &str, what: &str) -> f64 {
         .and_then(|v| v.parse().ok())
         .unwrap_or_else(|| panic!("{what}: {key} is not a number"))
 }
+
+/// The numbers of the `M361 P<id>` lines.
+pub fn m361_ids(text: &str) -> Vec<String> {
+    text.lines()
+        .filter_map(|l| {
+            l.split(';')
+                .next()?
+                .trim()
+                .strip_prefix("M361 P")
+                .map(str::to_owned)
+        })
+        .collect()
+}
