@@ -83,22 +83,38 @@ pub(crate) fn replay(text: &str) -> Replayed {
 /// Slices the bundled demo (block, LED and coin cell) into `dir`: `demo.gcode` and its report
 /// `demo.json`, whose paths it returns.
 pub(crate) fn slice_demo(dir: &Path) -> (PathBuf, PathBuf) {
+    let (o, out, report) = run_demo_slice(dir, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    (out, report)
+}
+
+/// `conduit slice` of the demo into `dir` (`demo.gcode`, report `demo.json`) with `extra`
+/// arguments: the run and the paths of the G-code and the report.
+pub(crate) fn run_demo_slice(
+    dir: &Path,
+    extra: &[&str],
+) -> (std::process::Output, PathBuf, PathBuf) {
     let (out, report) = (dir.join("demo.gcode"), dir.join("demo.json"));
     let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
-    let o = conduit([
+    let (stl, sch, toml) = (
+        demo("block.stl"),
+        demo("led_coin.sch"),
+        demo("placement.toml"),
+    );
+    let mut args: Vec<&std::ffi::OsStr> = vec![
         "slice".as_ref(),
-        demo("block.stl").as_os_str(),
+        stl.as_os_str(),
         "--circuit".as_ref(),
-        demo("led_coin.sch").as_os_str(),
+        sch.as_os_str(),
         "--placement".as_ref(),
-        demo("placement.toml").as_os_str(),
+        toml.as_os_str(),
         "-o".as_ref(),
         out.as_os_str(),
         "--report".as_ref(),
         report.as_os_str(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    (out, report)
+    ];
+    args.extend(extra.iter().map(std::ffi::OsStr::new));
+    (conduit(args), out, report)
 }
 
 #[test]

@@ -5,10 +5,11 @@
 //! come out unrouted for that reason. No test here depends on how fast the machine is (the
 //! time a moderate limit takes is measured by `bench/route.sh --time-limit`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use serde_json::Value;
 
+use crate::electronics::run_demo_slice;
 use crate::support::{conduit, corpus, files_in, sample, stderr, temp_dir};
 
 /// A limit no routing search fits in, s.
@@ -25,31 +26,10 @@ fn demo() -> [PathBuf; 3] {
     ]
 }
 
-/// `conduit slice` of the demo board into `dir` with `extra` arguments: the run and the paths
-/// of the G-code and the report.
-fn slice_demo(dir: &Path, extra: &[&str]) -> (std::process::Output, PathBuf, PathBuf) {
-    let [stl, sch, toml] = demo();
-    let (out, report) = (dir.join("demo.gcode"), dir.join("demo.json"));
-    let mut args: Vec<&std::ffi::OsStr> = vec![
-        "slice".as_ref(),
-        stl.as_os_str(),
-        "--circuit".as_ref(),
-        sch.as_os_str(),
-        "--placement".as_ref(),
-        toml.as_os_str(),
-        "-o".as_ref(),
-        out.as_os_str(),
-        "--report".as_ref(),
-        report.as_os_str(),
-    ];
-    args.extend(extra.iter().map(std::ffi::OsStr::new));
-    (conduit(args), out, report)
-}
-
 #[test]
 fn a_tiny_time_limit_fails_the_job_naming_the_limit() {
     let dir = temp_dir();
-    let (o, out, report) = slice_demo(dir.path(), &["--set", TINY]);
+    let (o, out, report) = run_demo_slice(dir.path(), &["--set", TINY]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
     let lines: Vec<&str> = err
@@ -80,7 +60,7 @@ fn the_defaults_list_the_time_limit() {
 #[test]
 fn a_tiny_time_limit_reports_every_wire_routed_or_out_of_time() {
     let dir = temp_dir();
-    let (o, out, report) = slice_demo(dir.path(), &["--set", TINY, "--allow-unrouted"]);
+    let (o, out, report) = run_demo_slice(dir.path(), &["--set", TINY, "--allow-unrouted"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(out.exists(), "the G-code is written with --allow-unrouted");
     let json: Value = serde_json::from_slice(&std::fs::read(&report).expect("report written"))
@@ -116,8 +96,8 @@ fn a_job_in_time_is_the_same_with_and_without_a_limit() {
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
     std::fs::create_dir_all(&a).expect("folder a");
     std::fs::create_dir_all(&b).expect("folder b");
-    let (oa, ga, ra) = slice_demo(&a, &[]);
-    let (ob, gb, rb) = slice_demo(&b, &["--set", "route.time_limit=0"]);
+    let (oa, ga, ra) = run_demo_slice(&a, &[]);
+    let (ob, gb, rb) = run_demo_slice(&b, &["--set", "route.time_limit=0"]);
     assert!(oa.status.success(), "{}", stderr(&oa));
     assert!(ob.status.success(), "{}", stderr(&ob));
     assert_eq!(
@@ -140,7 +120,7 @@ fn a_job_in_time_is_the_same_with_and_without_a_limit() {
 #[test]
 fn a_negative_time_limit_is_refused() {
     let dir = temp_dir();
-    let (o, out, _) = slice_demo(dir.path(), &["--set", "route.time_limit=-1"]);
+    let (o, out, _) = run_demo_slice(dir.path(), &["--set", "route.time_limit=-1"]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(
