@@ -20,7 +20,7 @@ use conduit::pipeline::{Electronics, slice_scene_with};
 use conduit::scene::{MeshFormat, Scene, SceneObject, save};
 use serde_json::Value;
 
-use crate::support::{conduit, corpus, stderr, temp_dir};
+use crate::support::{conduit, corpus, eagle_file, stderr, temp_dir};
 
 /// Smallest side of a grid cell, mm.
 const MIN_CELL_MM: f64 = 6.0;
@@ -34,25 +34,6 @@ const BLOCK_HEIGHT_MM: f64 = 4.0;
 const SEATING_Z_MM: f64 = 1.0;
 /// Body height of every part, mm.
 const BODY_HEIGHT_MM: f64 = 1.0;
-
-/// The schematic of corpus board `name` (`eagle/<name>/*/*.sch`).
-fn schematic(corpus: &Path, name: &str) -> PathBuf {
-    let dir = corpus.join("eagle").join(name);
-    let mut found = Vec::new();
-    let mut stack = vec![dir.clone()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).expect("corpus board folder readable") {
-            let path = entry.expect("directory entry").path();
-            if path.is_dir() {
-                stack.push(path);
-            } else if path.extension().is_some_and(|e| e == "sch") {
-                found.push(path);
-            }
-        }
-    }
-    assert_eq!(found.len(), 1, "one .sch under {}", dir.display());
-    found.remove(0)
-}
 
 /// Parts on a grid: the placement and the block it fits in.
 struct Grid {
@@ -282,7 +263,7 @@ impl Board {
     /// Corpus board `name`, or `None` (after the skip line) without the corpus.
     fn load(name: &'static str) -> Option<Board> {
         let corpus = corpus()?;
-        let sch = schematic(&corpus, name);
+        let sch = eagle_file(&corpus, name, "sch");
         let circuit = Circuit::load(&sch).unwrap_or_else(|e| panic!("{e}"));
         let grid = grid_placement(&circuit, &board_positions(&sch), CELL_MARGIN_MM);
         let expected = expected_wires(&circuit, &grid.placed);
@@ -317,7 +298,7 @@ impl Board {
         let (out, report) = (dir.join("board.gcode"), dir.join("report.json"));
         save(&block(&self.grid), &stl, MeshFormat::Stl).expect("block written");
         std::fs::write(&toml, &self.grid.toml).expect("placement written");
-        let sch = schematic(&corpus().expect("corpus"), self.name);
+        let sch = eagle_file(&corpus().expect("corpus"), self.name, "sch");
         let started = Instant::now();
         let mut args: Vec<&std::ffi::OsStr> = vec![
             "slice".as_ref(),
@@ -455,7 +436,7 @@ fn lilypad_tri_color_led_routes_completely_through_the_cli() {
     let check = conduit(["check".as_ref(), gcode.as_os_str()]);
     assert_eq!(check.status.code(), Some(0), "{}", stderr(&check));
     // The circuit rebuilt from the G-code alone: every net connected, nothing else wrong.
-    let sch = schematic(&corpus().expect("corpus"), board.name);
+    let sch = eagle_file(&corpus().expect("corpus"), board.name, "sch");
     let dir = dir.path();
     let check = conduit([
         "check".as_ref(),

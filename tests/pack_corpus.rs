@@ -2,35 +2,16 @@
 //! rubberbands no longer than a grid of cells improved by swaps gives.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use conduit::circuit::pack::{PackParams, Packed, pack, rubberband_length};
 use conduit::circuit::{Circuit, Part};
 use conduit::geom::{ExPolygon, Point2, Polygon, difference};
 
-use crate::support::corpus;
+use crate::support::{corpus, eagle_file};
 
 /// Distance between footprints, mm.
 const GAP_MM: f64 = 3.0;
-
-/// The schematic of corpus board `name` (`eagle/<name>/*/*.sch`).
-fn schematic(corpus: &Path, name: &str) -> PathBuf {
-    let mut found = Vec::new();
-    let mut stack = vec![corpus.join("eagle").join(name)];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).expect("corpus board folder readable") {
-            let path = entry.expect("directory entry").path();
-            if path.is_dir() {
-                stack.push(path);
-            } else if path.extension().is_some_and(|e| e == "sch") {
-                found.push(path);
-            }
-        }
-    }
-    assert_eq!(found.len(), 1, "one .sch for {name}");
-    found.remove(0)
-}
 
 /// A packed part's footprint in the region's frame, `[x0, y0, x1, y1]` mm.
 fn footprint(c: &Circuit, p: &Packed) -> [f64; 4] {
@@ -127,7 +108,7 @@ fn packs(name: &str) {
     let Some(corpus) = corpus() else {
         return;
     };
-    let c = Circuit::load(&schematic(&corpus, name)).unwrap_or_else(|e| panic!("{e}"));
+    let c = Circuit::load(&eagle_file(&corpus, name, "sch")).unwrap_or_else(|e| panic!("{e}"));
     let parts: Vec<(&Part, [f64; 4])> = c
         .parts
         .iter()

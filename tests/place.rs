@@ -9,24 +9,7 @@ use conduit::mesh::Mesh;
 use conduit::scene::{MeshFormat, Scene, SceneObject, save};
 use serde_json::Value;
 
-use crate::support::{conduit, corpus, stderr, stdout, temp_dir};
-
-/// The `.brd` of corpus board `name` (`eagle/<name>/*/*.brd`).
-fn board_file(corpus: &Path, name: &str) -> PathBuf {
-    let dir = corpus.join("eagle").join(name);
-    let mut found: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("board folder")
-        .flat_map(|e| {
-            std::fs::read_dir(e.expect("entry").path())
-                .into_iter()
-                .flatten()
-        })
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "brd"))
-        .collect();
-    assert_eq!(found.len(), 1, "one .brd under {}", dir.display());
-    found.remove(0)
-}
+use crate::support::{conduit, corpus, eagle_file, stderr, stdout, temp_dir};
 
 /// A block `size` mm with its bottom centre at the origin, written as STL.
 fn block(dir: &Path, name: &str, size: [f64; 3]) -> PathBuf {
@@ -96,7 +79,7 @@ fn every_corpus_board_is_placed_from_its_board_and_slices() {
         "Serial7SegmentDisplay",
         "RedBot",
     ] {
-        let brd = board_file(&corpus, name);
+        let brd = eagle_file(&corpus, name, "brd");
         let probe = block(d, "probe", [400.0, 400.0, 8.0]);
         let out = d.join(format!("{name}.toml"));
         let (_, first, err) = place_into(&probe, &out, &["--from-brd".as_ref(), brd.as_os_str()]);
@@ -220,7 +203,7 @@ fn a_board_layout_is_moved_turned_and_spread_as_asked() {
     };
     let dir = temp_dir();
     let d = dir.path();
-    let brd = board_file(&corpus, "LilyPad_Tri-Color_LED");
+    let brd = eagle_file(&corpus, "LilyPad_Tri-Color_LED", "brd");
     let board = conduit_eagle::read_board(&std::fs::read(&brd).expect("brd")).expect("brd");
     let model = block(d, "big", [200.0, 200.0, 8.0]);
     let run = |at: &str, out: &Path| {
@@ -277,7 +260,7 @@ fn a_layout_with_parts_in_each_others_cavities_or_outside_is_refused() {
     };
     let dir = temp_dir();
     let d = dir.path();
-    let brd = board_file(&corpus, "OpenLog");
+    let brd = eagle_file(&corpus, "OpenLog", "brd");
     let model = block(d, "big", [200.0, 200.0, 8.0]);
     let out = d.join("p.toml");
     let args = |model: &Path, scale: &'static str, force: bool| {
@@ -345,7 +328,7 @@ fn refusals_name_the_parts_the_plane_and_the_file() {
     let d = dir.path();
     let model = block(d, "big", [200.0, 200.0, 8.0]);
     let out = d.join("p.toml");
-    let openlog = board_file(&corpus, "OpenLog");
+    let openlog = eagle_file(&corpus, "OpenLog", "brd");
     let board = conduit_eagle::read_board(&std::fs::read(&openlog).expect("brd")).expect("brd");
     let (code, _, err) = place_into(
         &model,
@@ -395,7 +378,7 @@ fn refusals_name_the_parts_the_plane_and_the_file() {
         ),
         "{err}"
     );
-    let wifly = board_file(&corpus, "WiFly-Shield");
+    let wifly = eagle_file(&corpus, "WiFly-Shield", "brd");
     let (code, _, err) = place_into(&model, &out, &["--from-brd".as_ref(), wifly.as_os_str()]);
     assert_eq!(code, Some(1));
     assert_eq!(err.lines().count(), 1, "{err}");
@@ -416,7 +399,7 @@ fn auto_placed_boards_route_every_wire() {
     let d = dir.path();
     let model = block(d, "block", [70.0, 60.0, 6.0]);
     for name in ["LilyPad_Vibe_Board", "LilyPad_Tri-Color_LED", "OpenLog"] {
-        let sch = board_file(&corpus, name).with_extension("sch");
+        let sch = eagle_file(&corpus, name, "sch");
         let out = d.join(format!("{name}.toml"));
         let (code, summary, err) = place_into(
             &model,
@@ -491,7 +474,7 @@ fn auto_placement_names_the_parts_that_find_no_room() {
     let dir = temp_dir();
     let d = dir.path();
     let model = block(d, "small", [14.0, 12.0, 6.0]);
-    let sch = board_file(&corpus, "OpenLog").with_extension("sch");
+    let sch = eagle_file(&corpus, "OpenLog", "sch");
     let out = d.join("p.toml");
     let (code, _, err) = place_into(
         &model,

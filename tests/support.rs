@@ -147,3 +147,22 @@ pub fn m361_ids(text: &str) -> Vec<String> {
         })
         .collect()
 }
+
+/// The one file with extension `ext` (`sch`, `brd`) of corpus EAGLE board `name`, anywhere
+/// under `eagle/<name>/`.
+pub fn eagle_file(corpus: &Path, name: &str, ext: &str) -> PathBuf {
+    let mut found = Vec::new();
+    let mut stack = vec![corpus.join("eagle").join(name)];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).expect("corpus board folder readable") {
+            let path = entry.expect("directory entry").path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == ext) {
+                found.push(path);
+            }
+        }
+    }
+    assert_eq!(found.len(), 1, "one .{ext} under eagle/{name}");
+    found.remove(0)
+}
