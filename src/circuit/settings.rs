@@ -9,7 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::route::RouteParams;
+use crate::route::{RouteParams, Strategy};
 
 /// Cavities, channels and trace routing (`[route]`). Lengths in mm.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -52,6 +52,13 @@ pub struct RouteSettings {
     /// Rounds of rip-up and reroute for wires that could not be routed: the wires in their way
     /// are routed again after them. 0 routes each wire once. Default 3.
     pub rip_up_rounds: usize,
+    /// How the wires share the material: `negotiated` routes every wire with the other nets'
+    /// traces as a cost that rises, round by round, where traces still touch, until none do
+    /// (the wires then still in conflict are routed again in order); `ordered` routes wire
+    /// after wire, each around the traces before it. Default ordered.
+    pub strategy: Strategy,
+    /// Most rounds of negotiation (`strategy = "negotiated"`). From 1 to 1000. Default 12.
+    pub negotiation_rounds: usize,
     /// Longest route worth printing, as a multiple of the straight distance between the pads
     /// (plus `detour_slack`): a trace's resistance grows with its length, so a wire that needs a
     /// longer route is reported unrouted. Default 3.
@@ -97,6 +104,8 @@ impl Default for RouteSettings {
             layer_change_penalty: r.layer_change_penalty,
             layer_span: r.layer_span,
             rip_up_rounds: r.rip_up_rounds,
+            strategy: r.strategy,
+            negotiation_rounds: r.negotiation_rounds,
             max_detour: r.max_detour,
             time_limit: r.time_limit,
             detour_slack: r.detour_slack,
@@ -126,6 +135,8 @@ impl RouteSettings {
             layer_change_penalty: self.layer_change_penalty,
             layer_span: self.layer_span,
             rip_up_rounds: self.rip_up_rounds,
+            strategy: self.strategy,
+            negotiation_rounds: self.negotiation_rounds,
             max_detour: self.max_detour,
             detour_slack: self.detour_slack,
             time_limit: self.time_limit,
@@ -166,6 +177,12 @@ impl RouteSettings {
             out.push(format!(
                 "route.terminal_pad must be from 0 to 50 mm, got {}",
                 self.terminal_pad
+            ));
+        }
+        if !(1..=1000).contains(&self.negotiation_rounds) {
+            out.push(format!(
+                "route.negotiation_rounds must be from 1 to 1000, got {}",
+                self.negotiation_rounds
             ));
         }
         if self.perimeter_weights.len() < self.perimeters {

@@ -81,6 +81,13 @@ pub struct NetRoute {
     /// Why the wire was not routed ("no path within the detour limit (route.max_detour)",
     /// "time limit reached (route.time_limit = 180 s)", ...); `None` when it was.
     pub reason: Option<String>,
+    /// What stands in the way of a wire not routed: other nets' traces on its best way
+    /// (`trace of net GND (U1.3 to U1.5)`) and other nets' pads closer to its own than two
+    /// traces can run (`pad U1.7 (net N$2) 0.80 mm away`). Empty when it was routed.
+    pub blocked_by: Vec<String>,
+    /// What would help a wire not routed: a trace width, more room between the parts, more
+    /// layers, a longer detour or time. `None` when it was routed.
+    pub help: Option<String>,
 }
 
 /// How the routing of a job went, for the report.
@@ -88,6 +95,12 @@ pub struct NetRoute {
 pub struct RoutingSummary {
     /// Rip-up and reroute rounds run (the most of any object).
     pub rounds: usize,
+    /// Negotiated-congestion rounds run (the most of any object; 0 with `route.strategy =
+    /// "ordered"`).
+    pub negotiation_rounds: usize,
+    /// Wires still in conflict with another net's trace when negotiation stopped, routed again
+    /// in order (every object).
+    pub negotiation_conflicts: usize,
     /// Wall time spent routing, seconds (every object).
     pub wall_seconds: f64,
     /// Whether `route.time_limit` stopped routing before it was done.
@@ -153,6 +166,7 @@ impl ElectronicsReport {
                 .reason
                 .as_deref()
                 .filter(|r| r.starts_with(TIME_LIMIT_REASON))
+                .or(w.help.as_deref())
                 .map(|r| format!(": {r}"))
                 .unwrap_or_default();
             format!(
@@ -412,7 +426,7 @@ pub fn object_stage(
         .filter(|_| params.terminal_pad > 0.0)
         .map(|t| PadCopper::round(Some(&t.net), t.at, params.terminal_pad))
         .collect();
-    let result = route_object(
+    let (result, pad_names) = route_object(
         &mine,
         &mine_wires,
         &terminal_copper,
@@ -423,6 +437,7 @@ pub fn object_stage(
     );
     let style = TraceStyle::of(params);
     let mut per_layer = trace_paths(&result, &mine_wires, zs, style, report);
+    explain_unrouted(&result, &mine_wires, &pad_names, &params.route, report);
     if params.pad_drops {
         add_pad_drops(&mine, zs, style, &mut per_layer);
     }
@@ -509,13 +524,16 @@ fn report_between_objects(between: &[&CircuitWire], object: usize, report: &mut 
             perimeter_crossings: 0,
             joins: None,
             reason: Some("a trace cannot leave its object".to_owned()),
+            blocked_by: Vec::new(),
+            help: Some("join the objects, or wire it by hand".to_owned()),
         });
     }
 }
 
 /// Routes the object's wires through its layers (the islands with the cavities carved) around
 /// its parts' pads, after warning about pads too close for two traces, and carves the
-/// channels from the islands.
+/// channels from the islands. Returns the routes and the names of the pads routed round
+/// (`PART.PAD`, or `terminal of net N`), in the router's order.
 fn route_object(
     mine: &[(usize, &PlacedPart)],
     mine_wires: &[&CircuitWire],
@@ -524,7 +542,7 @@ fn route_object(
     zs: &[LayerZ],
     params: &RouteParams,
     report: &mut ElectronicsReport,
-) -> RouteResult {
+) -> (RouteResult, Vec<String>) {
     let wires: Vec<Wire> = mine_wires.iter().map(|w| w.wire.clone()).collect();
     let layers: Vec<RouteLayer> = zs
         .iter()
@@ -545,6 +563,15 @@ fn route_object(
         })
         .chain(terminal_copper.iter().cloned())
         .collect();
+    let pad_names: Vec<String> = mine
+        .iter()
+        .flat_map(|(_, p)| p.pads.iter().map(|pad| format!("{}.{}", p.name, pad.name)))
+        .chain(
+            terminal_copper
+                .iter()
+                .map(|t| format!("terminal of net {}", t.net.as_deref().unwrap_or("-"))),
+        )
+        .collect();
     report
         .warnings
         .extend(mine.iter().filter_map(|(_, p)| pitch_warning(p, params)));
@@ -552,10 +579,90 @@ fn route_object(
     let result = route(&layers, &wires, &pads, params);
     let summary = &mut report.routing;
     summary.rounds = summary.rounds.max(result.rounds);
+    summary.negotiation_rounds = summary.negotiation_rounds.max(result.negotiation_rounds);
+    summary.negotiation_conflicts += result.negotiation_conflicts;
     summary.wall_seconds += clock.elapsed().as_secs_f64();
     summary.time_limit_reached |= result.time_limit_reached;
     carve_channels(islands, &result.channels);
-    result
+    (result, pad_names)
+}
+
+/// Fills in `blocked_by` and `help` of the report entries of the wires `result` could not
+/// route (the last `mine_wires.len()` entries of `report.wires`), from the router's
+/// [`Blockage`](crate::route::Blockage)s.
+fn explain_unrouted(
+    result: &RouteResult,
+    mine_wires: &[&CircuitWire],
+    pad_names: &[String],
+    params: &RouteParams,
+    report: &mut ElectronicsReport,
+) {
+    let first = report.wires.len().saturating_sub(mine_wires.len());
+    let pins = |k: usize| {
+        mine_wires
+            .get(k)
+            .map_or_else(String::new, |w| format!("{} to {}", w.from, w.to))
+    };
+    for (entry, w) in report.wires[first..].iter_mut().zip(&result.wires) {
+        if w.routed {
+            continue;
+        }
+        if matches!(w.reason, Some(crate::route::Unrouted::TimeLimit(_))) {
+            entry.help = Some(format!(
+                "route.time_limit (now {} s) stopped routing before this wire: raise it",
+                params.time_limit
+            ));
+            continue;
+        }
+        let Some(b) = &w.blockage else {
+            continue;
+        };
+        for &k in &b.traces {
+            if let Some(other) = result.wires.get(k) {
+                entry
+                    .blocked_by
+                    .push(format!("trace of net {} ({})", other.net, pins(k)));
+            }
+        }
+        for &(k, d) in &b.pads {
+            let name = pad_names.get(k).map_or("?", String::as_str);
+            entry.blocked_by.push(format!("pad {name} {d:.2} mm away"));
+        }
+        entry.help = Some(if let Some(&(k, d)) = b.pads.first() {
+            format!(
+                "its pad and {} are {d:.2} mm apart, closer than two traces can run ({:.2} mm): \
+                 a route.conductive_width of {:.2} mm fits, or more room between the pads",
+                pad_names.get(k).map_or("?", String::as_str),
+                min_trace_spacing(params),
+                fitting_width(d, params)
+            )
+        } else if !b.traces.is_empty() {
+            let mut nets: Vec<&str> = b
+                .traces
+                .iter()
+                .filter_map(|&k| result.wires.get(k).map(|o| o.net.as_str()))
+                .collect();
+            nets.dedup();
+            format!(
+                "the traces of {} take its way: more room between the parts (conduit place \
+                 --scale), more layers to pass them (route.layer_span = {}), or \
+                 route.strategy = \"negotiated\"",
+                nets.join(", "),
+                params.layer_span + 1
+            )
+        } else if b.way_without_traces {
+            format!(
+                "its way is longer than route.max_detour = {} allows: raise it, or place its \
+                 parts closer",
+                params.max_detour
+            )
+        } else {
+            "no way through the material even without other traces: the parts are walled off \
+             or too far apart (route.max_detour), or the material is too thin for a channel \
+             (route.conductive_width, route.perimeters)"
+                .to_owned()
+        });
+    }
 }
 
 /// Reports every routed (or unrouted) wire and returns the traces: one path per routed wire
@@ -583,6 +690,8 @@ fn trace_paths(
                 .and_then(|k| mine_wires.get(k))
                 .map(|j| format!("{}-{}", j.from, j.to)),
             reason: w.reason.map(|r| r.to_string()),
+            blocked_by: Vec::new(),
+            help: None,
         });
         if !w.routed {
             continue;

@@ -36,7 +36,8 @@ pub fn routing_bar() -> (ProgressBar, ProgressFn) {
 }
 
 /// The router's callback moving `bar`: it shows `bar` as the routing bar (wires done of the
-/// job's, the rip-up round, the wires unrouted so far) until something restyles it.
+/// job's, the negotiation round and the wires still in conflict or the rip-up round, the wires
+/// unrouted so far) until something restyles it.
 pub fn routing_callback(bar: &ProgressBar) -> ProgressFn {
     let bar = bar.clone();
     Arc::new(move |p: RouteProgress| {
@@ -45,7 +46,14 @@ pub fn routing_callback(bar: &ProgressBar) -> ProgressFn {
             state.set_len(p.total as u64);
             state.set_pos(p.done as u64);
         });
-        bar.set_message(format!(", round {}, {} unrouted", p.round, p.unrouted));
+        if p.negotiation > 0 {
+            bar.set_message(format!(
+                ", negotiation round {}, {} in conflict, {} unrouted",
+                p.negotiation, p.conflicts, p.unrouted
+            ));
+        } else {
+            bar.set_message(format!(", round {}, {} unrouted", p.round, p.unrouted));
+        }
     })
 }
 

@@ -318,8 +318,8 @@ fn offset_progress(
         outer(RouteProgress {
             done: done_before + p.done,
             total,
-            round: p.round,
             unrouted: unrouted_before + p.unrouted,
+            ..p
         })
     }))
 }

@@ -23,7 +23,7 @@
 //!   total float order; vertex ids follow creation order, which depends only on the input; hash
 //!   maps are only looked up, never iterated.
 
-use super::graph::{self, Ends, Graph, LayerInput, PENALTY_FACTOR, PreparedLayer, VertexId, Zone};
+use super::graph::{self, Ends, Graph, LayerInput, PreparedLayer, VertexId, Zone};
 use super::index::{dist, lerp};
 use super::interlayer::{Parent, piece_fits, polyline_length, walk_back};
 use super::{RouteLayer, RouteParams, Unrouted, Wire, WireRoute, layer_of, trace};
@@ -125,21 +125,25 @@ pub(crate) fn change_cost(params: &RouteParams) -> f64 {
 
 /// The cost above which the search of a wire gives up, for pads `distance` mm apart (3D) and
 /// `layer_changes` layers apart: `max_detour` times the least cost the heuristic promises, in
-/// base-weight mm, plus `detour_slack`; a rip-up probe (`probe`) may also run through 5 mm of
-/// other traces. A route within the limit is at most `limit / min_weight` mm long.
+/// base-weight mm, plus `detour_slack`. A search with penalty regions (a rip-up probe, a
+/// negotiation round) may also run through 5 mm of them at their `penalty_factor`, and one with
+/// a congestion history capped at `history_cap` may find every link up to `1 + history_cap`
+/// times dearer. A route within the plain limit is at most `limit / min_weight` mm long.
 pub(crate) fn cost_limit(
     params: &RouteParams,
     distance: f64,
     layer_changes: usize,
-    probe: bool,
+    penalty_factor: Option<f64>,
+    history_cap: f64,
 ) -> f64 {
     let least = min_weight(params);
     let straight = distance.max(0.0)
         + change_cost(params) * layer_changes as f64 / least.max(f64::MIN_POSITIVE);
     let mut limit = params.max_detour.max(1.0) * straight * params.base_weight.max(least)
         + params.detour_slack.max(0.0);
-    if probe {
-        limit += PENALTY_FACTOR * 5.0;
+    limit *= 1.0 + history_cap.max(0.0);
+    if let Some(factor) = penalty_factor {
+        limit += factor.max(1.0) * 5.0;
     }
     limit
 }
@@ -204,6 +208,8 @@ impl Search {
                     original: layers[l].islands.clone(),
                     blocked: Vec::new(),
                     penalty: Vec::new(),
+                    penalty_factor: 1.0,
+                    history: None,
                 })
                 .collect()
         });
@@ -272,9 +278,19 @@ impl Search {
             let (la, lb) = (search.graph.layer(source), search.graph.layer(target));
             let dz = search.layer(la).z - search.layer(lb).z;
             let dxy = unscaled(1) * dist(a, b);
-            let probe = search.layers.iter().any(|l| !l.penalty.is_empty());
-            search.cost_limit =
-                cost_limit(params, (dxy * dxy + dz * dz).sqrt(), la.abs_diff(lb), probe);
+            let penalty_factor = search
+                .layers
+                .iter()
+                .find(|l| !l.penalty.is_empty())
+                .map(|l| l.penalty_factor);
+            let history_cap = search.layers[0].history.as_ref().map_or(0.0, |h| h.cap());
+            search.cost_limit = cost_limit(
+                params,
+                (dxy * dxy + dz * dz).sqrt(),
+                la.abs_diff(lb),
+                penalty_factor,
+                history_cap,
+            );
             search.grow();
             search.g[source as usize] = 0.0;
             let f = search.heuristic(source);
@@ -336,16 +352,14 @@ impl Search {
         self.explore_grid(u);
         self.explore_layers(u);
         self.explore_taps(u);
-        let penalised = !self.layer(self.graph.layer(u)).penalty.is_empty();
+        let (lu, pu) = (self.graph.layer(u), self.graph.pos(u));
         for k in 0..self.graph.adj[u as usize].len() {
             let e = self.graph.adj[u as usize][k];
-            let mut cost = e.cost;
-            if penalised && self.graph.layer(e.to) == self.graph.layer(u) {
-                let mid = lerp(self.graph.pos(u), self.graph.pos(e.to), 0.5);
-                if self.layer(self.graph.layer(u)).penalty.contains(mid) {
-                    cost *= PENALTY_FACTOR;
-                }
-            }
+            let cost = if self.graph.layer(e.to) == lu {
+                self.link_cost(lu, pu, self.graph.pos(e.to), e.cost)
+            } else {
+                e.cost
+            };
             self.relax(u, e.to, cost, None);
         }
         self.state
@@ -382,6 +396,31 @@ impl Search {
             tol,
             end,
         )
+    }
+
+    /// The cost of the planar link `a`–`b` on layer `l`, `cost` before the penalty regions
+    /// and the congestion history are priced in (at the link's midpoint).
+    fn link_cost(&self, l: usize, a: Point2, b: Point2, cost: f64) -> f64 {
+        let layer = self.layer(l);
+        if layer.penalty.is_empty() && layer.history.is_none() {
+            return cost;
+        }
+        let mid = lerp(a, b, 0.5);
+        let mut cost = cost;
+        if !layer.penalty.is_empty() {
+            if layer.history.is_some() {
+                // Negotiation: priced by the share of the link inside, so a long link (a pad's
+                // link to the rings, a direct connection) cannot cross a trace unpriced.
+                let inside = layer.penalty.inside_fraction(a, b);
+                cost *= 1.0 + (layer.penalty_factor - 1.0) * inside;
+            } else if layer.penalty.contains(mid) {
+                cost *= layer.penalty_factor;
+            }
+        }
+        if let Some(history) = &layer.history {
+            cost *= 1.0 + history.at(l, mid);
+        }
+        cost
     }
 
     /// Sizes the per-vertex arrays to the graph.
@@ -454,7 +493,7 @@ impl Search {
         if self.layer(l).link_weight(p, q, &self.params, tol) != Some(base) {
             return;
         }
-        let g = self.g[u as usize] + unscaled(1) * d * base;
+        let g = self.g[u as usize] + self.link_cost(l, p, q, unscaled(1) * d * base);
         let t = self.target as usize;
         if !self.closed[t] && g < self.g[t] {
             self.g[t] = g;
@@ -655,7 +694,19 @@ impl Search {
                 });
             }
             let dz = (self.layer(other).z - self.layer(l).z).abs();
-            let printed = unscaled(1) * polyline_length(&piece) * self.params.base_weight;
+            // The piece is printed on the other layer too, where it pays that layer's prices.
+            let target = self.layer(other);
+            let printed = if target.penalty.is_empty() && target.history.is_none() {
+                unscaled(1) * polyline_length(&piece) * self.params.base_weight
+            } else {
+                piece
+                    .windows(2)
+                    .map(|s| {
+                        let plain = unscaled(1) * dist(s[0], s[1]) * self.params.base_weight;
+                        self.link_cost(other, s[0], s[1], plain)
+                    })
+                    .sum()
+            };
             let cost = (printed + self.params.layer_change_penalty)
                 .max(self.change_cost + self.min_weight * dz);
             if self.g[u as usize] + cost < self.g[v as usize] {

@@ -26,11 +26,15 @@
 //! whose side has less copper, so the target has the most.
 
 use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
-use super::graph::LayerInput;
-use super::{PadCopper, RouteProgress, Unrouted, wire_order};
+use super::congestion::History;
+use super::graph::{LayerInput, PENALTY_FACTOR};
+use super::{Blockage, PadCopper, RouteProgress, Strategy, Unrouted, wire_order};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
-use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, union};
+use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, scaled, union, unscaled};
+use std::sync::Arc;
 use std::time::Instant;
+
+mod negotiate;
 
 /// Steps of one A* search between two looks at the clock.
 const CLOCK_EVERY: usize = 256;
@@ -67,6 +71,54 @@ fn overlaps(a: &BBox, b: &BBox) -> bool {
     a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3]
 }
 
+/// What the traces of other nets are to a search.
+#[derive(Debug, Clone)]
+pub(crate) enum Traces {
+    /// Holes in the material, with keep-outs no trace centre enters: a normal search.
+    Obstacles,
+    /// No obstacle but each mm inside their keep-outs costs [`PENALTY_FACTOR`] times more: the
+    /// rip-up probe looking for the route that runs into the fewest of them.
+    Probe,
+    /// No obstacle but each link inside their keep-outs costs `factor` times more, and every
+    /// link `1 + history` times more: a negotiation round.
+    Priced {
+        /// Present-congestion factor of the round.
+        factor: f64,
+        /// Congestion history of the earlier rounds.
+        history: Arc<History>,
+    },
+}
+
+impl Traces {
+    /// The cost factor of their keep-outs, if they are priced rather than holes.
+    fn penalty_factor(&self) -> Option<f64> {
+        match self {
+            Traces::Obstacles => None,
+            Traces::Probe => Some(PENALTY_FACTOR),
+            Traces::Priced { factor, .. } => Some(*factor),
+        }
+    }
+
+    /// The congestion history's cap (0 without one).
+    fn history_cap(&self) -> f64 {
+        match self {
+            Traces::Priced { history, .. } => history.cap(),
+            _ => 0.0,
+        }
+    }
+}
+
+/// What [`Board::route_all`] ran.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Summary {
+    /// Rip-up and reroute rounds.
+    pub rounds: usize,
+    /// Negotiated-congestion rounds.
+    pub negotiation_rounds: usize,
+    /// Wires still in conflict when negotiation stopped.
+    pub negotiation_conflicts: usize,
+}
+
 /// A routed wire's channel and keep-out on one layer.
 #[derive(Debug, Clone)]
 struct Placed {
@@ -81,6 +133,10 @@ struct Placed {
 /// Another net's pad as an obstacle: its layer, net, hole and keep-out.
 #[derive(Debug, Clone)]
 struct PadObstacle<'a> {
+    /// Index of the pad in the caller's list.
+    index: usize,
+    /// Centre of the pad's box.
+    centre: Point2,
     layer: usize,
     net: Option<&'a str>,
     hole: Vec<ExPolygon>,
@@ -115,9 +171,21 @@ impl<'a> Board<'a> {
     ) -> Self {
         let pads = pads
             .iter()
-            .filter_map(|p| {
+            .enumerate()
+            .filter_map(|(index, p)| {
                 let [hole, keep_out] = channels::pad_obstacle(&p.outline, params);
+                let pts = &p.outline.points;
+                let (x0, x1) = (
+                    pts.iter().map(|q| q.x).min()?,
+                    pts.iter().map(|q| q.x).max()?,
+                );
+                let (y0, y1) = (
+                    pts.iter().map(|q| q.y).min()?,
+                    pts.iter().map(|q| q.y).max()?,
+                );
                 Some(PadObstacle {
+                    index,
+                    centre: Point2::new(x0 + (x1 - x0) / 2, y0 + (y1 - y0) / 2),
                     layer: layer_of(layers, p.z)?,
                     net: p.net.as_deref(),
                     bbox: bbox_of(&keep_out),
@@ -138,26 +206,33 @@ impl<'a> Board<'a> {
         }
     }
 
-    /// Routes every wire in [`wire_order`], then runs the rip-up and reroute rounds, telling
-    /// the progress callback after each wire and attempt; returns the rounds run.
-    pub(crate) fn route_all(&mut self) -> usize {
+    /// Routes every wire: by negotiated congestion ([`Strategy::Negotiated`], see
+    /// `negotiate.rs`) or one after another in [`wire_order`]; then runs the rip-up and reroute
+    /// rounds for the wires left without a route, telling the progress callback after each wire
+    /// and attempt.
+    pub(crate) fn route_all(&mut self) -> Summary {
         let total = self.wires.len();
-        for (k, i) in wire_order(self.wires, self.params).into_iter().enumerate() {
-            self.route_one(i);
-            self.tell(k + 1, 0);
+        let order = wire_order(self.wires, self.params);
+        let mut summary = Summary::default();
+        if self.params.strategy == Strategy::Negotiated {
+            (summary.negotiation_rounds, summary.negotiation_conflicts) = self.negotiate(&order);
+        } else {
+            for (k, &i) in order.iter().enumerate() {
+                self.route_one(i);
+                self.tell(k + 1, 0);
+            }
         }
-        let mut rounds = 0;
         for round in 1..=self.params.rip_up_rounds {
             if self.routed_count() == total || self.past_deadline() {
                 break;
             }
-            rounds = round;
+            summary.rounds = round;
             self.tell(total, round);
             if !self.rip_up_round(round) {
                 break;
             }
         }
-        rounds
+        summary
     }
 
     /// Whether the deadline has passed; if so, routing stops (and says so).
@@ -175,11 +250,19 @@ impl<'a> Board<'a> {
 
     /// Tells the progress callback, if any, where routing stands.
     fn tell(&self, done: usize, round: usize) {
+        self.tell_negotiation(done, round, 0, 0);
+    }
+
+    /// Tells the progress callback, if any, where routing stands, in negotiation round
+    /// `negotiation` with `conflicts` wires in conflict.
+    fn tell_negotiation(&self, done: usize, round: usize, negotiation: usize, conflicts: usize) {
         if let Some(progress) = &self.params.watch.progress {
             progress(RouteProgress {
                 done,
                 total: self.wires.len(),
                 round,
+                negotiation,
+                conflicts,
                 unrouted: self
                     .routes
                     .iter()
@@ -187,6 +270,65 @@ impl<'a> Board<'a> {
                     .count(),
             });
         }
+    }
+
+    /// Looks at what stands in the way of every wire left without a route (not for lack of a
+    /// layer or time), until the deadline: see [`Blockage`]. Whether the deadline stopped
+    /// routing is left as it was: this only explains the result.
+    pub(crate) fn diagnose(&mut self) {
+        let stopped = self.stopped;
+        for i in 0..self.wires.len() {
+            let explain = self.routes[i].as_ref().is_none_or(|r| {
+                !r.routed && !matches!(r.reason, Some(Unrouted::TimeLimit(_) | Unrouted::NoLayer))
+            });
+            if !explain || self.past_deadline() {
+                continue;
+            }
+            let blockage = self.blockage(i);
+            let route = self.routes[i]
+                .get_or_insert_with(|| trace::unrouted(&self.wires[i], Unrouted::NoPath));
+            route.blockage = blockage;
+        }
+        self.stopped = stopped;
+    }
+
+    /// What stands in the way of wire `i`: the traces its rip-up probe runs into, and the pads
+    /// of other nets too close to its own; `None` if the deadline cut the probe short.
+    fn blockage(&mut self, i: usize) -> Option<Blockage> {
+        let probe = self.search(i, &Traces::Probe);
+        if matches!(probe.reason, Some(Unrouted::TimeLimit(_))) {
+            return None;
+        }
+        let traces = if probe.routed {
+            self.blockers(i, &probe)
+        } else {
+            Vec::new()
+        };
+        let wire = &self.wires[i];
+        let spacing = scaled(channels::keep_out_radius(self.params)) as f64;
+        let mut pads: Vec<(usize, f64)> = Vec::new();
+        for end in [wire.from, wire.to] {
+            let Some(l) = layer_of(self.layers, end.z) else {
+                continue;
+            };
+            let at = Point2::from_mm(end.x, end.y);
+            for p in &self.pads {
+                let d = super::index::dist(p.centre, at);
+                if p.layer.abs_diff(l) <= 1
+                    && p.net != Some(wire.net.as_str())
+                    && d < spacing
+                    && !pads.iter().any(|(k, _)| *k == p.index)
+                {
+                    pads.push((p.index, d * unscaled(1)));
+                }
+            }
+        }
+        pads.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        Some(Blockage {
+            traces,
+            pads,
+            way_without_traces: probe.routed,
+        })
     }
 
     /// A wire stopped by the deadline.
@@ -252,7 +394,7 @@ impl<'a> Board<'a> {
         if depth == 0 || self.routes[f].as_ref().is_some_and(|r| r.routed) || self.past_deadline() {
             return false;
         }
-        let probe = self.search(f, false);
+        let probe = self.search(f, &Traces::Probe);
         if !probe.routed {
             return false; // unroutable even on an empty board
         }
@@ -289,10 +431,16 @@ impl<'a> Board<'a> {
     /// Routes wire `i` on the board as it stands and places its channels (none, once the
     /// deadline has passed).
     fn route_one(&mut self, i: usize) {
+        self.route_with(i, &Traces::Obstacles);
+    }
+
+    /// Routes wire `i` with other nets' traces as `traces` says and places its channels (none,
+    /// once the deadline has passed).
+    fn route_with(&mut self, i: usize, traces: &Traces) {
         let result = if self.past_deadline() {
             self.out_of_time(i)
         } else {
-            self.search(i, true)
+            self.search(i, traces)
         };
         let half = self.params.channel_half_width();
         let keep_out_radius = channels::keep_out_radius(self.params);
@@ -416,15 +564,15 @@ impl<'a> Board<'a> {
         self.placed[near].iter().flatten()
     }
 
-    /// Runs the A* search of wire `i`; with `traces` the channels of other nets' wires are in
-    /// the way, without only the pads are.
+    /// Runs the A* search of wire `i`, with the channels of other nets' wires as `traces` says;
+    /// other nets' pads are always in the way.
     ///
     /// The route may end on the traces already connected to either pad (see [`Tap`]): it starts
     /// at the pad whose side has less trace and ends on the other side's pad or traces, so it
     /// has the most copper to aim at.
     ///
     /// A search still running at the deadline gives up: the wire is out of time.
-    fn search(&mut self, i: usize, traces: bool) -> WireRoute {
+    fn search(&mut self, i: usize, traces: &Traces) -> WireRoute {
         let wire = &self.wires[i];
         let Some(range) = layer_range(self.layers, wire, self.params) else {
             return trace::unrouted(wire, Unrouted::NoLayer);
@@ -468,7 +616,7 @@ impl<'a> Board<'a> {
     /// search's [`cost_limit`] over the smallest weight per mm. (The search measures `d` between
     /// the pads' vertices, which may sit up to `align_tolerance` away; the window's margin
     /// covers that.)
-    fn window(&self, wire: &Wire, traces: bool) -> Vec<ExPolygon> {
+    fn window(&self, wire: &Wire, traces: &Traces) -> Vec<ExPolygon> {
         let p = self.params;
         let d = ((wire.to.x - wire.from.x).powi(2)
             + (wire.to.y - wire.from.y).powi(2)
@@ -480,7 +628,13 @@ impl<'a> Board<'a> {
         ) else {
             return Vec::new();
         };
-        let limit = cost_limit(p, d, a.abs_diff(b), !traces);
+        let limit = cost_limit(
+            p,
+            d,
+            a.abs_diff(b),
+            traces.penalty_factor(),
+            traces.history_cap(),
+        );
         let min_weight = min_weight(p).max(1e-9);
         let grow = ((limit / min_weight - d) / 2.0).max(0.0) + WINDOW_MARGIN_MM;
         if !grow.is_finite() {
@@ -506,9 +660,9 @@ impl<'a> Board<'a> {
     }
 
     /// Layer `l` as `wire` sees it within `window` (everything if empty): the islands less the
-    /// holes of other nets' channels and pads, and their keep-outs; without `traces`, other
-    /// nets' traces are no obstacle but a penalty (their keep-outs).
-    fn input(&self, l: usize, wire: &Wire, traces: bool, window: &[ExPolygon]) -> LayerInput {
+    /// holes of other nets' pads and, if `traces` are obstacles, channels, and their keep-outs;
+    /// else other nets' traces are no obstacle but a penalty (their keep-outs).
+    fn input(&self, l: usize, wire: &Wire, traces: &Traces, window: &[ExPolygon]) -> LayerInput {
         let mut holes: Vec<ExPolygon> = Vec::new();
         let mut blocked: Vec<ExPolygon> = Vec::new();
         let mut penalty: Vec<ExPolygon> = Vec::new();
@@ -521,7 +675,7 @@ impl<'a> Board<'a> {
             .near(l)
             .filter(|p| p.net != wire.net && overlaps(&p.bbox, &frame))
         {
-            if traces {
+            if matches!(traces, Traces::Obstacles) {
                 holes.extend(p.channel.iter().cloned());
                 blocked.extend(p.keep_out.iter().cloned());
             } else {
@@ -564,6 +718,11 @@ impl<'a> Board<'a> {
                 penalty
             } else {
                 union(&penalty)
+            },
+            penalty_factor: traces.penalty_factor().unwrap_or(1.0),
+            history: match traces {
+                Traces::Priced { history, .. } => Some(Arc::clone(history)),
+                _ => None,
             },
         }
     }

@@ -28,6 +28,7 @@
 //! inter-layer edges then join vertices of exactly the same xy.
 
 use super::RouteParams;
+use super::congestion::History;
 use super::index::{Hit, RegionIndex, dist, lerp};
 use crate::geom::{
     ExPolygon, Join, Point2, intersection, offset, scaled, segment_distance, segment_param,
@@ -35,6 +36,7 @@ use crate::geom::{
 };
 use std::collections::{BTreeMap, HashMap};
 use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::Arc;
 
 /// A small multiplicative hasher for the integer keys of the vertex maps (the std SipHash is
 /// built against adversarial keys, which these are not). Maps are only looked up, never
@@ -66,7 +68,8 @@ impl Hasher for IntHasher {
     }
 }
 
-type IntMap<K, V> = HashMap<K, V, BuildHasherDefault<IntHasher>>;
+/// A hash map with [`IntHasher`].
+pub(crate) type IntMap<K, V> = HashMap<K, V, BuildHasherDefault<IntHasher>>;
 
 /// Vertex number within one wire's graph.
 pub(crate) type VertexId = u32;
@@ -92,9 +95,14 @@ pub(crate) struct LayerInput {
     /// Where no trace centre of this wire may run (other nets' traces grown by two channel
     /// half-widths).
     pub blocked: Vec<ExPolygon>,
-    /// Where links cost [`PENALTY_FACTOR`] times more: other nets' traces, when a rip-up probe
-    /// looks for the route that runs into the fewest of them. Empty in a normal search.
+    /// Where links cost `penalty_factor` times more: other nets' traces, when a rip-up probe
+    /// looks for the route that runs into the fewest of them, or a negotiation round routes
+    /// through them at a price. Empty in a normal search.
     pub penalty: Vec<ExPolygon>,
+    /// Cost multiplier of links in `penalty` ([`PENALTY_FACTOR`] for a rip-up probe).
+    pub penalty_factor: f64,
+    /// Congestion history of negotiated routing: links cost `1 + history` times more.
+    pub history: Option<Arc<History>>,
 }
 
 /// Cost multiplier of links in a [`LayerInput::penalty`] region.
@@ -136,8 +144,12 @@ pub(crate) struct PreparedLayer {
     pub contours: RegionIndex,
     /// Keep-outs of other nets' traces.
     pub blocked: RegionIndex,
-    /// Where links cost [`PENALTY_FACTOR`] times more.
+    /// Where links cost `penalty_factor` times more.
     pub penalty: RegionIndex,
+    /// Cost multiplier of links in `penalty`.
+    pub penalty_factor: f64,
+    /// Congestion history of negotiated routing, if any.
+    pub history: Option<Arc<History>>,
 }
 
 impl PreparedLayer {
@@ -238,6 +250,8 @@ impl PreparedLayer {
             contours: RegionIndex::new(&contours),
             blocked: RegionIndex::of_regions(&input.blocked),
             penalty: RegionIndex::of_regions(&input.penalty),
+            penalty_factor: input.penalty_factor,
+            history: input.history.clone(),
             rings,
         }
     }
@@ -796,6 +810,8 @@ mod tests {
             original: islands,
             blocked: Vec::new(),
             penalty: Vec::new(),
+            penalty_factor: 1.0,
+            history: None,
         }
     }
 

@@ -445,6 +445,24 @@ impl RegionIndex {
             .collect()
     }
 
+    /// The fraction of the segment `a`–`b` that runs inside the region (0 to 1).
+    pub(crate) fn inside_fraction(&self, a: Point2, b: Point2) -> f64 {
+        if !self.crosses(a, b) {
+            return if self.contains(lerp(a, b, 0.5)) {
+                1.0
+            } else {
+                0.0
+            };
+        }
+        let mut ts: Vec<f64> = vec![0.0, 1.0];
+        ts.extend(self.hits(a, b).iter().map(|h| h.t));
+        ts.sort_by(f64::total_cmp);
+        ts.windows(2)
+            .filter(|t| t[1] > t[0] && self.contains(lerp(a, b, (t[0] + t[1]) / 2.0)))
+            .map(|t| t[1] - t[0])
+            .sum()
+    }
+
     /// Whether the segment `a`–`b` properly crosses an edge (touching does not count).
     pub(crate) fn crosses(&self, a: Point2, b: Point2) -> bool {
         let lo = Point2::new(a.x.min(b.x), a.y.min(b.y));

@@ -53,6 +53,7 @@
 mod astar;
 mod board;
 mod channels;
+mod congestion;
 mod graph;
 mod index;
 mod interlayer;
@@ -164,6 +165,10 @@ pub struct RouteParams {
     /// Rounds of rip-up and reroute for wires that fail (default 3; 0 routes each wire once,
     /// in order).
     pub rip_up_rounds: usize,
+    /// How the wires share the material (default [`Strategy::Ordered`]).
+    pub strategy: Strategy,
+    /// Most rounds of negotiated congestion ([`Strategy::Negotiated`]; default 12).
+    pub negotiation_rounds: usize,
     /// Longest route worth printing, as a multiple of the straight 3D distance between the
     /// pads, plus `detour_slack` (default 3): a conductive trace's resistance grows with its
     /// length, so a wire that needs a longer route is reported unrouted, and the search stops
@@ -195,8 +200,12 @@ pub struct RouteProgress {
     pub done: usize,
     /// Wires to route.
     pub total: usize,
-    /// Rip-up and reroute round running (0 during the first pass).
+    /// Rip-up and reroute round running (0 before the rip-up rounds).
     pub round: usize,
+    /// Negotiated-congestion round running (0 outside negotiation).
+    pub negotiation: usize,
+    /// Wires whose routes touch another net's trace after the last negotiation round.
+    pub conflicts: usize,
     /// Wires without a route so far.
     pub unrouted: usize,
 }
@@ -249,6 +258,30 @@ impl PartialEq for RouteWatch {
     }
 }
 
+/// How the router shares the material out between the wires.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    schemars::JsonSchema,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Strategy {
+    /// Wire after wire, each avoiding the traces routed before it, then rounds of rip-up and
+    /// reroute for the wires that failed.
+    #[default]
+    Ordered,
+    /// Negotiated congestion: every wire routed with the others' traces as a cost rather than an
+    /// obstacle, rising round by round where traces still touch, until none do; the wires
+    /// still in conflict are then routed in order (see `board/negotiate.rs`).
+    Negotiated,
+}
+
 /// Why a wire has no route.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Unrouted {
@@ -293,6 +326,8 @@ impl Default for RouteParams {
             layer_change_penalty: 5.0,
             layer_span: 2,
             rip_up_rounds: 3,
+            strategy: Strategy::Ordered,
+            negotiation_rounds: 12,
             max_detour: 3.0,
             detour_slack: 30.0,
             max_expansions: 2_000_000,
@@ -348,6 +383,26 @@ pub struct WireRoute {
     pub ends_on_wire: Option<usize>,
     /// Why the wire has no route; `None` when it is routed.
     pub reason: Option<Unrouted>,
+    /// What stands in the way of an unrouted wire (`None` when it is routed, or when the
+    /// deadline left no time to look).
+    pub blockage: Option<Blockage>,
+}
+
+/// What stands in the way of a wire the router could not route: found by searching once more
+/// with other nets' traces as a cost instead of an obstacle (the rip-up probe) and by looking at
+/// the pads round the wire's ends.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Blockage {
+    /// Routed wires of other nets (indices in the input) whose traces the wire's best way runs
+    /// into, by increasing index. Empty when that way is free of traces or there is none.
+    pub traces: Vec<usize>,
+    /// Pads of other nets (indices in the pads given) closer to one of the wire's pads, centre
+    /// to centre, than two traces can run ([`min_trace_spacing`]), with that distance in mm;
+    /// closest first.
+    pub pads: Vec<(usize, f64)>,
+    /// Whether a way exists at all once other nets' traces are out of the way (within the
+    /// detour limit): if not, only the pads and the material are in the way.
+    pub way_without_traces: bool,
 }
 
 /// Routes of all wires and the channels to carve.
@@ -360,6 +415,11 @@ pub struct RouteResult {
     pub channels: Vec<Vec<ExPolygon>>,
     /// Rip-up and reroute rounds run.
     pub rounds: usize,
+    /// Negotiated-congestion rounds run (0 with [`Strategy::Ordered`]).
+    pub negotiation_rounds: usize,
+    /// Wires whose negotiated routes still touched other nets' traces when negotiation stopped,
+    /// and were routed again in order.
+    pub negotiation_conflicts: usize,
     /// Whether the deadline stopped routing before it was done.
     pub time_limit_reached: bool,
 }
@@ -417,13 +477,16 @@ pub fn route(
         .deadline
         .or_else(|| RouteWatch::deadline_in(params.time_limit));
     let mut board = board::Board::new(layers, wires, pads, params, deadline);
-    let rounds = board.route_all();
+    let summary = board.route_all();
     let time_limit_reached = board.stopped_by_deadline();
+    board.diagnose();
     let (wires, channels) = board.finish();
     RouteResult {
         wires,
         channels,
-        rounds,
+        rounds: summary.rounds,
+        negotiation_rounds: summary.negotiation_rounds,
+        negotiation_conflicts: summary.negotiation_conflicts,
         time_limit_reached,
     }
 }

@@ -31,9 +31,14 @@ fn stays_inside(region: &RegionIndex, a: Point2, b: Point2, tol: i64) -> bool {
         .all(|m| region.inside_or_on(m, tol))
 }
 
-/// Whether the route may run straight from `a` to `b` on `layer`.
+/// Whether the route may run straight from `a` to `b` on `layer`. In a negotiation round (a
+/// layer with a congestion history) the shortcut also keeps to one side of other nets'
+/// keep-outs: the search priced the way in or round them, and a shortcut taken for free
+/// would undo that.
 fn shortcut_ok(layer: &PreparedLayer, a: Point2, b: Point2, tol: i64) -> bool {
-    !layer.blocked_segment(a, b) && stays_inside(&layer.infill, a, b, tol)
+    !layer.blocked_segment(a, b)
+        && stays_inside(&layer.infill, a, b, tol)
+        && (layer.history.is_none() || !layer.penalty.crosses(a, b))
 }
 
 /// The run `points` of a route on `layer`, pulled taut; `fixed[i]` marks points that must be
@@ -119,6 +124,8 @@ mod tests {
             original: vec![square],
             blocked: Vec::new(),
             penalty: Vec::new(),
+            penalty_factor: 1.0,
+            history: None,
         };
         PreparedLayer::new(&input, &RouteParams::default())
     }

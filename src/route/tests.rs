@@ -644,3 +644,71 @@ fn deadline_in_takes_positive_finite_seconds() {
     let soon = RouteWatch::deadline_in(60.0).expect("a deadline");
     assert!(soon > std::time::Instant::now());
 }
+
+#[test]
+fn negotiated_routing_settles_crossings_with_disjoint_channels() {
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 6);
+    let z = top(&layers);
+    let params = RouteParams {
+        strategy: Strategy::Negotiated,
+        ..RouteParams::default()
+    };
+    // Two wall-to-wall wires and two diagonals: every rubberband crosses every other.
+    let wires = [
+        wire("a", (0.6, 20.0, z), (39.4, 20.0, z)),
+        wire("b", (20.0, 0.6, z), (20.0, 39.4, z)),
+        wire("c", (5.0, 5.0, z), (35.0, 35.0, z)),
+        wire("d", (5.0, 35.0, z), (35.0, 5.0, z)),
+    ];
+    let pads = end_pads(&wires);
+    let result = route(&layers, &wires, &pads, &params);
+    assert!(result.negotiation_rounds >= 1);
+    for (i, a) in result.wires.iter().enumerate() {
+        assert!(a.routed, "{a:?}");
+        assert!(a.length >= a.lower_bound - 1e-6);
+        for b in &result.wires[i + 1..] {
+            assert!(!channels_touch(a, b, layers.len(), &params), "{a:?} {b:?}");
+        }
+    }
+    // The same bytes again.
+    assert_eq!(route(&layers, &wires, &pads, &params), result);
+}
+
+#[test]
+fn an_impossible_board_names_what_blocks_each_unrouted_wire() {
+    // A span of one layer leaves no way past a wall-to-wall trace (see above).
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 6);
+    let z = top(&layers);
+    let params = RouteParams {
+        layer_span: 1,
+        ..RouteParams::default()
+    };
+    let wires = [
+        wire("a", (0.6, 20.0, z), (39.4, 20.0, z)),
+        wire("b", (20.0, 0.6, z), (20.0, 39.4, z)),
+    ];
+    let pads = end_pads(&wires);
+    let result = route(&layers, &wires, &pads, &params);
+    let (routed, failed): (Vec<usize>, Vec<usize>) = (0..2).partition(|&i| result.wires[i].routed);
+    assert_eq!((routed.len(), failed.len()), (1, 1), "{result:?}");
+    let (ok, bad) = (routed[0], failed[0]);
+    assert_eq!(result.wires[ok].blockage, None);
+    let blockage = result.wires[bad].blockage.as_ref().expect("a blockage");
+    assert_eq!(blockage.traces, vec![ok]);
+    assert!(blockage.pads.is_empty());
+    assert!(blockage.way_without_traces);
+
+    // A pad of net d 0.5 mm from b's end, closer than two traces can run, walls that end in:
+    // b has no way even without a's trace, and the pad is named with its distance.
+    let mut pads = pads;
+    pads.push(PadCopper::round(Some("d"), Point3::new(20.5, 39.4, z), 0.2));
+    let result = route(&layers, &wires, &pads, &params);
+    let b = &result.wires[1];
+    assert!(!b.routed);
+    let blockage = b.blockage.as_ref().expect("a blockage");
+    assert_eq!(blockage.pads.len(), 1, "{blockage:?}");
+    assert_eq!(blockage.pads[0].0, pads.len() - 1);
+    assert!((blockage.pads[0].1 - 0.5).abs() < 0.01, "{blockage:?}");
+    assert!(!blockage.way_without_traces);
+    assert!(blockage.traces.is_empty());
+}

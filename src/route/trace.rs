@@ -22,6 +22,7 @@ pub(crate) fn unrouted(wire: &Wire, reason: Unrouted) -> WireRoute {
         perimeter_crossings: 0,
         ends_on_wire: None,
         reason: Some(reason),
+        blockage: None,
     }
 }
 
@@ -154,5 +155,6 @@ pub(crate) fn assemble(
         perimeter_crossings,
         ends_on_wire: end.map(|(_, w)| w),
         reason: None,
+        blockage: None,
     }
 }
