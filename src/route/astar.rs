@@ -230,6 +230,17 @@ impl Search {
             .iter()
             .map(|i| PreparedLayer::new(i, params))
             .collect();
+        Self::with_prepared(layers, all, wire, params, taps)
+    }
+
+    /// A search over prepared layers (consecutive, ascending); see [`Search::with_layers`].
+    pub(crate) fn with_prepared(
+        layers: Vec<PreparedLayer>,
+        all: &[RouteLayer],
+        wire: &Wire,
+        params: &RouteParams,
+        taps: Vec<Tap>,
+    ) -> Self {
         let min_weight = min_weight(params);
         let change_cost = change_cost(params);
         let ends = match (layer_of(all, wire.from.z), layer_of(all, wire.to.z)) {

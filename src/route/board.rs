@@ -27,10 +27,11 @@
 
 use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
 use super::congestion::History;
-use super::graph::{LayerInput, PENALTY_FACTOR};
+use super::graph::{LayerGeometry, LayerInput, PENALTY_FACTOR, PreparedLayer};
 use super::{Blockage, PadCopper, RouteProgress, Strategy, Unrouted, wire_order};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
 use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, scaled, union, unscaled};
+use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -154,6 +155,9 @@ pub(crate) struct Board<'a> {
     pads: Vec<PadObstacle<'a>>,
     placed: Vec<Vec<Placed>>,
     routes: Vec<Option<WireRoute>>,
+    /// Layer geometry of negotiation rounds by (layer, net, routing window): the material less
+    /// other nets' pads, the same in every round.
+    geometry: HashMap<(usize, String, BBox), Arc<LayerGeometry>>,
     /// When routing must stop.
     deadline: Option<Instant>,
     /// Whether the deadline stopped any work.
@@ -201,6 +205,7 @@ impl<'a> Board<'a> {
             pads,
             placed: vec![Vec::new(); layers.len()],
             routes: vec![None; wires.len()],
+            geometry: HashMap::new(),
             deadline,
             stopped: false,
         }
@@ -596,10 +601,33 @@ impl<'a> Board<'a> {
             }
         };
         let window = self.window(wire, traces);
-        let inputs: Vec<LayerInput> = range
-            .map(|l| self.input(l, wire, traces, &window))
-            .collect();
-        let mut search = Search::with_layers(inputs, self.layers, &start, self.params, taps);
+        let mut search = if let Traces::Priced { .. } = traces {
+            // A negotiation round: the layer's geometry (the material less other nets' pads)
+            // is the same in every round; only the prices change.
+            let frame = bbox_of(&window);
+            let layers: Vec<PreparedLayer> = range
+                .map(|l| {
+                    let key = (l, wire.net.clone(), frame);
+                    let known = self.geometry.contains_key(&key);
+                    let input = self.input(l, wire, traces, &window, known);
+                    let geometry = match self.geometry.get(&key) {
+                        Some(g) => Arc::clone(g),
+                        None => {
+                            let g = Arc::new(LayerGeometry::new(&input, self.params));
+                            self.geometry.insert(key, Arc::clone(&g));
+                            g
+                        }
+                    };
+                    PreparedLayer::with_geometry(&input, geometry)
+                })
+                .collect();
+            Search::with_prepared(layers, self.layers, &start, self.params, taps)
+        } else {
+            let inputs: Vec<LayerInput> = range
+                .map(|l| self.input(l, wire, traces, &window, false))
+                .collect();
+            Search::with_layers(inputs, self.layers, &start, self.params, taps)
+        };
         let mut steps = 0usize;
         while search.step() == SearchState::Running {
             steps += 1;
@@ -628,13 +656,14 @@ impl<'a> Board<'a> {
         ) else {
             return Vec::new();
         };
-        let limit = cost_limit(
-            p,
-            d,
-            a.abs_diff(b),
-            traces.penalty_factor(),
-            traces.history_cap(),
-        );
+        // A negotiation round's window leaves out the room its present factor adds to the
+        // search's limit (5 mm through other traces): the window, and so the layer geometry
+        // made for it, stays the same from round to round.
+        let penalty = match traces {
+            Traces::Priced { .. } => None,
+            _ => traces.penalty_factor(),
+        };
+        let limit = cost_limit(p, d, a.abs_diff(b), penalty, traces.history_cap());
         let min_weight = min_weight(p).max(1e-9);
         let grow = ((limit / min_weight - d) / 2.0).max(0.0) + WINDOW_MARGIN_MM;
         if !grow.is_finite() {
@@ -662,7 +691,16 @@ impl<'a> Board<'a> {
     /// Layer `l` as `wire` sees it within `window` (everything if empty): the islands less the
     /// holes of other nets' pads and, if `traces` are obstacles, channels, and their keep-outs;
     /// else other nets' traces are no obstacle but a penalty (their keep-outs).
-    fn input(&self, l: usize, wire: &Wire, traces: &Traces, window: &[ExPolygon]) -> LayerInput {
+    /// With `prices_only`, only the penalty and the history are filled in (the geometry is
+    /// known already).
+    fn input(
+        &self,
+        l: usize,
+        wire: &Wire,
+        traces: &Traces,
+        window: &[ExPolygon],
+        prices_only: bool,
+    ) -> LayerInput {
         let mut holes: Vec<ExPolygon> = Vec::new();
         let mut blocked: Vec<ExPolygon> = Vec::new();
         let mut penalty: Vec<ExPolygon> = Vec::new();
@@ -681,6 +719,26 @@ impl<'a> Board<'a> {
             } else {
                 penalty.extend(p.keep_out.iter().cloned());
             }
+        }
+        let prices = |penalty: Vec<ExPolygon>| LayerInput {
+            index: l,
+            z: self.layers[l].z,
+            islands: Vec::new(),
+            original: Vec::new(),
+            blocked: Vec::new(),
+            penalty: if penalty.is_empty() {
+                penalty
+            } else {
+                union(&penalty)
+            },
+            penalty_factor: traces.penalty_factor().unwrap_or(1.0),
+            history: match traces {
+                Traces::Priced { history, .. } => Some(Arc::clone(history)),
+                _ => None,
+            },
+        };
+        if prices_only {
+            return prices(penalty);
         }
         // A pad is an obstacle on the layers just below and above its own too: its net's trace
         // leaves it on the pad's layer, and another net's trace under or over that start would
@@ -705,8 +763,6 @@ impl<'a> Board<'a> {
             difference(&original, &union(&holes))
         };
         LayerInput {
-            index: l,
-            z: self.layers[l].z,
             islands,
             original,
             blocked: if blocked.is_empty() {
@@ -714,16 +770,7 @@ impl<'a> Board<'a> {
             } else {
                 union(&blocked)
             },
-            penalty: if penalty.is_empty() {
-                penalty
-            } else {
-                union(&penalty)
-            },
-            penalty_factor: traces.penalty_factor().unwrap_or(1.0),
-            history: match traces {
-                Traces::Priced { history, .. } => Some(Arc::clone(history)),
-                _ => None,
-            },
+            ..prices(penalty)
         }
     }
 }

@@ -117,13 +117,56 @@ pub(crate) struct Ring {
     pub weight: f64,
 }
 
-/// A layer made ready for routing: its rings and the regions the router queries.
+/// A layer made ready for routing: its geometry (shared by the searches that see the layer
+/// alike, such as one wire's searches in successive negotiation rounds) and its prices.
 #[derive(Debug, Clone)]
 pub(crate) struct PreparedLayer {
     /// Index of the layer in the caller's list.
     pub index: usize,
     /// Top of the layer, mm.
     pub z: f64,
+    /// The rings and the regions the router queries.
+    pub geometry: Arc<LayerGeometry>,
+    /// Where links cost `penalty_factor` times more.
+    pub penalty: RegionIndex,
+    /// Cost multiplier of links in `penalty`.
+    pub penalty_factor: f64,
+    /// Congestion history of negotiated routing, if any.
+    pub history: Option<Arc<History>>,
+}
+
+impl std::ops::Deref for PreparedLayer {
+    type Target = LayerGeometry;
+
+    fn deref(&self) -> &LayerGeometry {
+        &self.geometry
+    }
+}
+
+impl PreparedLayer {
+    /// Deflates the islands of `input` into rings and indexes the regions.
+    pub(crate) fn new(input: &LayerInput, params: &RouteParams) -> Self {
+        Self::with_geometry(input, Arc::new(LayerGeometry::new(input, params)))
+    }
+
+    /// `input`'s layer with `geometry` already made from it (or from an input alike but for
+    /// its penalty and history), and `input`'s prices.
+    pub(crate) fn with_geometry(input: &LayerInput, geometry: Arc<LayerGeometry>) -> Self {
+        Self {
+            index: input.index,
+            z: input.z,
+            geometry,
+            penalty: RegionIndex::of_regions(&input.penalty),
+            penalty_factor: input.penalty_factor,
+            history: input.history.clone(),
+        }
+    }
+}
+
+/// A layer's rings and the regions the router queries: everything of a [`PreparedLayer`] but its
+/// prices.
+#[derive(Debug, Clone)]
+pub(crate) struct LayerGeometry {
     /// All deflated perimeter traces, outermost offset first.
     pub rings: Vec<Ring>,
     /// Edges of `rings`, grouped by ring number.
@@ -144,15 +187,9 @@ pub(crate) struct PreparedLayer {
     pub contours: RegionIndex,
     /// Keep-outs of other nets' traces.
     pub blocked: RegionIndex,
-    /// Where links cost `penalty_factor` times more.
-    pub penalty: RegionIndex,
-    /// Cost multiplier of links in `penalty`.
-    pub penalty_factor: f64,
-    /// Congestion history of negotiated routing, if any.
-    pub history: Option<Arc<History>>,
 }
 
-impl PreparedLayer {
+impl LayerGeometry {
     /// Deflates the islands of `input` into rings and indexes the regions.
     pub(crate) fn new(input: &LayerInput, params: &RouteParams) -> Self {
         let half = params.channel_half_width();
@@ -240,8 +277,6 @@ impl PreparedLayer {
             .map(|(k, ex)| (k as u32, ex.contour.points.as_slice()))
             .collect();
         Self {
-            index: input.index,
-            z: input.z,
             squeeze: RegionIndex::of_regions(&squeeze),
             ring_edges: RegionIndex::new(&ring_refs),
             clearance: RegionIndex::of_regions(areas.first().map_or(&[], Vec::as_slice)),
@@ -249,9 +284,6 @@ impl PreparedLayer {
             material: RegionIndex::of_regions(&input.original),
             contours: RegionIndex::new(&contours),
             blocked: RegionIndex::of_regions(&input.blocked),
-            penalty: RegionIndex::of_regions(&input.penalty),
-            penalty_factor: input.penalty_factor,
-            history: input.history.clone(),
             rings,
         }
     }

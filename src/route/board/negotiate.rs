@@ -15,7 +15,8 @@
 //!    (a link costs `1 + history` times more, capped at [`HISTORY_CAP`]), the present factor
 //!    grows by [`FACTOR_GROWTH`], and only the wires in conflict (with the wires that end on
 //!    their traces) are ripped up and routed again, in wire order.
-//! 3. When no wire is in conflict, or after `negotiation_rounds` rounds or at the deadline,
+//! 3. When no wire is in conflict, after `negotiation_rounds` rounds, after [`STALL_ROUNDS`]
+//!    rounds that leave no fewer wires in conflict than the best round, or at the deadline,
 //!    conflicts left are settled: the wire in the most conflicts (the later in wire order on a
 //!    tie) is ripped up until none is left, and the wires ripped are routed again with every
 //!    other net's trace as an obstacle, in wire order. The rip-up rounds take it from there.
@@ -48,6 +49,9 @@ const HISTORY_CAP: f64 = 2.0;
 /// `channel_extra` of plastic that still separates the traces themselves.
 const CONFLICT_MM2: f64 = 0.01;
 
+/// Rounds without fewer wires in conflict than the best so far after which negotiation stops.
+const STALL_ROUNDS: usize = 3;
+
 /// Two wires of different nets whose channels overlap, and where.
 #[derive(Debug, Clone)]
 struct Conflict {
@@ -74,6 +78,8 @@ impl Board<'_> {
         let mut conflicts: Vec<Conflict> = Vec::new();
         let mut in_conflict = 0;
         let mut rounds = 0;
+        let (mut best, mut best_round) = (usize::MAX, 0);
+        let mut best_state = None;
         for round in 1..=self.params.negotiation_rounds.max(1) {
             if self.past_deadline() {
                 break;
@@ -108,8 +114,25 @@ impl Board<'_> {
                     history.add(l, &c.area, HISTORY_STEP);
                 }
             }
+            if in_conflict < best {
+                best = in_conflict;
+                best_round = round;
+                best_state = Some((
+                    self.placed.clone(),
+                    self.routes.clone(),
+                    conflicts.clone(),
+                ));
+            } else if round >= best_round + STALL_ROUNDS {
+                // The conflicts left are ones the fixed graph has no way round (a fine-pitch
+                // pad row, where only rings formed round a trace find room): settled below.
+                break;
+            }
             factor *= FACTOR_GROWTH;
             todo = wires.into_iter().collect();
+        }
+        if let Some((placed, routes, kept)) = best_state.filter(|_| in_conflict > best) {
+            // The rounds after the best one did no better: settle from the best.
+            (self.placed, self.routes, conflicts, in_conflict) = (placed, routes, kept, best);
         }
         let ripped = self.settle(&conflicts, &rank);
         for (k, &i) in ripped.iter().enumerate() {
