@@ -32,6 +32,7 @@ mod regressions_route;
 mod regressions_slice;
 mod robot;
 mod roundtrip;
+mod route_help;
 mod route_limits;
 mod slice;
 mod support;

@@ -117,11 +117,7 @@ impl Board<'_> {
             if in_conflict < best {
                 best = in_conflict;
                 best_round = round;
-                best_state = Some((
-                    self.placed.clone(),
-                    self.routes.clone(),
-                    conflicts.clone(),
-                ));
+                best_state = Some((self.placed.clone(), self.routes.clone(), conflicts.clone()));
             } else if round >= best_round + STALL_ROUNDS {
                 // The conflicts left are ones the fixed graph has no way round (a fine-pitch
                 // pad row, where only rings formed round a trace find room): settled below.

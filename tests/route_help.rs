@@ -1,0 +1,112 @@
+//! What the report says about a wire the router could not route (`blocked_by`, `help`), and
+//! the negotiated strategy (`route.strategy = "negotiated"`) through the CLI.
+
+use serde_json::Value;
+
+use crate::electronics::run_demo_slice;
+use crate::support::{stderr, temp_dir};
+
+/// The electronics section of the report at `path`.
+fn electronics(path: &std::path::Path) -> Value {
+    let json: Value = serde_json::from_slice(&std::fs::read(path).expect("report written"))
+        .expect("report is JSON");
+    json["electronics"].clone()
+}
+
+#[test]
+fn traces_too_wide_for_the_pads_name_the_pads_and_the_width_that_fits() {
+    // 2.5 mm traces do not pass between the demo's pads, 1.9 and 2.0 mm apart.
+    let dir = temp_dir();
+    let (o, _, report) = run_demo_slice(
+        dir.path(),
+        &["--set", "route.conductive_width=2.5", "--allow-unrouted"],
+    );
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let e = electronics(&report);
+    let unrouted: Vec<&Value> = e["wires"]
+        .as_array()
+        .expect("wires")
+        .iter()
+        .filter(|w| w["routed"] == Value::Bool(false))
+        .collect();
+    assert!(!unrouted.is_empty(), "{e}");
+    assert_eq!(e["unrouted"], Value::from(unrouted.len()));
+    for w in &unrouted {
+        let blocked: Vec<&str> = w["blocked_by"]
+            .as_array()
+            .expect("blocked_by")
+            .iter()
+            .filter_map(Value::as_str)
+            .collect();
+        assert!(!blocked.is_empty(), "{w}");
+        // Each pad is named with its distance: R1's pads are 1.90 mm apart, LED1's 2.00.
+        for b in &blocked {
+            assert!(
+                b.starts_with("pad ")
+                    && (b.ends_with(" 1.90 mm away") || b.ends_with(" 2.00 mm away")),
+                "{b}"
+            );
+        }
+        let help = w["help"].as_str().expect("help");
+        assert!(
+            help.contains("closer than two traces can run (2.76 mm)")
+                && help.contains("a route.conductive_width of 1.65 mm fits"),
+            "{help}"
+        );
+        // The terminal's line says the same.
+        let line = format!(
+            "net {} could not be routed ({} to {}): {help}",
+            w["net"].as_str().expect("net"),
+            w["from"].as_str().expect("from"),
+            w["to"].as_str().expect("to")
+        );
+        assert!(err.contains(&line), "no '{line}' in {err}");
+    }
+    for w in e["wires"].as_array().expect("wires") {
+        if w["routed"] == Value::Bool(true) {
+            assert_eq!(w["blocked_by"], Value::Array(Vec::new()), "{w}");
+            assert_eq!(w["help"], Value::Null, "{w}");
+        }
+    }
+}
+
+#[test]
+fn negotiated_routing_routes_the_demo_the_same_way_twice() {
+    let dir = temp_dir();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    std::fs::create_dir_all(&a).expect("folder a");
+    std::fs::create_dir_all(&b).expect("folder b");
+    let set = ["--set", "route.strategy=negotiated"];
+    let (oa, ga, ra) = run_demo_slice(&a, &set);
+    let (ob, gb, _) = run_demo_slice(&b, &set);
+    assert!(oa.status.success(), "{}", stderr(&oa));
+    assert!(ob.status.success(), "{}", stderr(&ob));
+    assert_eq!(
+        std::fs::read(&ga).expect("G-code a"),
+        std::fs::read(&gb).expect("G-code b")
+    );
+    let e = electronics(&ra);
+    assert_eq!(e["unrouted"], Value::from(0), "{e}");
+    assert!(
+        e["routing"]["negotiation_rounds"]
+            .as_u64()
+            .is_some_and(|n| n >= 1),
+        "{e}"
+    );
+    assert_eq!(e["routing"]["negotiation_conflicts"], Value::from(0), "{e}");
+}
+
+#[test]
+fn an_unknown_strategy_is_refused() {
+    let dir = temp_dir();
+    let (o, out, _) = run_demo_slice(dir.path(), &["--set", "route.strategy=fastest"]);
+    let err = stderr(&o);
+    // A bad --set value is a usage error.
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(r#"route.strategy must be "ordered" or "negotiated", got "fastest""#),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
