@@ -31,6 +31,7 @@ use super::graph::{LayerGeometry, LayerInput, PENALTY_FACTOR, PreparedLayer};
 use super::{Blockage, PadCopper, RouteProgress, Strategy, Unrouted, wire_order};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
 use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, scaled, union, unscaled};
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
@@ -603,24 +604,38 @@ impl<'a> Board<'a> {
         let window = self.window(wire, traces);
         let mut search = if let Traces::Priced { .. } = traces {
             // A negotiation round: the layer's geometry (the material less other nets' pads)
-            // is the same in every round; only the prices change.
+            // is the same in every round; only the prices change. Layers not seen yet are
+            // deflated on rayon's threads (each from its input alone).
             let frame = bbox_of(&window);
-            let layers: Vec<PreparedLayer> = range
+            let inputs: Vec<(usize, bool, LayerInput)> = range
                 .map(|l| {
-                    let key = (l, wire.net.clone(), frame);
-                    let known = self.geometry.contains_key(&key);
-                    let input = self.input(l, wire, traces, &window, known);
-                    let geometry = match self.geometry.get(&key) {
-                        Some(g) => Arc::clone(g),
-                        None => {
-                            let g = Arc::new(LayerGeometry::new(&input, self.params));
-                            self.geometry.insert(key, Arc::clone(&g));
-                            g
-                        }
-                    };
-                    PreparedLayer::with_geometry(&input, geometry)
+                    let known = self.geometry.contains_key(&(l, wire.net.clone(), frame));
+                    (l, known, self.input(l, wire, traces, &window, known))
                 })
                 .collect();
+            let params = self.params;
+            let built: Vec<Option<LayerGeometry>> = inputs
+                .par_iter()
+                .map(|(_, known, input)| (!known).then(|| LayerGeometry::new(input, params)))
+                .collect();
+            let mut layers: Vec<PreparedLayer> = Vec::with_capacity(inputs.len());
+            for ((l, _, input), new) in inputs.iter().zip(built) {
+                let key = (*l, wire.net.clone(), frame);
+                let geometry = match new {
+                    Some(g) => {
+                        let g = Arc::new(g);
+                        self.geometry.insert(key, Arc::clone(&g));
+                        g
+                    }
+                    None => self.geometry.get(&key).map(Arc::clone).unwrap_or_else(|| {
+                        Arc::new(LayerGeometry::new(
+                            &self.input(*l, wire, traces, &window, false),
+                            params,
+                        ))
+                    }),
+                };
+                layers.push(PreparedLayer::with_geometry(input, geometry));
+            }
             Search::with_prepared(layers, self.layers, &start, self.params, taps)
         } else {
             let inputs: Vec<LayerInput> = range

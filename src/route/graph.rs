@@ -145,6 +145,7 @@ impl std::ops::Deref for PreparedLayer {
 
 impl PreparedLayer {
     /// Deflates the islands of `input` into rings and indexes the regions.
+    #[cfg(test)]
     pub(crate) fn new(input: &LayerInput, params: &RouteParams) -> Self {
         Self::with_geometry(input, Arc::new(LayerGeometry::new(input, params)))
     }
