@@ -32,7 +32,7 @@ use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::ops::RangeInclusive;
-use std::sync::Arc;
+use std::rc::Rc;
 
 /// Where a [`Search`] stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -237,7 +237,7 @@ impl Search {
         let layers: Vec<PreparedLayer> = inputs
             .iter()
             .zip(geometry)
-            .map(|(i, g)| PreparedLayer::with_geometry(i, Arc::new(g)))
+            .map(|(i, g)| PreparedLayer::with_geometry(i, Rc::new(g)))
             .collect();
         Self::with_prepared(layers, all, wire, params, taps)
     }

@@ -33,6 +33,7 @@ use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace}
 use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, scaled, union, unscaled};
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::rc::Rc;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -158,7 +159,7 @@ pub(crate) struct Board<'a> {
     routes: Vec<Option<WireRoute>>,
     /// Layer geometry of negotiation rounds by (layer, net, routing window): the material less
     /// other nets' pads, the same in every round.
-    geometry: HashMap<(usize, String, BBox), Arc<LayerGeometry>>,
+    geometry: HashMap<(usize, String, BBox), Rc<LayerGeometry>>,
     /// When routing must stop.
     deadline: Option<Instant>,
     /// Whether the deadline stopped any work.
@@ -623,12 +624,12 @@ impl<'a> Board<'a> {
                 let key = (*l, wire.net.clone(), frame);
                 let geometry = match new {
                     Some(g) => {
-                        let g = Arc::new(g);
-                        self.geometry.insert(key, Arc::clone(&g));
+                        let g = Rc::new(g);
+                        self.geometry.insert(key, Rc::clone(&g));
                         g
                     }
-                    None => self.geometry.get(&key).map(Arc::clone).unwrap_or_else(|| {
-                        Arc::new(LayerGeometry::new(
+                    None => self.geometry.get(&key).map(Rc::clone).unwrap_or_else(|| {
+                        Rc::new(LayerGeometry::new(
                             &self.input(*l, wire, traces, &window, false),
                             params,
                         ))

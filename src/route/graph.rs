@@ -36,6 +36,7 @@ use crate::geom::{
 };
 use std::collections::{BTreeMap, HashMap};
 use std::hash::{BuildHasherDefault, Hasher};
+use std::rc::Rc;
 use std::sync::Arc;
 
 /// A small multiplicative hasher for the integer keys of the vertex maps (the std SipHash is
@@ -126,7 +127,7 @@ pub(crate) struct PreparedLayer {
     /// Top of the layer, mm.
     pub z: f64,
     /// The rings and the regions the router queries.
-    pub geometry: Arc<LayerGeometry>,
+    pub geometry: Rc<LayerGeometry>,
     /// Where links cost `penalty_factor` times more.
     pub penalty: RegionIndex,
     /// Cost multiplier of links in `penalty`.
@@ -147,12 +148,12 @@ impl PreparedLayer {
     /// Deflates the islands of `input` into rings and indexes the regions.
     #[cfg(test)]
     pub(crate) fn new(input: &LayerInput, params: &RouteParams) -> Self {
-        Self::with_geometry(input, Arc::new(LayerGeometry::new(input, params)))
+        Self::with_geometry(input, Rc::new(LayerGeometry::new(input, params)))
     }
 
     /// `input`'s layer with `geometry` already made from it (or from an input alike but for
     /// its penalty and history), and `input`'s prices.
-    pub(crate) fn with_geometry(input: &LayerInput, geometry: Arc<LayerGeometry>) -> Self {
+    pub(crate) fn with_geometry(input: &LayerInput, geometry: Rc<LayerGeometry>) -> Self {
         Self {
             index: input.index,
             z: input.z,
