@@ -110,3 +110,34 @@ fn an_unknown_strategy_is_refused() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn routing_gives_the_same_bytes_on_one_thread_and_on_two() {
+    let demo = |f: &str| crate::support::sample(&format!("circuit_demo/{f}"));
+    let dir = temp_dir();
+    for strategy in ["ordered", "negotiated"] {
+        let mut outputs = Vec::new();
+        for threads in ["1", "2"] {
+            let out = dir.path().join(format!("{strategy}-{threads}.gcode"));
+            let o = std::process::Command::new(env!("CARGO_BIN_EXE_conduit"))
+                .env("RAYON_NUM_THREADS", threads)
+                .arg("slice")
+                .arg(demo("block.stl"))
+                .arg("--circuit")
+                .arg(demo("led_coin.sch"))
+                .arg("--placement")
+                .arg(demo("placement.toml"))
+                .arg("-o")
+                .arg(&out)
+                .args(["--set", &format!("route.strategy={strategy}")])
+                .output()
+                .expect("the conduit binary runs");
+            assert!(o.status.success(), "{}", stderr(&o));
+            outputs.push(std::fs::read(&out).expect("G-code written"));
+        }
+        assert!(
+            outputs[0] == outputs[1],
+            "{strategy}: 1 and 2 threads differ"
+        );
+    }
+}
