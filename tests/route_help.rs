@@ -40,11 +40,19 @@ fn traces_too_wide_for_the_pads_name_the_pads_and_the_width_that_fits() {
             .filter_map(Value::as_str)
             .collect();
         assert!(!blocked.is_empty(), "{w}");
-        // Each pad is named with its distance: R1's pads are 1.90 mm apart, LED1's 2.00.
+        // Each pad is named with its distance from the wire's pin: R1's pads are 1.90 mm
+        // apart, LED1's 2.00.
+        let pins = [
+            w["from"].as_str().expect("from"),
+            w["to"].as_str().expect("to"),
+        ];
         for b in &blocked {
             assert!(
                 b.starts_with("pad ")
-                    && (b.ends_with(" 1.90 mm away") || b.ends_with(" 2.00 mm away")),
+                    && pins.iter().any(|p| {
+                        b.ends_with(&format!(" 1.90 mm from {p}"))
+                            || b.ends_with(&format!(" 2.00 mm from {p}"))
+                    }),
                 "{b}"
             );
         }

@@ -14,7 +14,8 @@ use crate::geom::{BoundingBox, ExPolygon, Point2, Point3, Polygon, scaled};
 use crate::program::{Event, LayerExtras, Role, Toolpath};
 use crate::region::cavity::{Cavity, carve_cavities, carve_channels};
 use crate::route::{
-    PadCopper, RouteLayer, RouteParams, RouteResult, Wire, min_trace_spacing, route,
+    NearPad, PadCopper, RouteLayer, RouteParams, RouteResult, Unrouted, Wire, min_trace_spacing,
+    route,
 };
 use crate::slice::LayerZ;
 
@@ -83,7 +84,7 @@ pub struct NetRoute {
     pub reason: Option<String>,
     /// What stands in the way of a wire not routed: other nets' traces on its best way
     /// (`trace of net GND (U1.3 to U1.5)`) and other nets' pads closer to its own than two
-    /// traces can run (`pad U1.7 (net N$2) 0.80 mm away`). Empty when it was routed.
+    /// traces can run (`pad U1.7 0.80 mm from U1.6`). Empty when it was routed.
     pub blocked_by: Vec<String>,
     /// What would help a wire not routed: a trace width, more room between the parts, more
     /// layers, a longer detour or time. `None` when it was routed.
@@ -607,7 +608,7 @@ fn explain_unrouted(
         if w.routed {
             continue;
         }
-        if matches!(w.reason, Some(crate::route::Unrouted::TimeLimit(_))) {
+        if matches!(w.reason, Some(Unrouted::TimeLimit(_))) {
             entry.help = Some(format!(
                 "route.time_limit (now {} s) stopped routing before this wire: raise it",
                 params.time_limit
@@ -624,17 +625,23 @@ fn explain_unrouted(
                     .push(format!("trace of net {} ({})", other.net, pins(k)));
             }
         }
-        for &(k, d) in &b.pads {
-            let name = pad_names.get(k).map_or("?", String::as_str);
-            entry.blocked_by.push(format!("pad {name} {d:.2} mm away"));
-        }
-        entry.help = Some(if let Some(&(k, d)) = b.pads.first() {
+        let name = |k: usize| pad_names.get(k).map_or("?", String::as_str);
+        let end = |near: &NearPad| if near.near_to { &entry.to } else { &entry.from };
+        let pads: Vec<String> = b
+            .pads
+            .iter()
+            .map(|n| format!("pad {} {:.2} mm from {}", name(n.pad), n.distance, end(n)))
+            .collect();
+        entry.blocked_by.extend(pads);
+        entry.help = Some(if let Some(near) = b.pads.first() {
             format!(
-                "its pad and {} are {d:.2} mm apart, closer than two traces can run ({:.2} mm): \
+                "pads {} and {} are {:.2} mm apart, closer than two traces can run ({:.2} mm): \
                  a route.conductive_width of {:.2} mm fits, or more room between the pads",
-                pad_names.get(k).map_or("?", String::as_str),
+                end(near),
+                name(near.pad),
+                near.distance,
                 min_trace_spacing(params),
-                fitting_width(d, params)
+                fitting_width(near.distance, params)
             )
         } else if !b.traces.is_empty() {
             let mut nets: Vec<&str> = b

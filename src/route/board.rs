@@ -28,7 +28,7 @@
 use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
 use super::congestion::History;
 use super::graph::{LayerGeometry, LayerInput, PENALTY_FACTOR, PreparedLayer};
-use super::{Blockage, PadCopper, RouteProgress, Strategy, Unrouted, wire_order};
+use super::{Blockage, NearPad, PadCopper, RouteProgress, Strategy, Unrouted, wire_order};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
 use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, scaled, union, unscaled};
 use rayon::prelude::*;
@@ -313,8 +313,8 @@ impl<'a> Board<'a> {
         };
         let wire = &self.wires[i];
         let spacing = scaled(channels::keep_out_radius(self.params)) as f64;
-        let mut pads: Vec<(usize, f64)> = Vec::new();
-        for end in [wire.from, wire.to] {
+        let mut pads: Vec<NearPad> = Vec::new();
+        for (near_to, end) in [(false, wire.from), (true, wire.to)] {
             let Some(l) = layer_of(self.layers, end.z) else {
                 continue;
             };
@@ -324,13 +324,17 @@ impl<'a> Board<'a> {
                 if p.layer.abs_diff(l) <= 1
                     && p.net != Some(wire.net.as_str())
                     && d < spacing
-                    && !pads.iter().any(|(k, _)| *k == p.index)
+                    && !pads.iter().any(|n| n.pad == p.index)
                 {
-                    pads.push((p.index, d * unscaled(1)));
+                    pads.push(NearPad {
+                        pad: p.index,
+                        distance: d * unscaled(1),
+                        near_to,
+                    });
                 }
             }
         }
-        pads.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        pads.sort_by(|a, b| a.distance.total_cmp(&b.distance).then(a.pad.cmp(&b.pad)));
         Some(Blockage {
             traces,
             pads,

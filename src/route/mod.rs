@@ -388,6 +388,17 @@ pub struct WireRoute {
     pub blockage: Option<Blockage>,
 }
 
+/// A pad of another net too close to one of a wire's pads.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NearPad {
+    /// Index of the pad in the pads given to [`route`].
+    pub pad: usize,
+    /// Distance from the wire's pad, centre to centre, mm.
+    pub distance: f64,
+    /// Whether it is near the wire's `to` pad (else its `from` pad).
+    pub near_to: bool,
+}
+
 /// What stands in the way of a wire the router could not route: found by searching once more
 /// with other nets' traces as a cost instead of an obstacle (the rip-up probe) and by looking at
 /// the pads round the wire's ends.
@@ -396,10 +407,9 @@ pub struct Blockage {
     /// Routed wires of other nets (indices in the input) whose traces the wire's best way runs
     /// into, by increasing index. Empty when that way is free of traces or there is none.
     pub traces: Vec<usize>,
-    /// Pads of other nets (indices in the pads given) closer to one of the wire's pads, centre
-    /// to centre, than two traces can run ([`min_trace_spacing`]), with that distance in mm;
-    /// closest first.
-    pub pads: Vec<(usize, f64)>,
+    /// Pads of other nets closer to one of the wire's pads, centre to centre, than two traces
+    /// can run ([`min_trace_spacing`]); closest first.
+    pub pads: Vec<NearPad>,
     /// Whether a way exists at all once other nets' traces are out of the way (within the
     /// detour limit): if not, only the pads and the material are in the way.
     pub way_without_traces: bool,

@@ -707,8 +707,12 @@ fn an_impossible_board_names_what_blocks_each_unrouted_wire() {
     assert!(!b.routed);
     let blockage = b.blockage.as_ref().expect("a blockage");
     assert_eq!(blockage.pads.len(), 1, "{blockage:?}");
-    assert_eq!(blockage.pads[0].0, pads.len() - 1);
-    assert!((blockage.pads[0].1 - 0.5).abs() < 0.01, "{blockage:?}");
+    assert_eq!(blockage.pads[0].pad, pads.len() - 1);
+    assert!(blockage.pads[0].near_to, "{blockage:?}");
+    assert!(
+        (blockage.pads[0].distance - 0.5).abs() < 0.01,
+        "{blockage:?}"
+    );
     assert!(!blockage.way_without_traces);
     assert!(blockage.traces.is_empty());
 }
