@@ -588,6 +588,15 @@ fn route_object(
     (result, pad_names)
 }
 
+/// What helps a wire whose way is longer than the detour limit allows.
+fn detour_help(params: &RouteParams) -> String {
+    format!(
+        "its way is longer than route.max_detour = {} allows: raise it, or place its parts \
+         closer",
+        params.max_detour
+    )
+}
+
 /// Fills in `blocked_by` and `help` of the report entries of the wires `result` could not
 /// route (the last `mine_wires.len()` entries of `report.wires`), from the router's
 /// [`Blockage`](crate::route::Blockage)s.
@@ -616,6 +625,16 @@ fn explain_unrouted(
             continue;
         }
         let Some(b) = &w.blockage else {
+            // The deadline left no time to look: what the reason alone tells.
+            entry.help = Some(match w.reason {
+                Some(Unrouted::Detour) => detour_help(params),
+                Some(Unrouted::NoLayer) => "no layer of the object holds its pads".to_owned(),
+                _ => format!(
+                    "route.time_limit (now {} s) left no time to find out what blocks it: \
+                     raise it",
+                    params.time_limit
+                ),
+            });
             continue;
         };
         for &k in &b.traces {
@@ -658,11 +677,7 @@ fn explain_unrouted(
                 params.layer_span + 1
             )
         } else if b.way_without_traces {
-            format!(
-                "its way is longer than route.max_detour = {} allows: raise it, or place its \
-                 parts closer",
-                params.max_detour
-            )
+            detour_help(params)
         } else {
             "no way through the material even without other traces: the parts are walled off \
              or too far apart (route.max_detour), or the material is too thin for a channel \

@@ -166,13 +166,13 @@ pub(crate) struct Hit {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct RegionIndex {
     edges: Vec<Edge>,
-    /// Band of the lowest point of each edge.
-    first_band: Vec<u32>,
     y0: i64,
     /// Height of one band, scaled units: [`BAND`], or more for a region of more than
     /// [`MAX_BANDS`] bands.
     band: i64,
-    bands: Vec<Vec<u32>>,
+    /// The edges of each band, copied in edge order (a band's edges lie together in memory,
+    /// which the scans of a query run through), each with the band of its lowest point.
+    bands: Vec<Vec<(Edge, u32)>>,
     cells: CellMap,
 }
 
@@ -251,19 +251,16 @@ impl RegionIndex {
         };
         let count = ((y1 - y0) / band + 1) as usize;
         let mut bands = vec![Vec::new(); count];
-        let mut first_band = Vec::with_capacity(edges.len());
-        for (i, e) in edges.iter().enumerate() {
+        for e in &edges {
             let lo = ((e.a.y.min(e.b.y) - y0) / band) as usize;
             let hi = ((e.a.y.max(e.b.y) - y0) / band) as usize;
             for band in &mut bands[lo..=hi.min(count - 1)] {
-                band.push(i as u32);
+                band.push((*e, lo as u32));
             }
-            first_band.push(lo as u32);
         }
         let cells = CellMap::new(&edges);
         Self {
             edges,
-            first_band,
             y0,
             band,
             bands,
@@ -292,14 +289,14 @@ impl RegionIndex {
             (lo..=hi).flat_map(move |k| {
                 self.bands[k]
                     .iter()
-                    .filter(move |&&i| (self.first_band[i as usize] as usize).max(lo) == k)
-                    .map(move |&i| self.edges[i as usize])
+                    .filter(move |(_, first)| (*first as usize).max(lo) == k)
+                    .map(|(e, _)| *e)
             })
         })
     }
 
     /// Edges of the band holding `y` (each edge whose y range contains `y` is there).
-    fn band_at(&self, y: i64) -> &[u32] {
+    fn band_at(&self, y: i64) -> &[(Edge, u32)] {
         if self.bands.is_empty() || y < self.y0 {
             return &[];
         }
@@ -330,8 +327,7 @@ impl RegionIndex {
     /// Even-odd parity of the edges a ray from `p` towards +x crosses.
     fn ray_parity(&self, p: Point2) -> bool {
         let mut inside = false;
-        for &i in self.band_at(p.y) {
-            let e = self.edges[i as usize];
+        for &(e, _) in self.band_at(p.y) {
             if (e.a.y > p.y) != (e.b.y > p.y) && e.a.x.max(e.b.x) >= p.x {
                 let (lo, hi) = if e.a.y < e.b.y {
                     (e.a, e.b)
@@ -370,8 +366,7 @@ impl RegionIndex {
     /// Groups whose rings contain `p` (even-odd per group) or pass within `tol` of it, sorted.
     pub(crate) fn groups_at(&self, p: Point2, tol: i64) -> Vec<u32> {
         let mut parity: Vec<(u32, bool)> = Vec::new();
-        for &i in self.band_at(p.y) {
-            let e = self.edges[i as usize];
+        for &(e, _) in self.band_at(p.y) {
             if (e.a.y > p.y) != (e.b.y > p.y) {
                 let (lo, hi) = if e.a.y < e.b.y {
                     (e.a, e.b)
