@@ -9,17 +9,18 @@
 # wires, far more than SECONDS of routing) packed by `conduit place --auto` into a 120 × 110 ×
 # 4 mm block and sliced with route.time_limit = SECONDS. It prints the routing time, the whole
 # run's time and the wires routed, and fails unless routing stopped within SECONDS + 10 %.
-# usage: bench/route.sh [small|board]   (both without an argument)
+# A second argument, `negotiated`, routes with route.strategy = "negotiated" instead.
+# usage: bench/route.sh [small|board] [ordered|negotiated]   (both cases, ordered, without one)
 #        bench/route.sh --time-limit SECONDS   (the corpus is ../shared/corpus, or
 #        CONDUIT_CORPUS)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ "${1:-}" != "--time-limit" ]; then
     cargo build --release --quiet --example route_bench
-    cases=("$@")
-    [ ${#cases[@]} -gt 0 ] || cases=(small board)
+    cases=("${1:-}")
+    [ -n "${1:-}" ] || cases=(small board)
     for case in "${cases[@]}"; do
-        ./target/release/examples/route_bench "$case"
+        ./target/release/examples/route_bench "$case" ${2:+"$2"}
     done
     exit 0
 fi

@@ -1,5 +1,5 @@
-//! Router benchmark: `cargo run --release --example route_bench [small|board]` (or
-//! `bench/route.sh`).
+//! Router benchmark: `cargo run --release --example route_bench [small|board] [ordered|negotiated]`
+//! (or `bench/route.sh`).
 //!
 //! Routes a synthetic circuit with [`conduit::route::route`] and [`RouteParams::default`]: a
 //! solid block 10 mm tall (50 layers of 0.2 mm, each layer's island the block's square) and
@@ -14,7 +14,7 @@
 use std::time::{Duration, Instant};
 
 use conduit::geom::{ExPolygon, Point2, Point3, Polygon};
-use conduit::route::{PadCopper, RouteLayer, RouteParams, RouteResult, Wire, route};
+use conduit::route::{PadCopper, RouteLayer, RouteParams, RouteResult, Strategy, Wire, route};
 
 /// One benchmark case.
 #[derive(Clone, Copy)]
@@ -158,7 +158,18 @@ fn main() {
     };
     let layers = layers(c);
     let wires = wires(c);
-    let params = RouteParams::default();
+    let strategy = match std::env::args().nth(2).as_deref() {
+        None | Some("ordered") => Strategy::Ordered,
+        Some("negotiated") => Strategy::Negotiated,
+        Some(other) => {
+            eprintln!("route_bench: unknown strategy {other:?}; use ordered or negotiated");
+            std::process::exit(2);
+        }
+    };
+    let params = RouteParams {
+        strategy,
+        ..RouteParams::default()
+    };
     // A round pad of twice the trace width on each end of every wire.
     let pads: Vec<PadCopper> = wires
         .iter()

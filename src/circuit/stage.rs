@@ -663,12 +663,16 @@ fn explain_unrouted(
                 fitting_width(near.distance, params)
             )
         } else if !b.traces.is_empty() {
-            let mut nets: Vec<&str> = b
+            let mut nets: Vec<&str> = Vec::new();
+            for net in b
                 .traces
                 .iter()
                 .filter_map(|&k| result.wires.get(k).map(|o| o.net.as_str()))
-                .collect();
-            nets.dedup();
+            {
+                if !nets.contains(&net) {
+                    nets.push(net);
+                }
+            }
             format!(
                 "the traces of {} take its way: more room between the parts (conduit place \
                  --scale), more layers to pass them (route.layer_span = {}), or \
