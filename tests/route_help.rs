@@ -71,6 +71,19 @@ fn traces_too_wide_for_the_pads_name_the_pads_and_the_width_that_fits() {
         );
         assert!(err.contains(&line), "no '{line}' in {err}");
     }
+    // The progress lines: the first pass, then rip-up rounds; the last one's counts are the
+    // report's.
+    let lines = e["routing"]["progress"].as_array().expect("progress");
+    assert_eq!(lines[0]["phase"], "first-pass", "{lines:?}");
+    assert!(
+        lines[1..].iter().all(|l| l["phase"] == "rip-up"),
+        "{lines:?}"
+    );
+    let last = lines.last().expect("a progress line");
+    assert_eq!(
+        (&last["routed"], &last["unrouted"]),
+        (&e["routed"], &e["unrouted"])
+    );
     for w in e["wires"].as_array().expect("wires") {
         if w["routed"] == Value::Bool(true) {
             assert_eq!(w["blocked_by"], Value::Array(Vec::new()), "{w}");
@@ -103,6 +116,21 @@ fn negotiated_routing_routes_the_demo_the_same_way_twice() {
         "{e}"
     );
     assert_eq!(e["routing"]["negotiation_conflicts"], Value::from(0), "{e}");
+    // The progress lines: negotiation rounds, the last with every wire routed and none in
+    // conflict.
+    let lines = e["routing"]["progress"].as_array().expect("progress");
+    assert!(
+        lines
+            .iter()
+            .all(|l| l["phase"] == "negotiation" && l["object"] == 0),
+        "{lines:?}"
+    );
+    let last = lines.last().expect("a progress line");
+    assert_eq!(last["routed"], e["routed"], "{last}");
+    assert_eq!(
+        (last["unrouted"].as_u64(), last["conflicts"].as_u64()),
+        (Some(0), Some(0))
+    );
 }
 
 #[test]

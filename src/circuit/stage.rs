@@ -14,8 +14,8 @@ use crate::geom::{BoundingBox, ExPolygon, Point2, Point3, Polygon, scaled};
 use crate::program::{Event, LayerExtras, Role, Toolpath};
 use crate::region::cavity::{Cavity, carve_cavities, carve_channels};
 use crate::route::{
-    NearPad, PadCopper, RouteLayer, RouteParams, RouteResult, Unrouted, Wire, min_trace_spacing,
-    route,
+    NearPad, PadCopper, RoundLog, RouteLayer, RouteParams, RouteResult, Unrouted, Wire,
+    min_trace_spacing, route,
 };
 use crate::slice::LayerZ;
 
@@ -106,6 +106,19 @@ pub struct RoutingSummary {
     pub wall_seconds: f64,
     /// Whether `route.time_limit` stopped routing before it was done.
     pub time_limit_reached: bool,
+    /// Where routing stood after each pass and round (`first-pass`, `negotiation`, `settle`,
+    /// `rip-up`), object by object: wires routed, unrouted and in conflict.
+    pub progress: Vec<RoutingLine>,
+}
+
+/// One line of [`RoutingSummary::progress`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RoutingLine {
+    /// The object (index in the scene) whose wires these are.
+    pub object: usize,
+    /// Where its routing stood.
+    #[serde(flatten)]
+    pub at: RoundLog,
 }
 
 /// What the electronics stage did, for the report.
@@ -428,6 +441,7 @@ pub fn object_stage(
         .map(|t| PadCopper::round(Some(&t.net), t.at, params.terminal_pad))
         .collect();
     let (result, pad_names) = route_object(
+        object,
         &mine,
         &mine_wires,
         &terminal_copper,
@@ -536,6 +550,7 @@ fn report_between_objects(between: &[&CircuitWire], object: usize, report: &mut 
 /// channels from the islands. Returns the routes and the names of the pads routed round
 /// (`PART.PAD`, or `terminal of net N`), in the router's order.
 fn route_object(
+    object: usize,
     mine: &[(usize, &PlacedPart)],
     mine_wires: &[&CircuitWire],
     terminal_copper: &[PadCopper],
@@ -582,6 +597,9 @@ fn route_object(
     summary.rounds = summary.rounds.max(result.rounds);
     summary.negotiation_rounds = summary.negotiation_rounds.max(result.negotiation_rounds);
     summary.negotiation_conflicts += result.negotiation_conflicts;
+    summary
+        .progress
+        .extend(result.log.iter().map(|&at| RoutingLine { object, at }));
     summary.wall_seconds += clock.elapsed().as_secs_f64();
     summary.time_limit_reached |= result.time_limit_reached;
     carve_channels(islands, &result.channels);

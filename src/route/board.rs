@@ -28,7 +28,9 @@
 use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
 use super::congestion::History;
 use super::graph::{LayerGeometry, LayerInput, PENALTY_FACTOR, PreparedLayer};
-use super::{Blockage, NearPad, PadCopper, RouteProgress, Strategy, Unrouted, wire_order};
+use super::{
+    Blockage, NearPad, PadCopper, Phase, RoundLog, RouteProgress, Strategy, Unrouted, wire_order,
+};
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
 use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, scaled, union, unscaled};
 use rayon::prelude::*;
@@ -112,7 +114,7 @@ impl Traces {
 }
 
 /// What [`Board::route_all`] ran.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Summary {
     /// Rip-up and reroute rounds.
     pub rounds: usize,
@@ -120,6 +122,8 @@ pub(crate) struct Summary {
     pub negotiation_rounds: usize,
     /// Wires still in conflict when negotiation stopped.
     pub negotiation_conflicts: usize,
+    /// Where routing stood after each pass and round.
+    pub log: Vec<RoundLog>,
 }
 
 /// A routed wire's channel and keep-out on one layer.
@@ -222,12 +226,14 @@ impl<'a> Board<'a> {
         let order = wire_order(self.wires, self.params);
         let mut summary = Summary::default();
         if self.params.strategy == Strategy::Negotiated {
-            (summary.negotiation_rounds, summary.negotiation_conflicts) = self.negotiate(&order);
+            (summary.negotiation_rounds, summary.negotiation_conflicts) =
+                self.negotiate(&order, &mut summary.log);
         } else {
             for (k, &i) in order.iter().enumerate() {
                 self.route_one(i);
                 self.tell(k + 1, 0);
             }
+            summary.log.push(self.log_line(Phase::FirstPass, 1, 0));
         }
         for round in 1..=self.params.rip_up_rounds {
             if self.routed_count() == total || self.past_deadline() {
@@ -235,7 +241,9 @@ impl<'a> Board<'a> {
             }
             summary.rounds = round;
             self.tell(total, round);
-            if !self.rip_up_round(round) {
+            let kept = self.rip_up_round(round);
+            summary.log.push(self.log_line(Phase::RipUp, round, 0));
+            if !kept {
                 break;
             }
         }
@@ -253,6 +261,18 @@ impl<'a> Board<'a> {
     /// attempt not run.
     pub(crate) fn stopped_by_deadline(&self) -> bool {
         self.stopped
+    }
+
+    /// Where routing stands after `phase`'s round `round`, with `conflicts` wires in conflict.
+    fn log_line(&self, phase: Phase, round: usize, conflicts: usize) -> RoundLog {
+        let routed = self.routed_count();
+        RoundLog {
+            phase,
+            round,
+            routed,
+            unrouted: self.wires.len() - routed,
+            conflicts,
+        }
     }
 
     /// Tells the progress callback, if any, where routing stands.

@@ -432,6 +432,37 @@ pub struct RouteResult {
     pub negotiation_conflicts: usize,
     /// Whether the deadline stopped routing before it was done.
     pub time_limit_reached: bool,
+    /// Where routing stood after each pass and round, in order.
+    pub log: Vec<RoundLog>,
+}
+
+/// A stage of routing, for [`RoundLog`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Phase {
+    /// Every wire routed once, in order ([`Strategy::Ordered`]).
+    FirstPass,
+    /// A negotiated-congestion round.
+    Negotiation,
+    /// The conflicts left by negotiation settled and their wires routed in order.
+    Settle,
+    /// A rip-up and reroute round.
+    RipUp,
+}
+
+/// Where routing stood after one pass or round.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct RoundLog {
+    /// The stage.
+    pub phase: Phase,
+    /// Its round (1 for a first pass or the settling).
+    pub round: usize,
+    /// Wires routed after it.
+    pub routed: usize,
+    /// Wires without a route after it.
+    pub unrouted: usize,
+    /// Wires whose routes overlap another net's (only negotiation leaves any).
+    pub conflicts: usize,
 }
 
 /// Heights closer than this (mm) count as equal when a pad is matched to a layer: float noise in
@@ -498,5 +529,6 @@ pub fn route(
         negotiation_rounds: summary.negotiation_rounds,
         negotiation_conflicts: summary.negotiation_conflicts,
         time_limit_reached,
+        log: summary.log,
     }
 }

@@ -27,6 +27,7 @@
 use super::{Board, Placed, Traces, overlaps};
 use crate::geom::{ExPolygon, intersection, scaled};
 use crate::route::congestion::History;
+use crate::route::{Phase, RoundLog};
 use std::collections::BTreeSet;
 use std::sync::Arc;
 
@@ -66,7 +67,7 @@ struct Conflict {
 impl Board<'_> {
     /// Routes every wire by negotiated congestion (see the module doc); returns the rounds run
     /// and the wires that were still in conflict when they stopped.
-    pub(super) fn negotiate(&mut self, order: &[usize]) -> (usize, usize) {
+    pub(super) fn negotiate(&mut self, order: &[usize], log: &mut Vec<RoundLog>) -> (usize, usize) {
         let mut rank = vec![usize::MAX; self.wires.len()];
         for (k, &i) in order.iter().enumerate() {
             rank[i] = k;
@@ -106,6 +107,7 @@ impl Board<'_> {
             let wires: BTreeSet<usize> = conflicts.iter().flat_map(|c| c.wires).collect();
             in_conflict = wires.len();
             self.tell_negotiation(self.wires.len(), 0, round, in_conflict);
+            log.push(self.log_line(Phase::Negotiation, round, in_conflict));
             if conflicts.is_empty() {
                 break;
             }
@@ -134,6 +136,9 @@ impl Board<'_> {
         for (k, &i) in ripped.iter().enumerate() {
             self.route_one(i);
             self.tell_negotiation(self.wires.len() - ripped.len() + k + 1, 0, rounds, 0);
+        }
+        if !ripped.is_empty() {
+            log.push(self.log_line(Phase::Settle, 1, 0));
         }
         (rounds, in_conflict)
     }
