@@ -441,7 +441,6 @@ pub fn object_stage(
         .map(|t| PadCopper::round(Some(&t.net), t.at, params.terminal_pad))
         .collect();
     let (result, pad_names) = route_object(
-        object,
         &mine,
         &mine_wires,
         &terminal_copper,
@@ -451,6 +450,10 @@ pub fn object_stage(
         report,
     );
     let style = TraceStyle::of(params);
+    report
+        .routing
+        .progress
+        .extend(result.log.iter().map(|&at| RoutingLine { object, at }));
     let mut per_layer = trace_paths(&result, &mine_wires, zs, style, report);
     explain_unrouted(&result, &mine_wires, &pad_names, &params.route, report);
     if params.pad_drops {
@@ -550,7 +553,6 @@ fn report_between_objects(between: &[&CircuitWire], object: usize, report: &mut 
 /// channels from the islands. Returns the routes and the names of the pads routed round
 /// (`PART.PAD`, or `terminal of net N`), in the router's order.
 fn route_object(
-    object: usize,
     mine: &[(usize, &PlacedPart)],
     mine_wires: &[&CircuitWire],
     terminal_copper: &[PadCopper],
@@ -597,9 +599,6 @@ fn route_object(
     summary.rounds = summary.rounds.max(result.rounds);
     summary.negotiation_rounds = summary.negotiation_rounds.max(result.negotiation_rounds);
     summary.negotiation_conflicts += result.negotiation_conflicts;
-    summary
-        .progress
-        .extend(result.log.iter().map(|&at| RoutingLine { object, at }));
     summary.wall_seconds += clock.elapsed().as_secs_f64();
     summary.time_limit_reached |= result.time_limit_reached;
     carve_channels(islands, &result.channels);
