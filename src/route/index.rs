@@ -6,7 +6,10 @@
 //! at the edges whose y range overlaps the query's. A map of 0.5 mm cells marks the cells an
 //! edge's bounding box touches: a query that touches no marked cell is answered without looking
 //! at an edge (no crossing, not near the boundary), and a point in an unmarked cell shares the
-//! inside/outside answer of every point of that cell, which is worked out once and kept.
+//! inside/outside answer of every point of that cell, which is worked out once and kept. The
+//! map also lists each cell's edges, so a yes/no query over a few cells (does this grid link
+//! cross the boundary, is this point near it) looks only at the edges there, not at a band
+//! across the whole layer.
 //!
 //! Orientation tests are exact (`i128` cross products of nanometre coordinates); only the
 //! parameters of intersection points are `f64`.
@@ -28,6 +31,11 @@ const MAX_BANDS: i64 = 1 << 16;
 /// Most cells in one cell map.
 const MAX_CELLS: i64 = 1 << 22;
 
+/// Most cells a yes/no query (a crossing, a point near the boundary) looks through by the cell
+/// map's edge lists; a query over a larger box scans the bands instead. Either way it sees every
+/// edge whose box meets its own, so the answer is the same.
+const CELL_QUERY: i64 = 16;
+
 /// Inside/outside of the points of an unmarked cell: not yet known.
 const UNKNOWN: u8 = 0;
 /// ... all inside.
@@ -46,6 +54,10 @@ struct CellMap {
     ny: i64,
     marked: Vec<bool>,
     answer: Vec<Cell<u8>>,
+    /// The edges whose box touches each cell (indices into the index's edges, in edge order),
+    /// cell `k`'s from `starts[k]` to `starts[k + 1]` in `ids`.
+    starts: Vec<u32>,
+    ids: Vec<u32>,
 }
 
 impl CellMap {
@@ -71,21 +83,47 @@ impl CellMap {
             size *= 2;
         }
         let (nx, ny) = ((x1 - x0) / size + 1, (y1 - y0) / size + 1);
+        let cells = (nx * ny) as usize;
         let mut map = Self {
             x0,
             y0,
             size,
             nx,
             ny,
-            marked: vec![false; (nx * ny) as usize],
-            answer: vec![Cell::new(UNKNOWN); (nx * ny) as usize],
+            marked: vec![false; cells],
+            answer: vec![Cell::new(UNKNOWN); cells],
+            starts: vec![0; cells + 1],
+            ids: Vec::new(),
         };
-        for e in edges {
-            let (cx0, cy0) = map.cell(e.a.x.min(e.b.x), e.a.y.min(e.b.y));
-            let (cx1, cy1) = map.cell(e.a.x.max(e.b.x), e.a.y.max(e.b.y));
+        let boxes: Vec<(i64, i64, i64, i64)> = edges
+            .iter()
+            .map(|e| {
+                let (cx0, cy0) = map.cell(e.a.x.min(e.b.x), e.a.y.min(e.b.y));
+                let (cx1, cy1) = map.cell(e.a.x.max(e.b.x), e.a.y.max(e.b.y));
+                (cx0, cy0, cx1, cy1)
+            })
+            .collect();
+        // Counted, then filled: each cell's edges lie together, in edge order.
+        for &(cx0, cy0, cx1, cy1) in &boxes {
             for cy in cy0..=cy1 {
                 for cx in cx0..=cx1 {
-                    map.marked[(cy * nx + cx) as usize] = true;
+                    let k = (cy * nx + cx) as usize;
+                    map.marked[k] = true;
+                    map.starts[k + 1] += 1;
+                }
+            }
+        }
+        for k in 0..cells {
+            map.starts[k + 1] += map.starts[k];
+        }
+        let mut next: Vec<u32> = map.starts[..cells].to_vec();
+        map.ids = vec![0; map.starts[cells] as usize];
+        for (i, &(cx0, cy0, cx1, cy1)) in boxes.iter().enumerate() {
+            for cy in cy0..=cy1 {
+                for cx in cx0..=cx1 {
+                    let k = (cy * nx + cx) as usize;
+                    map.ids[next[k] as usize] = i as u32;
+                    next[k] += 1;
                 }
             }
         }
@@ -109,6 +147,32 @@ impl CellMap {
         let (cx0, cy0) = self.cell(lo.x, lo.y);
         let (cx1, cy1) = self.cell(hi.x, hi.y);
         (cy0..=cy1).any(|cy| (cx0..=cx1).any(|cx| self.marked[(cy * self.nx + cx) as usize]))
+    }
+
+    /// The edges whose box touches a cell of the box `lo..=hi` (an edge may come more than
+    /// once), if that box spans at most `max_cells` cells; `None` for a larger box.
+    fn edges_near(
+        &self,
+        lo: Point2,
+        hi: Point2,
+        max_cells: i64,
+    ) -> Option<impl Iterator<Item = u32> + '_> {
+        if self.marked.is_empty() {
+            return None;
+        }
+        let (cx0, cy0) = self.cell(lo.x, lo.y);
+        let (cx1, cy1) = self.cell(hi.x, hi.y);
+        if (cx1 - cx0 + 1) * (cy1 - cy0 + 1) > max_cells {
+            return None;
+        }
+        Some((cy0..=cy1).flat_map(move |cy| {
+            (cx0..=cx1).flat_map(move |cx| {
+                let k = (cy * self.nx + cx) as usize;
+                self.ids[self.starts[k] as usize..self.starts[k + 1] as usize]
+                    .iter()
+                    .copied()
+            })
+        }))
     }
 
     /// The unmarked cell holding `p`, if `p` is on the grid and its cell is unmarked.
@@ -351,11 +415,15 @@ impl RegionIndex {
         if !self.cells.may_touch(lo, hi) {
             return false;
         }
-        self.edges_between(p.y - tol, p.y + tol).any(|e| {
+        let near = |e: &Edge| {
             e.a.x.min(e.b.x) - tol <= p.x
                 && e.a.x.max(e.b.x) + tol >= p.x
                 && segment_distance(p, e.a, e.b) <= tol as f64
-        })
+        };
+        match self.cells.edges_near(lo, hi, CELL_QUERY) {
+            Some(mut ids) => ids.any(|i| near(&self.edges[i as usize])),
+            None => self.edges_between(p.y - tol, p.y + tol).any(|e| near(&e)),
+        }
     }
 
     /// Whether `p` is inside or within `tol` of the boundary.
@@ -465,8 +533,12 @@ impl RegionIndex {
         if !self.cells.may_touch(lo, hi) {
             return false;
         }
-        self.edges_between(a.y.min(b.y), a.y.max(b.y))
-            .any(|e| proper_crossing(a, b, e))
+        match self.cells.edges_near(lo, hi, CELL_QUERY) {
+            Some(mut ids) => ids.any(|i| proper_crossing(a, b, self.edges[i as usize])),
+            None => self
+                .edges_between(a.y.min(b.y), a.y.max(b.y))
+                .any(|e| proper_crossing(a, b, e)),
+        }
     }
 
     /// How many times the segment `a`–`b` properly crosses the boundary.
