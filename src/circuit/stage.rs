@@ -14,7 +14,7 @@ use crate::geom::{BoundingBox, ExPolygon, Point2, Point3, Polygon, scaled};
 use crate::program::{Event, LayerExtras, Role, Toolpath};
 use crate::region::cavity::{Cavity, carve_cavities, carve_channels};
 use crate::route::{
-    NearPad, PadCopper, RoundLog, RouteLayer, RouteParams, RouteResult, Unrouted, Wire,
+    NearPad, PadCopper, RoundLog, RouteLayer, RouteParams, RouteResult, Unrouted, Wire, WireRoute,
     min_trace_spacing, route,
 };
 use crate::slice::LayerZ;
@@ -454,8 +454,15 @@ pub fn object_stage(
         .routing
         .progress
         .extend(result.log.iter().map(|&at| RoutingLine { object, at }));
-    let mut per_layer = trace_paths(&result, &mine_wires, zs, style, report);
-    explain_unrouted(&result, &mine_wires, &pad_names, &params.route, report);
+    let mut per_layer = trace_paths(
+        &result,
+        &mine_wires,
+        &pad_names,
+        &params.route,
+        zs,
+        style,
+        report,
+    );
     if params.pad_drops {
         add_pad_drops(&mine, zs, style, &mut per_layer);
     }
@@ -614,98 +621,93 @@ fn detour_help(params: &RouteParams) -> String {
     )
 }
 
-/// Fills in `blocked_by` and `help` of the report entries of the wires `result` could not
-/// route (the last `mine_wires.len()` entries of `report.wires`), from the router's
-/// [`Blockage`](crate::route::Blockage)s.
-fn explain_unrouted(
+/// What blocks the unrouted wire `w` (pins `ends`) and what would help: its report entry's
+/// `blocked_by` and `help`, from the router's [`Blockage`](crate::route::Blockage) (or, where the
+/// deadline left no time to look, from its reason alone).
+fn unrouted_explanation(
+    w: &WireRoute,
+    ends: &CircuitWire,
     result: &RouteResult,
     mine_wires: &[&CircuitWire],
     pad_names: &[String],
     params: &RouteParams,
-    report: &mut ElectronicsReport,
-) {
-    let first = report.wires.len().saturating_sub(mine_wires.len());
+) -> (Vec<String>, String) {
+    if matches!(w.reason, Some(Unrouted::TimeLimit(_))) {
+        let help = format!(
+            "route.time_limit (now {} s) stopped routing before this wire: raise it",
+            params.time_limit
+        );
+        return (Vec::new(), help);
+    }
+    let Some(b) = &w.blockage else {
+        let help = match w.reason {
+            Some(Unrouted::Detour) => detour_help(params),
+            Some(Unrouted::NoLayer) => "no layer of the object holds its pads".to_owned(),
+            _ => format!(
+                "route.time_limit (now {} s) left no time to find out what blocks it: \
+                 raise it",
+                params.time_limit
+            ),
+        };
+        return (Vec::new(), help);
+    };
     let pins = |k: usize| {
         mine_wires
             .get(k)
             .map_or_else(String::new, |w| format!("{} to {}", w.from, w.to))
     };
-    for (entry, w) in report.wires[first..].iter_mut().zip(&result.wires) {
-        if w.routed {
-            continue;
-        }
-        if matches!(w.reason, Some(Unrouted::TimeLimit(_))) {
-            entry.help = Some(format!(
-                "route.time_limit (now {} s) stopped routing before this wire: raise it",
-                params.time_limit
-            ));
-            continue;
-        }
-        let Some(b) = &w.blockage else {
-            // The deadline left no time to look: what the reason alone tells.
-            entry.help = Some(match w.reason {
-                Some(Unrouted::Detour) => detour_help(params),
-                Some(Unrouted::NoLayer) => "no layer of the object holds its pads".to_owned(),
-                _ => format!(
-                    "route.time_limit (now {} s) left no time to find out what blocks it: \
-                     raise it",
-                    params.time_limit
-                ),
-            });
-            continue;
-        };
-        for &k in &b.traces {
-            if let Some(other) = result.wires.get(k) {
-                entry
-                    .blocked_by
-                    .push(format!("trace of net {} ({})", other.net, pins(k)));
-            }
-        }
-        let name = |k: usize| pad_names.get(k).map_or("?", String::as_str);
-        let end = |near: &NearPad| if near.near_to { &entry.to } else { &entry.from };
-        let pads: Vec<String> = b
-            .pads
+    let mut blocked_by: Vec<String> = b
+        .traces
+        .iter()
+        .filter_map(|&k| {
+            let other = result.wires.get(k)?;
+            Some(format!("trace of net {} ({})", other.net, pins(k)))
+        })
+        .collect();
+    let name = |k: usize| pad_names.get(k).map_or("?", String::as_str);
+    let end = |near: &NearPad| if near.near_to { &ends.to } else { &ends.from };
+    blocked_by.extend(
+        b.pads
             .iter()
-            .map(|n| format!("pad {} {:.2} mm from {}", name(n.pad), n.distance, end(n)))
-            .collect();
-        entry.blocked_by.extend(pads);
-        entry.help = Some(if let Some(near) = b.pads.first() {
-            format!(
-                "pads {} and {} are {:.2} mm apart, closer than two traces can run ({:.2} mm): \
-                 a route.conductive_width of {:.2} mm fits, or more room between the pads",
-                end(near),
-                name(near.pad),
-                near.distance,
-                min_trace_spacing(params),
-                fitting_width(near.distance, params)
-            )
-        } else if !b.traces.is_empty() {
-            let mut nets: Vec<&str> = Vec::new();
-            for net in b
-                .traces
-                .iter()
-                .filter_map(|&k| result.wires.get(k).map(|o| o.net.as_str()))
-            {
-                if !nets.contains(&net) {
-                    nets.push(net);
-                }
+            .map(|n| format!("pad {} {:.2} mm from {}", name(n.pad), n.distance, end(n))),
+    );
+    let help = if let Some(near) = b.pads.first() {
+        format!(
+            "pads {} and {} are {:.2} mm apart, closer than two traces can run ({:.2} mm): \
+             a route.conductive_width of {:.2} mm fits, or more room between the pads",
+            end(near),
+            name(near.pad),
+            near.distance,
+            min_trace_spacing(params),
+            fitting_width(near.distance, params)
+        )
+    } else if !b.traces.is_empty() {
+        let mut nets: Vec<&str> = Vec::new();
+        for net in b
+            .traces
+            .iter()
+            .filter_map(|&k| result.wires.get(k).map(|o| o.net.as_str()))
+        {
+            if !nets.contains(&net) {
+                nets.push(net);
             }
-            format!(
-                "the traces of {} take its way: more room between the parts (conduit place \
-                 --scale), more layers to pass them (route.layer_span = {}), or \
-                 route.strategy = \"negotiated\"",
-                nets.join(", "),
-                params.layer_span + 1
-            )
-        } else if b.way_without_traces {
-            detour_help(params)
-        } else {
-            "no way through the material even without other traces: the parts are walled off \
-             or too far apart (route.max_detour), or the material is too thin for a channel \
-             (route.conductive_width, route.perimeters)"
-                .to_owned()
-        });
-    }
+        }
+        format!(
+            "the traces of {} take its way: more room between the parts (conduit place \
+             --scale), more layers to pass them (route.layer_span = {}), or \
+             route.strategy = \"negotiated\"",
+            nets.join(", "),
+            params.layer_span + 1
+        )
+    } else if b.way_without_traces {
+        detour_help(params)
+    } else {
+        "no way through the material even without other traces: the parts are walled off \
+         or too far apart (route.max_detour), or the material is too thin for a channel \
+         (route.conductive_width, route.perimeters)"
+            .to_owned()
+    };
+    (blocked_by, help)
 }
 
 /// Reports every routed (or unrouted) wire and returns the traces: one path per routed wire
@@ -713,12 +715,21 @@ fn explain_unrouted(
 fn trace_paths(
     result: &RouteResult,
     mine_wires: &[&CircuitWire],
+    pad_names: &[String],
+    params: &RouteParams,
     zs: &[LayerZ],
     style: TraceStyle,
     report: &mut ElectronicsReport,
 ) -> BTreeMap<usize, Vec<Toolpath>> {
     let mut per_layer: BTreeMap<usize, Vec<Toolpath>> = BTreeMap::new();
     for (w, ends) in result.wires.iter().zip(mine_wires) {
+        let (blocked_by, help) = if w.routed {
+            (Vec::new(), None)
+        } else {
+            let (blocked_by, help) =
+                unrouted_explanation(w, ends, result, mine_wires, pad_names, params);
+            (blocked_by, Some(help))
+        };
         report.wires.push(NetRoute {
             net: w.net.clone(),
             from: ends.from.clone(),
@@ -733,8 +744,8 @@ fn trace_paths(
                 .and_then(|k| mine_wires.get(k))
                 .map(|j| format!("{}-{}", j.from, j.to)),
             reason: w.reason.map(|r| r.to_string()),
-            blocked_by: Vec::new(),
-            help: None,
+            blocked_by,
+            help,
         });
         if !w.routed {
             continue;

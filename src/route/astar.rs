@@ -23,16 +23,14 @@
 //!   total float order; vertex ids follow creation order, which depends only on the input; hash
 //!   maps are only looked up, never iterated.
 
-use super::graph::{self, Ends, Graph, LayerGeometry, LayerInput, PreparedLayer, VertexId, Zone};
+use super::graph::{self, Ends, Graph, LayerInput, PreparedLayer, VertexId, Zone};
 use super::index::{dist, lerp};
 use super::interlayer::{Parent, piece_fits, polyline_length, walk_back};
 use super::{RouteLayer, RouteParams, Unrouted, Wire, WireRoute, layer_of, trace};
 use crate::geom::{Point2, scaled, segment_distance, segment_param, unscaled};
-use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::ops::RangeInclusive;
-use std::rc::Rc;
 
 /// Where a [`Search`] stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -228,17 +226,8 @@ impl Search {
         params: &RouteParams,
         taps: Vec<Tap>,
     ) -> Self {
-        // The layers are deflated on rayon's threads: each is a function of its input alone, so
-        // the result is the same on any number of threads.
-        let geometry: Vec<LayerGeometry> = inputs
-            .par_iter()
-            .map(|i| LayerGeometry::new(i, params))
-            .collect();
-        let layers: Vec<PreparedLayer> = inputs
-            .iter()
-            .zip(geometry)
-            .map(|(i, g)| PreparedLayer::with_geometry(i, Rc::new(g)))
-            .collect();
+        let known = vec![None; inputs.len()];
+        let layers = graph::prepare(&inputs, known, params);
         Self::with_prepared(layers, all, wire, params, taps)
     }
 

@@ -27,13 +27,12 @@
 
 use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
 use super::congestion::History;
-use super::graph::{LayerGeometry, LayerInput, PENALTY_FACTOR, PreparedLayer};
+use super::graph::{LayerGeometry, LayerInput, PENALTY_FACTOR, prepare};
 use super::{
     Blockage, NearPad, PadCopper, Phase, RoundLog, RouteProgress, Strategy, Unrouted, wire_order,
 };
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
 use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, scaled, union, unscaled};
-use rayon::prelude::*;
 use std::collections::HashMap;
 use std::rc::Rc;
 use std::sync::Arc;
@@ -627,47 +626,31 @@ impl<'a> Board<'a> {
             }
         };
         let window = self.window(wire, traces);
-        let mut search = if let Traces::Priced { .. } = traces {
-            // A negotiation round: the layer's geometry (the material less other nets' pads)
-            // is the same in every round; only the prices change. Layers not seen yet are
-            // deflated on rayon's threads (each from its input alone).
-            let frame = bbox_of(&window);
-            let inputs: Vec<(usize, bool, LayerInput)> = range
-                .map(|l| {
-                    let known = self.geometry.contains_key(&(l, wire.net.clone(), frame));
-                    (l, known, self.input(l, wire, traces, &window, known))
-                })
-                .collect();
-            let params = self.params;
-            let built: Vec<Option<LayerGeometry>> = inputs
-                .par_iter()
-                .map(|(_, known, input)| (!known).then(|| LayerGeometry::new(input, params)))
-                .collect();
-            let mut layers: Vec<PreparedLayer> = Vec::with_capacity(inputs.len());
-            for ((l, _, input), new) in inputs.iter().zip(built) {
-                let key = (*l, wire.net.clone(), frame);
-                let geometry = match new {
-                    Some(g) => {
-                        let g = Rc::new(g);
-                        self.geometry.insert(key, Rc::clone(&g));
-                        g
-                    }
-                    None => self.geometry.get(&key).map(Rc::clone).unwrap_or_else(|| {
-                        Rc::new(LayerGeometry::new(
-                            &self.input(*l, wire, traces, &window, false),
-                            params,
-                        ))
-                    }),
-                };
-                layers.push(PreparedLayer::with_geometry(input, geometry));
+        // In a negotiation round the layer's geometry (the material less other nets' pads) is
+        // the same in every round, only the prices change: it is built once per layer, net and
+        // window, and kept.
+        let keep = matches!(traces, Traces::Priced { .. });
+        let frame = bbox_of(&window);
+        let keys: Vec<(usize, String, BBox)> =
+            range.map(|l| (l, wire.net.clone(), frame)).collect();
+        let known: Vec<Option<Rc<LayerGeometry>>> = keys
+            .iter()
+            .map(|k| keep.then(|| self.geometry.get(k).cloned()).flatten())
+            .collect();
+        let inputs: Vec<LayerInput> = keys
+            .iter()
+            .zip(&known)
+            .map(|(k, g)| self.input(k.0, wire, traces, &window, g.is_some()))
+            .collect();
+        let layers = prepare(&inputs, known, self.params);
+        if keep {
+            for (key, layer) in keys.into_iter().zip(&layers) {
+                self.geometry
+                    .entry(key)
+                    .or_insert_with(|| Rc::clone(&layer.geometry));
             }
-            Search::with_prepared(layers, self.layers, &start, self.params, taps)
-        } else {
-            let inputs: Vec<LayerInput> = range
-                .map(|l| self.input(l, wire, traces, &window, false))
-                .collect();
-            Search::with_layers(inputs, self.layers, &start, self.params, taps)
-        };
+        }
+        let mut search = Search::with_prepared(layers, self.layers, &start, self.params, taps);
         let mut steps = 0usize;
         while search.step() == SearchState::Running {
             steps += 1;

@@ -34,6 +34,7 @@ use crate::geom::{
     ExPolygon, Join, Point2, intersection, offset, scaled, segment_distance, segment_param,
     unscaled,
 };
+use rayon::prelude::*;
 use std::collections::{BTreeMap, HashMap};
 use std::hash::{BuildHasherDefault, Hasher};
 use std::rc::Rc;
@@ -163,6 +164,33 @@ impl PreparedLayer {
             history: input.history.clone(),
         }
     }
+}
+
+/// `inputs` made ready for routing, each with its `known` geometry, or, where none is known,
+/// the geometry deflated from it. The layers without are deflated on rayon's threads: each is a
+/// function of its input alone, so the result is the same on any number of threads.
+pub(crate) fn prepare(
+    inputs: &[LayerInput],
+    known: Vec<Option<Rc<LayerGeometry>>>,
+    params: &RouteParams,
+) -> Vec<PreparedLayer> {
+    let missing: Vec<bool> = known.iter().map(Option::is_none).collect();
+    let built: Vec<Option<LayerGeometry>> = inputs
+        .par_iter()
+        .zip(missing.par_iter())
+        .map(|(input, &missing)| missing.then(|| LayerGeometry::new(input, params)))
+        .collect();
+    inputs
+        .iter()
+        .zip(known.into_iter().zip(built))
+        .map(|(input, pair)| {
+            let geometry = match pair {
+                (Some(g), _) => g,
+                (None, new) => Rc::new(new.unwrap_or_else(|| LayerGeometry::new(input, params))),
+            };
+            PreparedLayer::with_geometry(input, geometry)
+        })
+        .collect()
 }
 
 /// A layer's rings and the regions the router queries: everything of a [`PreparedLayer`] but its

@@ -208,7 +208,7 @@ impl Board<'_> {
 
 /// Where the channels of `p` and `q` overlap, if they are of different nets and do.
 fn overlap(p: &Placed, q: &Placed) -> Option<Vec<ExPolygon>> {
-    if p.net == q.net || p.wire == q.wire || !overlaps(&p.bbox, &q.bbox) {
+    if p.net == q.net || !overlaps(&p.bbox, &q.bbox) {
         return None;
     }
     let common = intersection(&p.channel, &q.channel);
