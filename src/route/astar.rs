@@ -201,16 +201,7 @@ impl Search {
     pub fn new(layers: &[RouteLayer], wire: &Wire, params: &RouteParams) -> Self {
         let inputs = layer_range(layers, wire, params).map_or(Vec::new(), |range| {
             range
-                .map(|l| LayerInput {
-                    index: l,
-                    z: layers[l].z,
-                    islands: layers[l].islands.clone(),
-                    original: layers[l].islands.clone(),
-                    blocked: Vec::new(),
-                    penalty: Vec::new(),
-                    penalty_factor: 1.0,
-                    history: None,
-                })
+                .map(|l| LayerInput::plain(l, layers[l].z, &layers[l].islands, params))
                 .collect()
         });
         Self::with_layers(inputs, layers, wire, params, Vec::new())

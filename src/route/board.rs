@@ -27,12 +27,15 @@
 
 use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
 use super::congestion::History;
-use super::graph::{LayerGeometry, LayerInput, PENALTY_FACTOR, prepare};
+use super::graph::{
+    Eroded, Grown, LayerGeometry, LayerInput, PENALTY_FACTOR, bbox, boxes_meet, prepare,
+};
 use super::{
     Blockage, NearPad, PadCopper, Phase, RoundLog, RouteProgress, Strategy, Unrouted, wire_order,
 };
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
-use crate::geom::{ExPolygon, Point2, Point3, difference, intersection, scaled, union, unscaled};
+use crate::geom::{ExPolygon, Point2, Point3, intersection, scaled, union, unscaled};
+use std::cell::OnceCell;
 use std::collections::HashMap;
 use std::rc::Rc;
 use std::sync::Arc;
@@ -53,27 +56,29 @@ const RIP_UP_DEPTH: usize = 2;
 /// Extra margin of a wire's routing window beyond the farthest its route may go, mm.
 const WINDOW_MARGIN_MM: f64 = 2.0;
 
+/// The box around the pads of `wire` grown by `grow` mm, as a region.
+fn window_box(wire: &Wire, grow: f64) -> Vec<ExPolygon> {
+    let (x0, x1) = (
+        wire.from.x.min(wire.to.x) - grow,
+        wire.from.x.max(wire.to.x) + grow,
+    );
+    let (y0, y1) = (
+        wire.from.y.min(wire.to.y) - grow,
+        wire.from.y.max(wire.to.y) + grow,
+    );
+    vec![ExPolygon {
+        contour: crate::geom::Polygon::new(vec![
+            Point2::from_mm(x0, y0),
+            Point2::from_mm(x1, y0),
+            Point2::from_mm(x1, y1),
+            Point2::from_mm(x0, y1),
+        ]),
+        holes: Vec::new(),
+    }]
+}
+
 /// An axis-aligned box, scaled units: `[min x, min y, max x, max y]`.
 type BBox = [i64; 4];
-
-/// The box around every point of `regions` (an empty box for none).
-fn bbox_of(regions: &[ExPolygon]) -> BBox {
-    let mut b = [i64::MAX, i64::MAX, i64::MIN, i64::MIN];
-    for p in regions.iter().flat_map(|ex| &ex.contour.points) {
-        b = [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)];
-    }
-    b
-}
-
-/// Whether box `inner` lies within box `outer`.
-fn bbox_within(inner: &BBox, outer: &BBox) -> bool {
-    outer[0] <= inner[0] && outer[1] <= inner[1] && inner[2] <= outer[2] && inner[3] <= outer[3]
-}
-
-/// Whether two boxes share a point.
-fn overlaps(a: &BBox, b: &BBox) -> bool {
-    a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3]
-}
 
 /// What the traces of other nets are to a search.
 #[derive(Debug, Clone)]
@@ -130,10 +135,26 @@ pub(crate) struct Summary {
 struct Placed {
     wire: usize,
     net: String,
+    /// The trace's centreline on the layer.
+    centreline: Vec<Point2>,
     channel: Vec<ExPolygon>,
     keep_out: Vec<ExPolygon>,
     /// Box of the keep-out (which holds the channel).
     bbox: BBox,
+    /// The channel grown by every deflation inset, made when a search first needs it.
+    grown: OnceCell<Arc<Grown>>,
+}
+
+impl Placed {
+    /// The channel grown by every deflation inset (see [`Grown`]).
+    fn grown(&self, params: &RouteParams) -> Arc<Grown> {
+        let half = params.channel_half_width();
+        Arc::clone(self.grown.get_or_init(|| {
+            Arc::new(Grown::new(params, |d| {
+                channels::polyline_grown(&self.centreline, half + d)
+            }))
+        }))
+    }
 }
 
 /// Another net's pad as an obstacle: its layer, net, hole and keep-out.
@@ -145,7 +166,8 @@ struct PadObstacle<'a> {
     centre: Point2,
     layer: usize,
     net: Option<&'a str>,
-    hole: Vec<ExPolygon>,
+    /// The hole grown by every deflation inset.
+    grown: Arc<Grown>,
     keep_out: Vec<ExPolygon>,
     /// Box of the keep-out (which holds the hole).
     bbox: BBox,
@@ -159,6 +181,8 @@ pub(crate) struct Board<'a> {
     params: &'a RouteParams,
     pads: Vec<PadObstacle<'a>>,
     placed: Vec<Vec<Placed>>,
+    /// Each layer's islands eroded by every deflation inset, made when first needed.
+    eroded: Vec<OnceCell<Arc<Eroded>>>,
     routes: Vec<Option<WireRoute>>,
     /// Layer geometry of negotiation rounds by (layer, net, routing window): the material less
     /// other nets' pads, the same in every round.
@@ -197,8 +221,8 @@ impl<'a> Board<'a> {
                     centre: Point2::new(x0 + (x1 - x0) / 2, y0 + (y1 - y0) / 2),
                     layer: layer_of(layers, p.z)?,
                     net: p.net.as_deref(),
-                    bbox: bbox_of(&keep_out),
-                    hole,
+                    bbox: bbox(&keep_out),
+                    grown: Arc::new(Grown::of_polygons(&hole, params)),
                     keep_out,
                 })
             })
@@ -209,6 +233,7 @@ impl<'a> Board<'a> {
             params,
             pads,
             placed: vec![Vec::new(); layers.len()],
+            eroded: vec![OnceCell::new(); layers.len()],
             routes: vec![None; wires.len()],
             geometry: HashMap::new(),
             deadline,
@@ -481,8 +506,10 @@ impl<'a> Board<'a> {
                 wire: i,
                 net: self.wires[i].net.clone(),
                 channel: channels::polyline_channel(&xy, half),
-                bbox: bbox_of(&keep_out),
+                centreline: xy,
+                bbox: bbox(&keep_out),
                 keep_out,
+                grown: OnceCell::new(),
             });
         }
         self.routes[i] = Some(result);
@@ -626,13 +653,29 @@ impl<'a> Board<'a> {
             }
         };
         let window = self.window(wire, traces);
+        self.search_in(i, &start, traces, &window, &range, taps)
+    }
+
+    /// Runs the A* search of wire `i` from `start`, within `window`, on the layers of `range`.
+    fn search_in(
+        &mut self,
+        i: usize,
+        start: &Wire,
+        traces: &Traces,
+        window: &[ExPolygon],
+        range: &std::ops::RangeInclusive<usize>,
+        taps: Vec<Tap>,
+    ) -> WireRoute {
+        let wire = &self.wires[i];
         // In a negotiation round the layer's geometry (the material less other nets' pads) is
         // the same in every round, only the prices change: it is built once per layer, net and
         // window, and kept.
         let keep = matches!(traces, Traces::Priced { .. });
-        let frame = bbox_of(&window);
-        let keys: Vec<(usize, String, BBox)> =
-            range.map(|l| (l, wire.net.clone(), frame)).collect();
+        let frame = bbox(window);
+        let keys: Vec<(usize, String, BBox)> = range
+            .clone()
+            .map(|l| (l, wire.net.clone(), frame))
+            .collect();
         let known: Vec<Option<Rc<LayerGeometry>>> = keys
             .iter()
             .map(|k| keep.then(|| self.geometry.get(k).cloned()).flatten())
@@ -640,7 +683,7 @@ impl<'a> Board<'a> {
         let inputs: Vec<LayerInput> = keys
             .iter()
             .zip(&known)
-            .map(|(k, g)| self.input(k.0, wire, traces, &window, g.is_some()))
+            .map(|(k, g)| self.input(k.0, wire, traces, window, g.is_some()))
             .collect();
         let layers = prepare(&inputs, known, self.params);
         if keep {
@@ -650,7 +693,7 @@ impl<'a> Board<'a> {
                     .or_insert_with(|| Rc::clone(&layer.geometry));
             }
         }
-        let mut search = Search::with_prepared(layers, self.layers, &start, self.params, taps);
+        let mut search = Search::with_prepared(layers, self.layers, start, self.params, taps);
         let mut steps = 0usize;
         while search.step() == SearchState::Running {
             steps += 1;
@@ -692,23 +735,15 @@ impl<'a> Board<'a> {
         if !grow.is_finite() {
             return Vec::new();
         }
-        let (x0, x1) = (
-            wire.from.x.min(wire.to.x) - grow,
-            wire.from.x.max(wire.to.x) + grow,
-        );
-        let (y0, y1) = (
-            wire.from.y.min(wire.to.y) - grow,
-            wire.from.y.max(wire.to.y) + grow,
-        );
-        vec![ExPolygon {
-            contour: crate::geom::Polygon::new(vec![
-                Point2::from_mm(x0, y0),
-                Point2::from_mm(x1, y0),
-                Point2::from_mm(x1, y1),
-                Point2::from_mm(x0, y1),
-            ]),
-            holes: Vec::new(),
-        }]
+        window_box(wire, grow)
+    }
+
+    /// Layer `l`'s islands eroded by every deflation inset (made on first use).
+    fn eroded(&self, l: usize) -> Arc<Eroded> {
+        Arc::clone(
+            self.eroded[l]
+                .get_or_init(|| Arc::new(Eroded::new(&self.layers[l].islands, self.params))),
+        )
     }
 
     /// Layer `l` as `wire` sees it within `window` (everything if empty): the islands less the
@@ -724,31 +759,48 @@ impl<'a> Board<'a> {
         window: &[ExPolygon],
         prices_only: bool,
     ) -> LayerInput {
-        let mut holes: Vec<ExPolygon> = Vec::new();
+        let mut holes: Vec<Arc<Grown>> = Vec::new();
         let mut blocked: Vec<ExPolygon> = Vec::new();
         let mut penalty: Vec<ExPolygon> = Vec::new();
         let frame = if window.is_empty() {
             [i64::MIN, i64::MIN, i64::MAX, i64::MAX]
         } else {
-            bbox_of(window)
+            bbox(window)
         };
         for p in self
             .near(l)
-            .filter(|p| p.net != wire.net && overlaps(&p.bbox, &frame))
+            .filter(|p| p.net != wire.net && boxes_meet(&p.bbox, &frame))
         {
             if matches!(traces, Traces::Obstacles) {
-                holes.extend(p.channel.iter().cloned());
-                blocked.extend(p.keep_out.iter().cloned());
+                if !prices_only {
+                    holes.push(p.grown(self.params));
+                    blocked.extend(p.keep_out.iter().cloned());
+                }
             } else {
                 penalty.extend(p.keep_out.iter().cloned());
             }
         }
-        let prices = |penalty: Vec<ExPolygon>| LayerInput {
+        if !prices_only {
+            // A pad is an obstacle on the layers just below and above its own too: its net's
+            // trace leaves it on the pad's layer, and another net's trace under or over that
+            // start would touch it (as between any two traces of adjacent layers) and wall the
+            // pad in.
+            for pad in self.pads.iter().filter(|p| {
+                p.layer.abs_diff(l) <= 1
+                    && p.net != Some(wire.net.as_str())
+                    && boxes_meet(&p.bbox, &frame)
+            }) {
+                holes.push(Arc::clone(&pad.grown));
+                blocked.extend(pad.keep_out.iter().cloned());
+            }
+        }
+        LayerInput {
             index: l,
             z: self.layers[l].z,
-            islands: Vec::new(),
-            original: Vec::new(),
-            blocked: Vec::new(),
+            eroded: self.eroded(l),
+            window: (!window.is_empty()).then_some(frame),
+            holes,
+            blocked,
             penalty: if penalty.is_empty() {
                 penalty
             } else {
@@ -759,41 +811,6 @@ impl<'a> Board<'a> {
                 Traces::Priced { history, .. } => Some(Arc::clone(history)),
                 _ => None,
             },
-        };
-        if prices_only {
-            return prices(penalty);
-        }
-        // A pad is an obstacle on the layers just below and above its own too: its net's trace
-        // leaves it on the pad's layer, and another net's trace under or over that start would
-        // touch it (as between any two traces of adjacent layers) and wall the pad in.
-        for pad in self.pads.iter().filter(|p| {
-            p.layer.abs_diff(l) <= 1
-                && p.net != Some(wire.net.as_str())
-                && overlaps(&p.bbox, &frame)
-        }) {
-            holes.extend(pad.hole.iter().cloned());
-            blocked.extend(pad.keep_out.iter().cloned());
-        }
-        let original =
-            if window.is_empty() || bbox_within(&bbox_of(&self.layers[l].islands), &frame) {
-                self.layers[l].islands.clone()
-            } else {
-                intersection(&self.layers[l].islands, window)
-            };
-        let islands = if holes.is_empty() {
-            original.clone()
-        } else {
-            difference(&original, &union(&holes))
-        };
-        LayerInput {
-            islands,
-            original,
-            blocked: if blocked.is_empty() {
-                blocked
-            } else {
-                union(&blocked)
-            },
-            ..prices(penalty)
         }
     }
 }

@@ -64,13 +64,18 @@ pub(crate) fn pad_obstacle(outline: &Polygon, params: &RouteParams) -> [Vec<ExPo
 /// A regular 16-gon around `center` circumscribing the circle of radius `radius_mm`, as one
 /// counter-clockwise ExPolygon.
 pub(crate) fn disc(center: Point2, radius_mm: f64) -> Vec<ExPolygon> {
-    let r = scaled(circumscribed(radius_mm)) as f64;
+    disc_of(center, radius_mm, JOINT_SIDES)
+}
+
+/// A regular `sides`-gon around `center` circumscribing the circle of radius `radius_mm`.
+fn disc_of(center: Point2, radius_mm: f64, sides: usize) -> Vec<ExPolygon> {
+    let r = scaled(radius_mm / (PI / sides as f64).cos()) as f64;
     if r <= 0.0 {
         return Vec::new();
     }
-    let points = (0..JOINT_SIDES)
+    let points = (0..sides)
         .map(|k| {
-            let a = 2.0 * PI * k as f64 / JOINT_SIDES as f64;
+            let a = 2.0 * PI * k as f64 / sides as f64;
             Point2::new(
                 center.x + (r * a.cos()).round() as i64,
                 center.y + (r * a.sin()).round() as i64,
@@ -121,12 +126,40 @@ fn simplify(points: &[Point2]) -> Vec<Point2> {
 
 /// The polyline `points` grown by `half_mm` on each side, with round (16-gon) joints and ends.
 pub(crate) fn polyline_channel(points: &[Point2], half_mm: f64) -> Vec<ExPolygon> {
+    polyline_outline(points, half_mm, JOINT_SIDES)
+}
+
+/// Sides of the joints of a polyline grown by `radius_mm`: as many as keep the circumscribing
+/// polygon within [`GROWN_BULGE_MM`] of the circle, at least [`JOINT_SIDES`].
+fn sides_for(radius_mm: f64) -> usize {
+    let mut sides = JOINT_SIDES;
+    while sides < 256 && radius_mm * (1.0 / (PI / sides as f64).cos() - 1.0) > GROWN_BULGE_MM {
+        sides *= 2;
+    }
+    sides
+}
+
+/// Farthest the joints of a grown polyline ([`polyline_grown`]) reach past the true round
+/// outline, mm.
+const GROWN_BULGE_MM: f64 = 0.01;
+
+/// The polyline `points` grown by `radius_mm` with joints fine enough to stay within
+/// [`GROWN_BULGE_MM`] of the true round outline: a channel grown by a deflation inset.
+pub(crate) fn polyline_grown(points: &[Point2], radius_mm: f64) -> Vec<ExPolygon> {
+    polyline_outline(points, radius_mm, sides_for(radius_mm))
+}
+
+/// The polyline `points` grown by `half_mm` on each side, with round (`sides`-gon) joints.
+fn polyline_outline(points: &[Point2], half_mm: f64, sides: usize) -> Vec<ExPolygon> {
     let pts = simplify(points);
     let h = scaled(half_mm) as f64;
     if pts.is_empty() || h <= 0.0 {
         return Vec::new();
     }
-    let mut pieces: Vec<ExPolygon> = pts.iter().flat_map(|&p| disc(p, half_mm)).collect();
+    let mut pieces: Vec<ExPolygon> = pts
+        .iter()
+        .flat_map(|&p| disc_of(p, half_mm, sides))
+        .collect();
     for w in pts.windows(2) {
         let (a, b) = (w[0], w[1]);
         let len = dist(a, b);

@@ -21,6 +21,13 @@
 //!   ring within the perimeter zone (plus a grid step), to the first point of every ring in each
 //!   of the eight 45° directions within that reach, and to every vertex within a grid step.
 //!
+//! The deflated areas are not deflated afresh for every search. Shrinking the islands less some
+//! holes by `d` is shrinking the islands by `d` and taking out the holes grown by `d`: each
+//! layer's islands are shrunk once per inset ([`Eroded`]), each pad and channel is grown once
+//! per inset when a search first meets it ([`Grown`]), and a search takes the grown holes in its
+//! window out of the shrunk islands (`carve`) — a subtraction of the holes near the route
+//! instead of an offset of the whole layer with all of its holes.
+//!
 //! Rings and sections are supersampled so consecutive vertices are at most
 //! `min(interlayer_overlap, grid_step)` apart. Ring samples sit at fixed arc lengths from the
 //! ring's canonical start, so identical rings on neighbouring layers give identical vertices, and
@@ -31,8 +38,8 @@ use super::RouteParams;
 use super::congestion::History;
 use super::index::{Hit, RegionIndex, dist, lerp};
 use crate::geom::{
-    ExPolygon, Join, Point2, intersection, offset, scaled, segment_distance, segment_param,
-    unscaled,
+    ExPolygon, Join, Point2, difference, intersection, offset, scaled, segment_distance,
+    segment_param, union, unscaled,
 };
 use rayon::prelude::*;
 use std::collections::{BTreeMap, HashMap};
@@ -90,12 +97,16 @@ pub(crate) struct LayerInput {
     pub index: usize,
     /// Top of the layer, mm.
     pub z: f64,
-    /// Material where this wire's channel may go: the islands with other nets' channels removed.
-    pub islands: Vec<ExPolygon>,
-    /// The caller's islands, before any channel was carved (inside/outside and crossings).
-    pub original: Vec<ExPolygon>,
+    /// The caller's islands, eroded once per layer for every deflation inset.
+    pub eroded: Arc<Eroded>,
+    /// The routing window (`[min x, min y, max x, max y]`, scaled): the deflated areas end
+    /// where the window shrunk by the same inset does. `None` for the whole layer.
+    pub window: Option<[i64; 4]>,
+    /// Other nets' channels and pads in the window, grown by every inset: what they take out
+    /// of the eroded islands.
+    pub holes: Vec<Arc<Grown>>,
     /// Where no trace centre of this wire may run (other nets' traces grown by two channel
-    /// half-widths).
+    /// half-widths, and their pads'); the pieces may overlap.
     pub blocked: Vec<ExPolygon>,
     /// Where links cost `penalty_factor` times more: other nets' traces, when a rip-up probe
     /// looks for the route that runs into the fewest of them, or a negotiation round routes
@@ -105,6 +116,215 @@ pub(crate) struct LayerInput {
     pub penalty_factor: f64,
     /// Congestion history of negotiated routing: links cost `1 + history` times more.
     pub history: Option<Arc<History>>,
+}
+
+impl LayerInput {
+    /// Layer `index` at `z` with `islands` as its material, nothing in the way and nothing
+    /// priced.
+    pub(crate) fn plain(index: usize, z: f64, islands: &[ExPolygon], params: &RouteParams) -> Self {
+        Self {
+            index,
+            z,
+            eroded: Arc::new(Eroded::new(islands, params)),
+            window: None,
+            holes: Vec::new(),
+            blocked: Vec::new(),
+            penalty: Vec::new(),
+            penalty_factor: 1.0,
+            history: None,
+        }
+    }
+}
+
+/// The distances the router deflates a layer's material by, mm: one per deflated perimeter
+/// trace, `i·perimeter_width + (conductive_width + channel_extra)/2` for `i = 1..=perimeters`
+/// (half a channel alone without perimeters, where a trace centre keeps its channel inside).
+pub(crate) fn insets(params: &RouteParams) -> Vec<f64> {
+    let half = params.channel_half_width();
+    if params.perimeters == 0 {
+        return vec![half];
+    }
+    (1..=params.perimeters)
+        .map(|i| i as f64 * params.perimeter_width + half)
+        .collect()
+}
+
+/// The squeeze region's two distances, mm: clear of other nets' keep-outs (which reach a
+/// polygonal channel's circumscribed half-width past their holes, so the squeeze rings are
+/// themselves usable), and one perimeter inside the layer's own walls.
+fn squeeze_insets(params: &RouteParams) -> (f64, f64) {
+    let half = params.channel_half_width();
+    (
+        super::channels::keep_out_radius(params) - super::channels::circumscribed(half)
+            + ROUND_DEVIATION_MM,
+        params.perimeter_width + half,
+    )
+}
+
+/// A layer's islands eroded by every inset (see [`insets`]), made once per layer: eroding
+/// the islands less the holes of other nets' channels and pads by `d` is eroding the islands by
+/// `d` and taking out the holes grown by `d`, so each search only subtracts its holes' grown
+/// shapes ([`Grown`]) instead of deflating the whole layer again.
+#[derive(Debug, Default)]
+pub(crate) struct Eroded {
+    /// The islands shrunk by each inset of [`insets`].
+    areas: Vec<Vec<ExPolygon>>,
+    /// The islands shrunk by both squeeze distances (see [`squeeze_insets`]); empty when the
+    /// squeeze region is off.
+    squeeze: Vec<ExPolygon>,
+    /// The islands (inside/outside decisions, perimeter crossings).
+    material: Arc<RegionIndex>,
+    /// Outer contours of the islands, grouped by island.
+    contours: Arc<RegionIndex>,
+}
+
+impl Eroded {
+    /// `islands` eroded for `params`.
+    pub(crate) fn new(islands: &[ExPolygon], params: &RouteParams) -> Self {
+        let erode = |d: f64| offset(islands, -d, Join::Round(ROUND_DEVIATION_MM));
+        let areas = insets(params).into_iter().map(erode).collect();
+        let squeeze = if params.squeeze_weight.is_finite() {
+            let (clear, walls) = squeeze_insets(params);
+            intersection(&erode(clear), &erode(walls))
+        } else {
+            Vec::new()
+        };
+        let contours: Vec<(u32, &[Point2])> = islands
+            .iter()
+            .enumerate()
+            .map(|(k, ex)| (k as u32, ex.contour.points.as_slice()))
+            .collect();
+        Self {
+            areas,
+            squeeze,
+            material: Arc::new(RegionIndex::of_regions(islands)),
+            contours: Arc::new(RegionIndex::new(&contours)),
+        }
+    }
+}
+
+/// A region and its box.
+type Boxed = (Vec<ExPolygon>, [i64; 4]);
+
+/// A hole in the material (another net's channel or pad) grown by every inset of [`insets`]
+/// and by the squeeze clearance, each with its box: what it takes out of the [`Eroded`]
+/// islands.
+#[derive(Debug, Default)]
+pub(crate) struct Grown {
+    /// Grown by each inset.
+    areas: Vec<Boxed>,
+    /// Grown by the squeeze clearance.
+    squeeze: Boxed,
+}
+
+impl Grown {
+    /// A hole grown by `grow(d)` for each distance `d` (mm) it is needed at.
+    pub(crate) fn new(params: &RouteParams, grow: impl Fn(f64) -> Vec<ExPolygon>) -> Self {
+        let boxed = |d: f64| {
+            let region = grow(d);
+            let b = bbox(&region);
+            (region, b)
+        };
+        Self {
+            areas: insets(params).into_iter().map(boxed).collect(),
+            squeeze: if params.squeeze_weight.is_finite() {
+                boxed(squeeze_insets(params).0)
+            } else {
+                (Vec::new(), bbox(&[]))
+            },
+        }
+    }
+
+    /// A polygonal hole, grown by offsetting with round corners.
+    pub(crate) fn of_polygons(hole: &[ExPolygon], params: &RouteParams) -> Self {
+        Self::new(params, |d| {
+            decimate(offset(hole, d, Join::Round(ROUND_DEVIATION_MM)))
+        })
+    }
+}
+
+/// The box around every point of `regions` (an empty box for none), scaled units.
+pub(crate) fn bbox(regions: &[ExPolygon]) -> [i64; 4] {
+    let mut b = [i64::MAX, i64::MAX, i64::MIN, i64::MIN];
+    for p in regions.iter().flat_map(|ex| &ex.contour.points) {
+        b = [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)];
+    }
+    b
+}
+
+/// Whether two boxes share a point.
+pub(crate) fn boxes_meet(a: &[i64; 4], b: &[i64; 4]) -> bool {
+    a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3]
+}
+
+/// `eroded` (the islands shrunk by `inset` mm) within `window` shrunk by the same inset, less
+/// `holes` (grown by it; only those that reach the rest are taken out).
+fn carve<'h>(
+    eroded: &[ExPolygon],
+    window: Option<[i64; 4]>,
+    inset: f64,
+    holes: impl Iterator<Item = &'h Boxed>,
+) -> Vec<ExPolygon> {
+    let clipped = match window {
+        None => eroded.to_vec(),
+        Some(w) => {
+            let d = scaled(inset);
+            let frame = [w[0] + d, w[1] + d, w[2] - d, w[3] - d];
+            if frame[0] >= frame[2] || frame[1] >= frame[3] {
+                return Vec::new();
+            }
+            // Only the parts that reach into the frame matter to the intersection.
+            let mut near: Vec<ExPolygon> = Vec::new();
+            let mut inside = true;
+            for ex in eroded {
+                let b = bbox(std::slice::from_ref(ex));
+                if !boxes_meet(&b, &frame) {
+                    continue;
+                }
+                inside &=
+                    frame[0] <= b[0] && frame[1] <= b[1] && b[2] <= frame[2] && b[3] <= frame[3];
+                near.push(ExPolygon {
+                    contour: ex.contour.clone(),
+                    holes: ex
+                        .holes
+                        .iter()
+                        .filter(|h| {
+                            let hb = bbox(&[ExPolygon {
+                                contour: (*h).clone(),
+                                holes: Vec::new(),
+                            }]);
+                            boxes_meet(&hb, &frame)
+                        })
+                        .cloned()
+                        .collect(),
+                });
+            }
+            if inside {
+                near
+            } else {
+                let rect = ExPolygon {
+                    contour: crate::geom::Polygon::new(vec![
+                        Point2::new(frame[0], frame[1]),
+                        Point2::new(frame[2], frame[1]),
+                        Point2::new(frame[2], frame[3]),
+                        Point2::new(frame[0], frame[3]),
+                    ]),
+                    holes: Vec::new(),
+                };
+                intersection(&near, &[rect])
+            }
+        }
+    };
+    let reach = bbox(&clipped);
+    let holes: Vec<ExPolygon> = holes
+        .filter(|(_, b)| boxes_meet(b, &reach))
+        .flat_map(|(region, _)| region.iter().cloned())
+        .collect();
+    if holes.is_empty() || clipped.is_empty() {
+        decimate(clipped)
+    } else {
+        decimate(difference(&clipped, &holes))
+    }
 }
 
 /// Cost multiplier of links in a [`LayerInput::penalty`] region.
@@ -212,9 +432,9 @@ pub(crate) struct LayerGeometry {
     /// traces leave out here, at `squeeze_weight`.
     pub squeeze: RegionIndex,
     /// The original islands (inside/outside decisions, perimeter crossings).
-    pub material: RegionIndex,
+    pub material: Arc<RegionIndex>,
     /// Outer contours of the original islands, grouped by island.
-    pub contours: RegionIndex,
+    pub contours: Arc<RegionIndex>,
     /// Keep-outs of other nets' traces.
     pub blocked: RegionIndex,
 }
@@ -222,54 +442,40 @@ pub(crate) struct LayerGeometry {
 impl LayerGeometry {
     /// Deflates the islands of `input` into rings and indexes the regions.
     pub(crate) fn new(input: &LayerInput, params: &RouteParams) -> Self {
-        let half = params.channel_half_width();
+        let eroded = &input.eroded;
+        let insets = insets(params);
+        let areas: Vec<Vec<ExPolygon>> = eroded
+            .areas
+            .iter()
+            .zip(&insets)
+            .enumerate()
+            .map(|(k, (base, &d))| {
+                let holes = input.holes.iter().filter_map(|g| g.areas.get(k));
+                carve(base, input.window, d, holes)
+            })
+            .collect();
         let mut rings = Vec::new();
-        let mut areas: Vec<Vec<ExPolygon>> = Vec::new();
-        for i in 1..=params.perimeters {
-            let inset = i as f64 * params.perimeter_width + half;
-            let area = decimate(offset(
-                &input.islands,
-                -inset,
-                Join::Round(ROUND_DEVIATION_MM),
-            ));
-            let weight = params.perimeter_weight(i);
-            for ex in &area {
-                for ring in std::iter::once(&ex.contour).chain(&ex.holes) {
-                    if ring.points.len() >= 3 {
-                        rings.push(Ring {
-                            points: ring.points.clone(),
-                            weight,
-                        });
+        if params.perimeters > 0 {
+            for (k, area) in areas.iter().enumerate() {
+                let weight = params.perimeter_weight(k + 1);
+                for ex in area {
+                    for ring in std::iter::once(&ex.contour).chain(&ex.holes) {
+                        if ring.points.len() >= 3 {
+                            rings.push(Ring {
+                                points: ring.points.clone(),
+                                weight,
+                            });
+                        }
                     }
                 }
             }
-            areas.push(area);
         }
-        if areas.is_empty() {
-            areas.push(offset(
-                &input.islands,
-                -half,
-                Join::Round(ROUND_DEVIATION_MM),
-            ));
-        }
-        let squeeze = if params.squeeze_weight.is_finite() {
-            // Just outside the keep-outs of other nets' channels and pads (which reach a
-            // polygonal channel's circumscribed half-width past their holes), so the squeeze
-            // rings are themselves usable.
-            let clear = offset(
-                &input.islands,
-                -(super::channels::keep_out_radius(params) - super::channels::circumscribed(half)
-                    + ROUND_DEVIATION_MM),
-                Join::Round(ROUND_DEVIATION_MM),
-            );
-            let walls = offset(
-                &input.original,
-                -(params.perimeter_width + half),
-                Join::Round(ROUND_DEVIATION_MM),
-            );
-            decimate(intersection(&clear, &walls))
-        } else {
+        let squeeze = if eroded.squeeze.is_empty() {
             Vec::new()
+        } else {
+            let (clear, walls) = squeeze_insets(params);
+            let holes = input.holes.iter().map(|g| &g.squeeze);
+            carve(&eroded.squeeze, input.window, clear.max(walls), holes)
         };
         // Away from other nets' channels and pads the squeeze region ends where the first
         // deflated area does: those rings are there already.
@@ -300,20 +506,19 @@ impl LayerGeometry {
             .enumerate()
             .map(|(k, r)| (k as u32, r.points.as_slice()))
             .collect();
-        let contours: Vec<(u32, &[Point2])> = input
-            .original
-            .iter()
-            .enumerate()
-            .map(|(k, ex)| (k as u32, ex.contour.points.as_slice()))
-            .collect();
+        let blocked = if input.blocked.len() > 1 {
+            union(&input.blocked)
+        } else {
+            input.blocked.clone()
+        };
         Self {
             squeeze: RegionIndex::of_regions(&squeeze),
             ring_edges: RegionIndex::new(&ring_refs),
             clearance: RegionIndex::of_regions(areas.first().map_or(&[], Vec::as_slice)),
             infill: RegionIndex::of_regions(areas.last().map_or(&[], Vec::as_slice)),
-            material: RegionIndex::of_regions(&input.original),
-            contours: RegionIndex::new(&contours),
-            blocked: RegionIndex::of_regions(&input.blocked),
+            material: Arc::clone(&eroded.material),
+            contours: Arc::clone(&eroded.contours),
+            blocked: RegionIndex::of_regions(&blocked),
             rings,
         }
     }
@@ -865,16 +1070,12 @@ mod tests {
             contour: square(0.0, 60.0),
             holes: vec![hole],
         }];
-        LayerInput {
+        LayerInput::plain(
             index,
-            z: 0.2 * (index + 1) as f64,
-            islands: islands.clone(),
-            original: islands,
-            blocked: Vec::new(),
-            penalty: Vec::new(),
-            penalty_factor: 1.0,
-            history: None,
-        }
+            0.2 * (index + 1) as f64,
+            &islands,
+            &RouteParams::default(),
+        )
     }
 
     #[test]

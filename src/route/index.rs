@@ -15,7 +15,7 @@
 //! parameters of intersection points are `f64`.
 
 use crate::geom::{ExPolygon, Point2, segment_distance};
-use std::cell::Cell;
+use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Height of one band of edges, in scaled units (1 mm).
 const BAND: i64 = 1_000_000;
@@ -45,7 +45,7 @@ const OUTSIDE: u8 = 2;
 
 /// Which cells of a grid over the edges' bounding box an edge's bounding box touches, and the
 /// inside/outside answer of the untouched ones once asked.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 struct CellMap {
     x0: i64,
     y0: i64,
@@ -53,11 +53,29 @@ struct CellMap {
     nx: i64,
     ny: i64,
     marked: Vec<bool>,
-    answer: Vec<Cell<u8>>,
+    /// Atomic so an index can be shared between threads: two threads that both work out a
+    /// cell's answer store the same value.
+    answer: Vec<AtomicU8>,
     /// The edges whose box touches each cell (indices into the index's edges, in edge order),
     /// cell `k`'s from `starts[k]` to `starts[k + 1]` in `ids`.
     starts: Vec<u32>,
     ids: Vec<u32>,
+}
+
+impl Clone for CellMap {
+    fn clone(&self) -> Self {
+        Self {
+            marked: self.marked.clone(),
+            answer: self
+                .answer
+                .iter()
+                .map(|a| AtomicU8::new(a.load(Ordering::Relaxed)))
+                .collect(),
+            starts: self.starts.clone(),
+            ids: self.ids.clone(),
+            ..*self
+        }
+    }
 }
 
 impl CellMap {
@@ -91,7 +109,7 @@ impl CellMap {
             nx,
             ny,
             marked: vec![false; cells],
-            answer: vec![Cell::new(UNKNOWN); cells],
+            answer: (0..cells).map(|_| AtomicU8::new(UNKNOWN)).collect(),
             starts: vec![0; cells + 1],
             ids: Vec::new(),
         };
@@ -377,12 +395,13 @@ impl RegionIndex {
         let Some(k) = self.cells.free_cell(p) else {
             return self.ray_parity(p);
         };
-        match self.cells.answer[k].get() {
+        match self.cells.answer[k].load(Ordering::Relaxed) {
             INSIDE => true,
             OUTSIDE => false,
             _ => {
                 let inside = self.ray_parity(p);
-                self.cells.answer[k].set(if inside { INSIDE } else { OUTSIDE });
+                self.cells.answer[k]
+                    .store(if inside { INSIDE } else { OUTSIDE }, Ordering::Relaxed);
                 inside
             }
         }

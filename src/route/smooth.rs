@@ -117,17 +117,9 @@ mod tests {
             ]),
             holes: Vec::new(),
         };
-        let input = LayerInput {
-            index: 0,
-            z: 0.2,
-            islands: vec![square.clone()],
-            original: vec![square],
-            blocked: Vec::new(),
-            penalty: Vec::new(),
-            penalty_factor: 1.0,
-            history: None,
-        };
-        PreparedLayer::new(&input, &RouteParams::default())
+        let params = RouteParams::default();
+        let input = LayerInput::plain(0, 0.2, &[square], &params);
+        PreparedLayer::new(&input, &params)
     }
 
     #[test]

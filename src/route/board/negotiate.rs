@@ -24,7 +24,7 @@
 //! Every step runs in a fixed order on data that depends only on the input, so the result does
 //! too.
 
-use super::{Board, Placed, Traces, overlaps};
+use super::{Board, Placed, Traces, boxes_meet};
 use crate::geom::{ExPolygon, intersection, scaled};
 use crate::route::congestion::History;
 use crate::route::{Phase, RoundLog};
@@ -208,7 +208,7 @@ impl Board<'_> {
 
 /// Where the channels of `p` and `q` overlap, if they are of different nets and do.
 fn overlap(p: &Placed, q: &Placed) -> Option<Vec<ExPolygon>> {
-    if p.net == q.net || !overlaps(&p.bbox, &q.bbox) {
+    if p.net == q.net || !boxes_meet(&p.bbox, &q.bbox) {
         return None;
     }
     let common = intersection(&p.channel, &q.channel);
