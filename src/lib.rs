@@ -52,6 +52,7 @@
 //! command lines, calls one walk, writes files and prints.
 
 // Vocabulary.
+pub mod interrupt;
 pub mod geom;
 pub mod mesh;
 pub mod scene;

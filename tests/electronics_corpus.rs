@@ -502,3 +502,58 @@ fn redbot_reports_every_wire_and_names_the_unrouted_nets() {
     );
     println!("RedBot: unrouted nets {failed:?}");
 }
+
+/// Ctrl-C during routing: the job stops within seconds, exits 130 and leaves no output and no
+/// temporary file (RedBot routes for far longer than the test waits).
+#[test]
+fn ctrl_c_stops_routing_and_writes_nothing() {
+    let Some(board) = Board::load("RedBot") else {
+        return;
+    };
+    let dir = temp_dir();
+    let dir = dir.path();
+    let (stl, toml) = (dir.join("block.stl"), dir.join("placement.toml"));
+    save(&block(&board.grid), &stl, MeshFormat::Stl).expect("block written");
+    std::fs::write(&toml, &board.grid.toml).expect("placement written");
+    let sch = eagle_file(&corpus().expect("corpus"), board.name, "sch");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_conduit"))
+        .args([
+            "slice".as_ref(),
+            stl.as_os_str(),
+            "--circuit".as_ref(),
+            sch.as_os_str(),
+        ])
+        .args(["--placement".as_ref(), toml.as_os_str(), "-o".as_ref()])
+        .arg(dir.join("board.gcode"))
+        .arg("--report")
+        .arg(dir.join("report.json"))
+        .args(["--set", "route.conductive_width=0.4", "--allow-unrouted"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("conduit runs");
+    // Routing starts after slicing (about a second); the first pass alone takes far longer.
+    std::thread::sleep(std::time::Duration::from_secs(4));
+    let sent = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success());
+    let stopped = Instant::now();
+    let out = child.wait_with_output().expect("conduit ends");
+    let after = stopped.elapsed().as_secs_f64();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("interrupted (Ctrl-C): nothing written"),
+        "{err}"
+    );
+    assert!(!err.contains("could not be routed"), "{err}");
+    assert!(after < 10.0, "stopped {after:.1} s after Ctrl-C");
+    let mut left: Vec<String> = std::fs::read_dir(dir)
+        .expect("dir listed")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["block.stl", "placement.toml"]);
+    println!("RedBot: Ctrl-C after 4 s, stopped {after:.2} s later, nothing written");
+}

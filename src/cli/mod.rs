@@ -91,6 +91,9 @@ const EXIT_FAILURE: u8 = 1;
 /// Exit code for usage errors (clap uses the same).
 const EXIT_USAGE: u8 = 2;
 
+/// Exit code of a job stopped by Ctrl-C (128 + SIGINT, as shells report it).
+pub(crate) const EXIT_INTERRUPTED: u8 = 130;
+
 /// A failure that decides the exit code.
 pub(crate) enum Failure {
     /// Bad arguments: exit 2.
@@ -242,6 +245,12 @@ pub fn run() -> ExitCode {
     };
     // Output still buffered (a last line without its end) fails here rather than unseen at exit.
     let result = result.and_then(|()| std::io::stdout().flush().map_err(Failure::stdout));
+    if conduit::interrupt::requested() {
+        if let Err(Failure::Work(e)) = &result {
+            errorln!("{e:#}");
+        }
+        return ExitCode::from(EXIT_INTERRUPTED);
+    }
     match result {
         Ok(()) | Err(Failure::StdoutClosed) => ExitCode::SUCCESS,
         Err(Failure::Usage(msg)) => {

@@ -294,6 +294,14 @@ pub(crate) fn refuse_unbuilt_circuit(
     output: &std::path::Path,
     consequence: &str,
 ) -> Result<(), Failure> {
+    if conduit::interrupt::requested() {
+        // The wires Ctrl-C left unrouted are no problem of the circuit's.
+        return Err(Failure::Work(anyhow::anyhow!(
+            "{}: {}",
+            output.display(),
+            conduit::interrupt::error()
+        )));
+    }
     let failures = r.failures();
     if failures.is_empty() {
         return Ok(());

@@ -276,7 +276,8 @@ impl<'a> Board<'a> {
 
     /// Whether the deadline has passed; if so, routing stops (and says so).
     fn past_deadline(&mut self) -> bool {
-        let past = self.deadline.is_some_and(|d| Instant::now() >= d);
+        let past =
+            self.deadline.is_some_and(|d| Instant::now() >= d) || crate::interrupt::requested();
         self.stopped |= past;
         past
     }

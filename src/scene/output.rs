@@ -214,7 +214,8 @@ fn temp_beside(target: &Path, given: &Path) -> Result<tempfile::NamedTempFile, O
 }
 
 /// Writes `path`: `fill` writes into a temporary file in the target's folder, which is renamed
-/// over the target only when `fill` succeeds. A symbolic link is followed (the link is kept); a
+/// over the target only when `fill` succeeds (and no stop was requested, see
+/// [`crate::interrupt`]). A symbolic link is followed (the link is kept); a
 /// device or FIFO is written directly. Errors name no temporary file; a missing folder is said
 /// as such.
 pub fn write_atomically<F, E>(path: &Path, fill: F) -> Result<(), E>
@@ -241,6 +242,9 @@ where
             })?;
             fill(tmp.as_file_mut())?;
             tmp.as_file_mut().sync_all().map_err(plain)?;
+            if crate::interrupt::requested() {
+                return Err(crate::interrupt::error().into());
+            }
             tmp.persist(&p).map_err(|e| plain(e.error))?;
             Ok(())
         }
@@ -381,6 +385,13 @@ impl OutputSet {
     /// Writes the set: devices and FIFOs first (a failure there leaves every regular target
     /// untouched), then every staged file renamed over its target.
     pub fn commit(self) -> Result<(), OutputError> {
+        if crate::interrupt::requested() {
+            let path = self
+                .staged
+                .first()
+                .map_or_else(PathBuf::new, |s| s.path.clone());
+            return Err(OutputError::io(&path, crate::interrupt::error()));
+        }
         let mut temps = Vec::with_capacity(self.staged.len());
         for s in self.staged {
             match s.how {
