@@ -688,9 +688,27 @@ impl Graph {
         if let Some(&v) = self.by_pos.get(&(layer, p.x, p.y)) {
             return Some(v);
         }
-        self.within(layer, p, radius)
-            .into_iter()
-            .min_by_key(|&v| (self.verts[v as usize].p.distance_squared(p), v))
+        let (x0, x1) = (
+            (p.x - radius).div_euclid(self.cell),
+            (p.x + radius).div_euclid(self.cell),
+        );
+        let (y0, y1) = (
+            (p.y - radius).div_euclid(self.cell),
+            (p.y + radius).div_euclid(self.cell),
+        );
+        let r2 = (radius as i128) * (radius as i128);
+        let mut best: Option<(i128, VertexId)> = None;
+        for cx in x0..=x1 {
+            for cy in y0..=y1 {
+                for &v in self.cells.get(&(layer, cx, cy)).into_iter().flatten() {
+                    let d = self.verts[v as usize].p.distance_squared(p);
+                    if d <= r2 && best.is_none_or(|b| (d, v) < b) {
+                        best = Some((d, v));
+                    }
+                }
+            }
+        }
+        best.map(|(_, v)| v)
     }
 
     /// The vertex at `p` on `layer`: an existing one within [`MERGE_NM`], else a new one, snapped
