@@ -35,7 +35,7 @@ use super::{
 };
 use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace};
 use crate::geom::{ExPolygon, Point2, Point3, intersection, scaled, union, unscaled};
-use std::cell::OnceCell;
+use std::cell::{OnceCell, RefCell};
 use std::collections::HashMap;
 use std::rc::Rc;
 use std::sync::Arc;
@@ -55,6 +55,34 @@ const RIP_UP_DEPTH: usize = 2;
 
 /// Extra margin of a wire's routing window beyond the farthest its route may go, mm.
 const WINDOW_MARGIN_MM: f64 = 2.0;
+
+/// `pads` grouped by layer and [`PAD_GROUP_MM`] cell of their centres, in a fixed order.
+fn group_pads(pads: &[PadObstacle]) -> Vec<PadGroup> {
+    let cell = scaled(PAD_GROUP_MM).max(1);
+    let mut groups: std::collections::BTreeMap<(usize, i64, i64), PadGroup> =
+        std::collections::BTreeMap::new();
+    for (k, p) in pads.iter().enumerate() {
+        let key = (
+            p.layer,
+            p.centre.x.div_euclid(cell),
+            p.centre.y.div_euclid(cell),
+        );
+        let reach = p.grown.bbox().unwrap_or(p.bbox);
+        let g = groups.entry(key).or_insert_with(|| PadGroup {
+            layer: p.layer,
+            pads: Vec::new(),
+            bbox: reach,
+        });
+        g.pads.push(k);
+        g.bbox = [
+            g.bbox[0].min(p.bbox[0]).min(reach[0]),
+            g.bbox[1].min(p.bbox[1]).min(reach[1]),
+            g.bbox[2].max(p.bbox[2]).max(reach[2]),
+            g.bbox[3].max(p.bbox[3]).max(reach[3]),
+        ];
+    }
+    groups.into_values().collect()
+}
 
 /// The box around the pads of `wire` grown by `grow` mm, as a region.
 fn window_box(wire: &Wire, grow: f64) -> Vec<ExPolygon> {
@@ -173,6 +201,21 @@ struct PadObstacle<'a> {
     bbox: BBox,
 }
 
+/// Side of the cells pads are grouped by (mm): the pads of one part's row fall into a few.
+const PAD_GROUP_MM: f64 = 5.0;
+
+/// Pads of one layer whose centres share a [`PAD_GROUP_MM`] cell: their grown holes, which
+/// overlap where the pads are close, are subtracted as one union per net that does not own
+/// them.
+#[derive(Debug, Clone)]
+struct PadGroup {
+    layer: usize,
+    /// Indices into the board's pads.
+    pads: Vec<usize>,
+    /// Box of the pads' keep-outs and grown holes.
+    bbox: BBox,
+}
+
 /// The state of routing: every wire's route so far and the channels on every layer.
 #[derive(Debug, Clone)]
 pub(crate) struct Board<'a> {
@@ -180,6 +223,11 @@ pub(crate) struct Board<'a> {
     wires: &'a [Wire],
     params: &'a RouteParams,
     pads: Vec<PadObstacle<'a>>,
+    /// The pads grouped by layer and place.
+    pad_groups: Vec<PadGroup>,
+    /// Per pad group and net, the union of the group's grown holes of the pads of other nets,
+    /// made when first needed.
+    pad_unions: RefCell<HashMap<(usize, String), Arc<Grown>>>,
     placed: Vec<Vec<Placed>>,
     /// Each layer's islands eroded by every deflation inset, made when first needed.
     eroded: Vec<OnceCell<Arc<Eroded>>>,
@@ -202,7 +250,7 @@ impl<'a> Board<'a> {
         params: &'a RouteParams,
         deadline: Option<Instant>,
     ) -> Self {
-        let pads = pads
+        let pads: Vec<PadObstacle> = pads
             .iter()
             .enumerate()
             .filter_map(|(index, p)| {
@@ -227,11 +275,14 @@ impl<'a> Board<'a> {
                 })
             })
             .collect();
+        let pad_groups = group_pads(&pads);
         Self {
             layers,
             wires,
             params,
             pads,
+            pad_groups,
+            pad_unions: RefCell::new(HashMap::new()),
             placed: vec![Vec::new(); layers.len()],
             eroded: vec![OnceCell::new(); layers.len()],
             routes: vec![None; wires.len()],
@@ -739,6 +790,28 @@ impl<'a> Board<'a> {
         window_box(wire, grow)
     }
 
+    /// The union of the grown holes of pad group `g`'s pads that are not of `net` (made on first
+    /// use); `None` if all are of `net`.
+    fn pad_union(&self, g: usize, net: &str) -> Option<Arc<Grown>> {
+        let key = (g, net.to_owned());
+        if let Some(known) = self.pad_unions.borrow().get(&key) {
+            return Some(Arc::clone(known));
+        }
+        let members: Vec<&Grown> = self.pad_groups[g]
+            .pads
+            .iter()
+            .map(|&k| &self.pads[k])
+            .filter(|p| p.net != Some(net))
+            .map(|p| p.grown.as_ref())
+            .collect();
+        if members.is_empty() {
+            return None;
+        }
+        let union = Arc::new(Grown::union(&members));
+        self.pad_unions.borrow_mut().insert(key, Arc::clone(&union));
+        Some(union)
+    }
+
     /// Layer `l`'s islands eroded by every deflation inset (made on first use).
     fn eroded(&self, l: usize) -> Arc<Eroded> {
         Arc::clone(
@@ -786,13 +859,18 @@ impl<'a> Board<'a> {
             // trace leaves it on the pad's layer, and another net's trace under or over that
             // start would touch it (as between any two traces of adjacent layers) and wall the
             // pad in.
-            for pad in self.pads.iter().filter(|p| {
-                p.layer.abs_diff(l) <= 1
-                    && p.net != Some(wire.net.as_str())
-                    && boxes_meet(&p.bbox, &frame)
-            }) {
-                holes.push(Arc::clone(&pad.grown));
-                blocked.extend(pad.keep_out.iter().cloned());
+            for (g, group) in self.pad_groups.iter().enumerate() {
+                if group.layer.abs_diff(l) > 1 || !boxes_meet(&group.bbox, &frame) {
+                    continue;
+                }
+                if let Some(union) = self.pad_union(g, &wire.net) {
+                    holes.push(union);
+                }
+                for pad in group.pads.iter().map(|&k| &self.pads[k]) {
+                    if pad.net != Some(wire.net.as_str()) && boxes_meet(&pad.bbox, &frame) {
+                        blocked.extend(pad.keep_out.iter().cloned());
+                    }
+                }
             }
         }
         LayerInput {

@@ -235,6 +235,42 @@ impl Grown {
         }
     }
 
+    /// The union of `parts`, inset by inset.
+    pub(crate) fn union(parts: &[&Grown]) -> Self {
+        let merge = |pick: &dyn Fn(&Grown) -> Option<&Boxed>| -> Boxed {
+            let all: Vec<ExPolygon> = parts
+                .iter()
+                .filter_map(|g| pick(g))
+                .flat_map(|b| b.0.iter().cloned())
+                .collect();
+            let region = if all.is_empty() { all } else { union(&all) };
+            let b = bbox(&region);
+            (region, b)
+        };
+        let insets = parts.iter().map(|g| g.areas.len()).max().unwrap_or(0);
+        Self {
+            areas: (0..insets).map(|k| merge(&|g| g.areas.get(k))).collect(),
+            squeeze: merge(&|g| Some(&g.squeeze)),
+        }
+    }
+
+    /// The box of the largest growth, if any.
+    pub(crate) fn bbox(&self) -> Option<[i64; 4]> {
+        self.areas
+            .iter()
+            .chain(std::iter::once(&self.squeeze))
+            .filter(|b| !b.0.is_empty())
+            .map(|b| b.1)
+            .reduce(|a, b| {
+                [
+                    a[0].min(b[0]),
+                    a[1].min(b[1]),
+                    a[2].max(b[2]),
+                    a[3].max(b[3]),
+                ]
+            })
+    }
+
     /// A polygonal hole, grown by offsetting with round corners.
     pub(crate) fn of_polygons(hole: &[ExPolygon], params: &RouteParams) -> Self {
         Self::new(params, |d| {
