@@ -28,7 +28,7 @@
 use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
 use super::congestion::History;
 use super::graph::{
-    Eroded, Grown, LayerGeometry, LayerInput, PENALTY_FACTOR, bbox, boxes_meet, prepare,
+    Eroded, Grown, LayerGeometry, LayerInput, PENALTY_FACTOR, bbox, box_union, boxes_meet, prepare,
 };
 use super::{
     Blockage, NearPad, PadCopper, Phase, RoundLog, RouteProgress, Strategy, Unrouted, wire_order,
@@ -67,42 +67,16 @@ fn group_pads(pads: &[PadObstacle]) -> Vec<PadGroup> {
             p.centre.x.div_euclid(cell),
             p.centre.y.div_euclid(cell),
         );
-        let reach = p.grown.bbox().unwrap_or(p.bbox);
+        let reach = p.grown.bbox().map_or(p.bbox, |b| box_union(b, p.bbox));
         let g = groups.entry(key).or_insert_with(|| PadGroup {
             layer: p.layer,
             pads: Vec::new(),
             bbox: reach,
         });
         g.pads.push(k);
-        g.bbox = [
-            g.bbox[0].min(p.bbox[0]).min(reach[0]),
-            g.bbox[1].min(p.bbox[1]).min(reach[1]),
-            g.bbox[2].max(p.bbox[2]).max(reach[2]),
-            g.bbox[3].max(p.bbox[3]).max(reach[3]),
-        ];
+        g.bbox = box_union(g.bbox, reach);
     }
     groups.into_values().collect()
-}
-
-/// The box around the pads of `wire` grown by `grow` mm, as a region.
-fn window_box(wire: &Wire, grow: f64) -> Vec<ExPolygon> {
-    let (x0, x1) = (
-        wire.from.x.min(wire.to.x) - grow,
-        wire.from.x.max(wire.to.x) + grow,
-    );
-    let (y0, y1) = (
-        wire.from.y.min(wire.to.y) - grow,
-        wire.from.y.max(wire.to.y) + grow,
-    );
-    vec![ExPolygon {
-        contour: crate::geom::Polygon::new(vec![
-            Point2::from_mm(x0, y0),
-            Point2::from_mm(x1, y0),
-            Point2::from_mm(x1, y1),
-            Point2::from_mm(x0, y1),
-        ]),
-        holes: Vec::new(),
-    }]
 }
 
 /// An axis-aligned box, scaled units: `[min x, min y, max x, max y]`.
@@ -705,25 +679,11 @@ impl<'a> Board<'a> {
             }
         };
         let window = self.window(wire, traces);
-        self.search_in(i, &start, traces, &window, &range, taps)
-    }
-
-    /// Runs the A* search of wire `i` from `start`, within `window`, on the layers of `range`.
-    fn search_in(
-        &mut self,
-        i: usize,
-        start: &Wire,
-        traces: &Traces,
-        window: &[ExPolygon],
-        range: &std::ops::RangeInclusive<usize>,
-        taps: Vec<Tap>,
-    ) -> WireRoute {
-        let wire = &self.wires[i];
         // In a negotiation round the layer's geometry (the material less other nets' pads) is
         // the same in every round, only the prices change: it is built once per layer, net and
         // window, and kept.
         let keep = matches!(traces, Traces::Priced { .. });
-        let frame = bbox(window);
+        let frame = bbox(&window);
         let keys: Vec<(usize, String, BBox)> = range
             .clone()
             .map(|l| (l, wire.net.clone(), frame))
@@ -735,7 +695,7 @@ impl<'a> Board<'a> {
         let inputs: Vec<LayerInput> = keys
             .iter()
             .zip(&known)
-            .map(|(k, g)| self.input(k.0, wire, traces, window, g.is_some()))
+            .map(|(k, g)| self.input(k.0, wire, traces, &window, g.is_some()))
             .collect();
         let layers = prepare(&inputs, known, self.params);
         if keep {
@@ -745,7 +705,7 @@ impl<'a> Board<'a> {
                     .or_insert_with(|| Rc::clone(&layer.geometry));
             }
         }
-        let mut search = Search::with_prepared(layers, self.layers, start, self.params, taps);
+        let mut search = Search::with_prepared(layers, self.layers, &start, self.params, taps);
         let mut steps = 0usize;
         while search.step() == SearchState::Running {
             steps += 1;
@@ -787,7 +747,23 @@ impl<'a> Board<'a> {
         if !grow.is_finite() {
             return Vec::new();
         }
-        window_box(wire, grow)
+        let (x0, x1) = (
+            wire.from.x.min(wire.to.x) - grow,
+            wire.from.x.max(wire.to.x) + grow,
+        );
+        let (y0, y1) = (
+            wire.from.y.min(wire.to.y) - grow,
+            wire.from.y.max(wire.to.y) + grow,
+        );
+        vec![ExPolygon {
+            contour: crate::geom::Polygon::new(vec![
+                Point2::from_mm(x0, y0),
+                Point2::from_mm(x1, y0),
+                Point2::from_mm(x1, y1),
+                Point2::from_mm(x0, y1),
+            ]),
+            holes: Vec::new(),
+        }]
     }
 
     /// The union of the grown holes of pad group `g`'s pads that are not of `net` (made on first

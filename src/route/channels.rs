@@ -31,7 +31,12 @@ const KEEP_OUT_MARGIN_MM: f64 = 0.005;
 
 /// Farthest a channel of half-width `half` reaches from its centreline, mm.
 pub(crate) fn circumscribed(half: f64) -> f64 {
-    half / (PI / JOINT_SIDES as f64).cos()
+    circumscribed_by(half, JOINT_SIDES)
+}
+
+/// Vertex radius of the regular `sides`-gon whose sides touch the circle of radius `radius`.
+fn circumscribed_by(radius: f64, sides: usize) -> f64 {
+    radius / (PI / sides as f64).cos()
 }
 
 /// Radius (mm) around another net's trace in which no trace centre may run: two channels, plus
@@ -69,7 +74,7 @@ pub(crate) fn disc(center: Point2, radius_mm: f64) -> Vec<ExPolygon> {
 
 /// A regular `sides`-gon around `center` circumscribing the circle of radius `radius_mm`.
 fn disc_of(center: Point2, radius_mm: f64, sides: usize) -> Vec<ExPolygon> {
-    let r = scaled(radius_mm / (PI / sides as f64).cos()) as f64;
+    let r = scaled(circumscribed_by(radius_mm, sides)) as f64;
     if r <= 0.0 {
         return Vec::new();
     }
@@ -133,7 +138,7 @@ pub(crate) fn polyline_channel(points: &[Point2], half_mm: f64) -> Vec<ExPolygon
 /// polygon within [`GROWN_BULGE_MM`] of the circle, at least [`JOINT_SIDES`].
 fn sides_for(radius_mm: f64) -> usize {
     let mut sides = JOINT_SIDES;
-    while sides < 256 && radius_mm * (1.0 / (PI / sides as f64).cos() - 1.0) > GROWN_BULGE_MM {
+    while sides < 256 && circumscribed_by(radius_mm, sides) - radius_mm > GROWN_BULGE_MM {
         sides *= 2;
     }
     sides

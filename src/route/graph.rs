@@ -261,14 +261,7 @@ impl Grown {
             .chain(std::iter::once(&self.squeeze))
             .filter(|b| !b.0.is_empty())
             .map(|b| b.1)
-            .reduce(|a, b| {
-                [
-                    a[0].min(b[0]),
-                    a[1].min(b[1]),
-                    a[2].max(b[2]),
-                    a[3].max(b[3]),
-                ]
-            })
+            .reduce(box_union)
     }
 
     /// A polygonal hole, grown by offsetting with round corners.
@@ -281,16 +274,36 @@ impl Grown {
 
 /// The box around every point of `regions` (an empty box for none), scaled units.
 pub(crate) fn bbox(regions: &[ExPolygon]) -> [i64; 4] {
+    points_box(regions.iter().flat_map(|ex| &ex.contour.points))
+}
+
+/// The box around `points` (an empty box for none), scaled units.
+fn points_box<'p>(points: impl IntoIterator<Item = &'p Point2>) -> [i64; 4] {
     let mut b = [i64::MAX, i64::MAX, i64::MIN, i64::MIN];
-    for p in regions.iter().flat_map(|ex| &ex.contour.points) {
+    for p in points {
         b = [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)];
     }
     b
 }
 
+/// The box around two boxes.
+pub(crate) fn box_union(a: [i64; 4], b: [i64; 4]) -> [i64; 4] {
+    [
+        a[0].min(b[0]),
+        a[1].min(b[1]),
+        a[2].max(b[2]),
+        a[3].max(b[3]),
+    ]
+}
+
 /// Whether two boxes share a point.
 pub(crate) fn boxes_meet(a: &[i64; 4], b: &[i64; 4]) -> bool {
     a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3]
+}
+
+/// Whether box `inner` lies within box `outer`.
+fn box_within(inner: &[i64; 4], outer: &[i64; 4]) -> bool {
+    outer[0] <= inner[0] && outer[1] <= inner[1] && inner[2] <= outer[2] && inner[3] <= outer[3]
 }
 
 /// `eroded` (the islands shrunk by `inset` mm) within `window` shrunk by the same inset, less
@@ -317,20 +330,13 @@ fn carve<'h>(
                 if !boxes_meet(&b, &frame) {
                     continue;
                 }
-                inside &=
-                    frame[0] <= b[0] && frame[1] <= b[1] && b[2] <= frame[2] && b[3] <= frame[3];
+                inside &= box_within(&b, &frame);
                 near.push(ExPolygon {
                     contour: ex.contour.clone(),
                     holes: ex
                         .holes
                         .iter()
-                        .filter(|h| {
-                            let hb = bbox(&[ExPolygon {
-                                contour: (*h).clone(),
-                                holes: Vec::new(),
-                            }]);
-                            boxes_meet(&hb, &frame)
-                        })
+                        .filter(|h| boxes_meet(&points_box(&h.points), &frame))
                         .cloned()
                         .collect(),
                 });
@@ -692,8 +698,14 @@ impl Graph {
         }
     }
 
-    /// Vertices of `layer` within `radius` of `p`, by increasing id.
-    pub(crate) fn within(&self, layer: usize, p: Point2, radius: i64) -> Vec<VertexId> {
+    /// Vertices of `layer` within `radius` of `p`, each with its squared distance to `p`, in no
+    /// particular order.
+    fn near(
+        &self,
+        layer: usize,
+        p: Point2,
+        radius: i64,
+    ) -> impl Iterator<Item = (VertexId, i128)> + '_ {
         let (x0, x1) = (
             (p.x - radius).div_euclid(self.cell),
             (p.x + radius).div_euclid(self.cell),
@@ -703,18 +715,16 @@ impl Graph {
             (p.y + radius).div_euclid(self.cell),
         );
         let r2 = (radius as i128) * (radius as i128);
-        let mut out = Vec::new();
-        for cx in x0..=x1 {
-            for cy in y0..=y1 {
-                if let Some(ids) = self.cells.get(&(layer, cx, cy)) {
-                    out.extend(
-                        ids.iter()
-                            .copied()
-                            .filter(|&v| self.verts[v as usize].p.distance_squared(p) <= r2),
-                    );
-                }
-            }
-        }
+        (x0..=x1)
+            .flat_map(move |cx| (y0..=y1).map(move |cy| (cx, cy)))
+            .flat_map(move |(cx, cy)| self.cells.get(&(layer, cx, cy)).into_iter().flatten())
+            .map(move |&v| (v, self.verts[v as usize].p.distance_squared(p)))
+            .filter(move |&(_, d)| d <= r2)
+    }
+
+    /// Vertices of `layer` within `radius` of `p`, by increasing id.
+    pub(crate) fn within(&self, layer: usize, p: Point2, radius: i64) -> Vec<VertexId> {
+        let mut out: Vec<VertexId> = self.near(layer, p, radius).map(|(v, _)| v).collect();
         out.sort_unstable();
         out
     }
@@ -724,27 +734,9 @@ impl Graph {
         if let Some(&v) = self.by_pos.get(&(layer, p.x, p.y)) {
             return Some(v);
         }
-        let (x0, x1) = (
-            (p.x - radius).div_euclid(self.cell),
-            (p.x + radius).div_euclid(self.cell),
-        );
-        let (y0, y1) = (
-            (p.y - radius).div_euclid(self.cell),
-            (p.y + radius).div_euclid(self.cell),
-        );
-        let r2 = (radius as i128) * (radius as i128);
-        let mut best: Option<(i128, VertexId)> = None;
-        for cx in x0..=x1 {
-            for cy in y0..=y1 {
-                for &v in self.cells.get(&(layer, cx, cy)).into_iter().flatten() {
-                    let d = self.verts[v as usize].p.distance_squared(p);
-                    if d <= r2 && best.is_none_or(|b| (d, v) < b) {
-                        best = Some((d, v));
-                    }
-                }
-            }
-        }
-        best.map(|(_, v)| v)
+        self.near(layer, p, radius)
+            .min_by_key(|&(v, d)| (d, v))
+            .map(|(v, _)| v)
     }
 
     /// The vertex at `p` on `layer`: an existing one within [`MERGE_NM`], else a new one, snapped

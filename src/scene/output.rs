@@ -215,9 +215,8 @@ fn temp_beside(target: &Path, given: &Path) -> Result<tempfile::NamedTempFile, O
 
 /// Writes `path`: `fill` writes into a temporary file in the target's folder, which is renamed
 /// over the target only when `fill` succeeds (and no stop was requested, see
-/// [`crate::interrupt`]). A symbolic link is followed (the link is kept); a
-/// device or FIFO is written directly. Errors name no temporary file; a missing folder is said
-/// as such.
+/// [`crate::interrupt`]). A symbolic link is followed (the link is kept); a device or FIFO is
+/// written directly. Errors name no temporary file; a missing folder is said as such.
 pub fn write_atomically<F, E>(path: &Path, fill: F) -> Result<(), E>
 where
     F: FnOnce(&mut fs::File) -> Result<(), E>,
