@@ -25,6 +25,7 @@ ln -s "$root/samples" samples
 mkdir out
 export NO_COLOR=1
 
+# GOLDEN_KEEP=DIR keeps a copy of every output in DIR (the browser tests view them).
 # run NAME ARGS...: runs conduit with ARGS in the work folder; stdout is kept as out/NAME.stdout.
 # A failing command fails the script (its stderr is shown).
 run() {
@@ -155,6 +156,17 @@ run info info --json samples/cube_20mm.stl samples/l_bracket.obj samples/circuit
 run check_demo check out/demo.gcode --json
 run check_bracket check out/bracket_two_tool.gcode -c samples/two_tool_printer.toml --json
 run config_defaults config --defaults
+
+# --- view: the 3D pages of a planar print and of the circuit demo with its model --------------
+run view_cube view out/cube.gcode -o out/view_cube.html
+run view_demo view out/demo.gcode --model samples/circuit_demo/block.stl \
+    --circuit samples/circuit_demo/led_coin.sch --placement samples/circuit_demo/placement.toml \
+    -o out/view_demo.html
+
+if [ -n "${GOLDEN_KEEP:-}" ]; then
+    mkdir -p "$GOLDEN_KEEP"
+    cp -r out/. "$GOLDEN_KEEP"/
+fi
 
 # Hash every output, reports without their wall-clock fields.
 cd out

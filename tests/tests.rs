@@ -5,6 +5,7 @@
 
 mod architecture;
 mod board_copper;
+mod browser;
 mod calibrate;
 mod clfff;
 mod cli;
@@ -37,3 +38,4 @@ mod route_limits;
 mod slice;
 mod support;
 mod three_de;
+mod view;

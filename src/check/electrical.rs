@@ -63,7 +63,9 @@ use serde::Serialize;
 
 use conduit_gcode::{Gcode, Move, moves};
 
-use crate::circuit::stage::{Electronics, ElectronicsError, ElectronicsParams, place_circuit};
+use crate::circuit::stage::{
+    Electronics, ElectronicsError, ElectronicsParams, PlacedCircuit, place_circuit,
+};
 use crate::circuit::{PlacedPart, PlacingMethod};
 use crate::geom::{
     BoundingBox, Cap, ExPolygon, FillRule, Join, Point2, Polyline, offset, polygons_to_expolygons,
@@ -263,6 +265,45 @@ struct Terminal {
     outline: Vec<P2>,
 }
 
+/// The objects' boxes and bed offsets `frame` gives: from the plastic of the file for
+/// [`Frame::Printed`].
+fn frame_boxes(
+    frame: &Frame,
+    plastic: &[&Move],
+    params: &ElectricalParams,
+) -> (Vec<BoundingBox>, Vec<[f64; 3]>) {
+    match frame {
+        Frame::Printed => (
+            vec![printed_bbox(plastic, params.plastic_width)],
+            vec![[0.0; 3]],
+        ),
+        Frame::Objects { bboxes, offsets } => (bboxes.clone(), offsets.clone()),
+    }
+}
+
+/// The circuit of `e` placed on the bed as [`check_electrical`] places it in `frame`: parts
+/// and rubberbands in bed coordinates.
+///
+/// # Errors
+/// The placement does not fit the circuit or the frame ([`ElectronicsError`]).
+pub fn place_in_frame(
+    gcode: &Gcode,
+    flavor: Flavor,
+    e: &Electronics,
+    frame: &Frame,
+    stage: &ElectronicsParams,
+    params: &ElectricalParams,
+) -> Result<PlacedCircuit, ElectronicsError> {
+    let replay = moves(gcode, flavor);
+    let plastic: Vec<&Move> = replay
+        .moves
+        .iter()
+        .filter(|m| is_plastic(m, params.conductive_tool))
+        .collect();
+    let (bboxes, offsets) = frame_boxes(frame, &plastic, params);
+    place_circuit(e, &bboxes, &offsets, stage)
+}
+
 /// Replays `gcode` (with the firmware of `flavor`) and checks the circuit of `e` in it, placed
 /// by `frame` (see the [module docs](self)).
 ///
@@ -283,13 +324,7 @@ pub fn check_electrical(
         .iter()
         .filter(|m| is_plastic(m, params.conductive_tool))
         .collect();
-    let (bboxes, offsets) = match frame {
-        Frame::Printed => (
-            vec![printed_bbox(&plastic, params.plastic_width)],
-            vec![[0.0; 3]],
-        ),
-        Frame::Objects { bboxes, offsets } => (bboxes.clone(), offsets.clone()),
-    };
+    let (bboxes, offsets) = frame_boxes(frame, &plastic, params);
     let placed = place_circuit(e, &bboxes, &offsets, stage)?;
     let nets: Vec<String> = e.circuit.nets.iter().map(|n| n.name.clone()).collect();
     let terminals = terminals(e, &placed.parts, &nets, &bboxes, &offsets)?;

@@ -310,9 +310,9 @@ impl Checker<'_> {
         if length > 0.0 {
             let dir_in = direction(path.first(), path.get(1));
             let dir_out = direction(path.iter().rev().nth(1), path.last());
-            self.planner.push(length, v, dir_in, dir_out);
+            self.planner.push(mv.line, length, v, dir_in, dir_out);
         } else {
-            self.planner.push(de.abs(), v, [0.0; 3], [0.0; 3]);
+            self.planner.push(mv.line, de.abs(), v, [0.0; 3], [0.0; 3]);
         }
 
         // XY moves that extrude, or that dispense paste between `;DISPENSE:` markers.
@@ -571,6 +571,7 @@ impl Checker<'_> {
             errors: self.errors,
             warnings: self.warnings,
             stats: self.stats,
+            move_times: std::mem::take(&mut self.planner.times),
         }
     }
 }

@@ -63,7 +63,7 @@ mod machine;
 mod time;
 
 pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves};
-pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical};
+pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical, place_in_frame};
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -347,6 +347,11 @@ pub struct CheckReport {
     pub warnings: usize,
     /// What the print consists of.
     pub stats: Stats,
+    /// The time estimate move by move: (G-code line, s) for each move that takes time, in file
+    /// order (dwells not included); sums to [`Stats::estimated_time_s`] less the dwells. Not
+    /// serialised: the 3D view's layer times come from it.
+    #[serde(skip)]
+    pub move_times: Vec<(usize, f64)>,
 }
 
 impl CheckReport {

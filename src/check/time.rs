@@ -8,6 +8,8 @@
 /// One planned move.
 #[derive(Debug, Clone, Copy)]
 struct Block {
+    /// G-code line of the move, for [`Planner::times`].
+    line: usize,
     length: f64,
     speed: f64,
     dir_in: [f64; 3],
@@ -24,6 +26,8 @@ pub(super) struct Planner {
     entry: Option<f64>,
     /// Time of the moves committed so far, s.
     pub total: f64,
+    /// Planned time of each committed move: (G-code line, s), in file order.
+    pub times: Vec<(usize, f64)>,
 }
 
 /// Moves queued before the older half is committed. As in firmware, the queue is planned as if
@@ -42,16 +46,25 @@ impl Planner {
             blocks: Vec::new(),
             entry: None,
             total: 0.0,
+            times: Vec::new(),
         }
     }
 
-    /// Queues a move of `length` mm at `speed` mm/s, leaving in unit direction `dir_in` and
-    /// arriving in `dir_out` (zero vectors for moves of E only).
-    pub(super) fn push(&mut self, length: f64, speed: f64, dir_in: [f64; 3], dir_out: [f64; 3]) {
+    /// Queues the move on G-code line `line` of `length` mm at `speed` mm/s, leaving in unit
+    /// direction `dir_in` and arriving in `dir_out` (zero vectors for moves of E only).
+    pub(super) fn push(
+        &mut self,
+        line: usize,
+        length: f64,
+        speed: f64,
+        dir_in: [f64; 3],
+        dir_out: [f64; 3],
+    ) {
         if !(length > 0.0 && speed > 0.0) {
             return;
         }
         self.blocks.push(Block {
+            line,
             length,
             speed,
             dir_in,
@@ -76,6 +89,9 @@ impl Planner {
         let a = self.accel;
         let b = &self.blocks;
         if !(a > 0.0 && a.is_finite()) {
+            for k in b {
+                self.times.push((k.line, k.length / k.speed));
+            }
             self.total += b.iter().map(|k| k.length / k.speed).sum::<f64>();
             self.blocks.clear();
             return;
@@ -96,7 +112,9 @@ impl Planner {
         let commit = commit.min(n);
         let mut t = 0.0;
         for (i, k) in b.iter().enumerate().take(commit) {
-            t += block_time(k.length, k.speed, j[i], j[i + 1], a);
+            let dt = block_time(k.length, k.speed, j[i], j[i + 1], a);
+            self.times.push((k.line, dt));
+            t += dt;
         }
         self.total += t;
         self.blocks.drain(..commit);
@@ -159,7 +177,7 @@ mod tests {
     fn plan(jerk: f64, moves: &[(f64, [f64; 3])]) -> f64 {
         let mut p = Planner::new(1000.0, jerk);
         for &(len, d) in moves {
-            p.push(len, 100.0, d, d);
+            p.push(0, len, 100.0, d, d);
         }
         p.flush();
         p.total

@@ -13,6 +13,7 @@
 //! [`Circuit`] the pipeline uses.
 
 pub mod board_layout;
+pub mod events;
 pub mod fit;
 mod placed;
 mod placement;

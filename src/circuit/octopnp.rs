@@ -93,6 +93,137 @@ fn package_outline(part: &PlacedPart) -> Vec<[f64; 2]> {
         .collect()
 }
 
+/// One `<part>` of an OctoPNP block, as read back from a G-code file.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct OctoPart {
+    /// The number its `M361 P<id>` event carries.
+    pub id: u32,
+    /// Part name.
+    pub name: String,
+    /// Body height, mm.
+    pub height: f64,
+    /// Outline corners in the package frame (mm, unrotated).
+    pub shape: Vec<[f64; 2]>,
+    /// Package origin on the seating plane, bed coordinates, mm.
+    pub destination: [f64; 3],
+    /// Rotation about +z, degrees.
+    pub orientation: f64,
+}
+
+impl OctoPart {
+    /// The outline in bed coordinates: rotated by the orientation about the destination.
+    pub fn outline_on_bed(&self) -> Vec<[f64; 2]> {
+        let (s, c) = self.orientation.to_radians().sin_cos();
+        let [dx, dy, _] = self.destination;
+        self.shape
+            .iter()
+            .map(|&[x, y]| [dx + x * c - y * s, dy + x * s + y * c])
+            .collect()
+    }
+}
+
+/// Reads the OctoPNP block of a G-code file: the parts, in file order. `lines` are the raw
+/// lines of the file; the text OctoPNP would collect ([`collected`]) is parsed as XML.
+///
+/// # Errors
+/// The collected text is not well-formed XML, or a part lacks its name or destination: the
+/// message says which.
+pub fn read_block<'a>(lines: impl IntoIterator<Item = &'a [u8]>) -> Result<Vec<OctoPart>, String> {
+    use quick_xml::events::Event;
+    let mut text = Vec::new();
+    for line in lines {
+        if let Some(c) = collected(line) {
+            text.extend_from_slice(c);
+            text.push(b'\n');
+        }
+    }
+    let mut parts = Vec::new();
+    if text.is_empty() {
+        return Ok(parts);
+    }
+    let text = String::from_utf8_lossy(&text);
+    let mut reader = quick_xml::Reader::from_str(&text);
+    let mut current: Option<(OctoPart, bool)> = None;
+    let attr = |e: &quick_xml::events::BytesStart, key: &str| -> Option<String> {
+        e.attributes()
+            .flatten()
+            .find(|a| a.key.local_name().as_ref() == key)
+            .and_then(|a| {
+                a.normalized_value(quick_xml::XmlVersion::Implicit1_0)
+                    .ok()
+                    .map(|v| v.into_owned())
+            })
+    };
+    let attr_f64 = |e: &quick_xml::events::BytesStart, key: &str| -> Option<f64> {
+        attr(e, key)?
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+    };
+    loop {
+        let event = reader
+            .read_event()
+            .map_err(|e| format!("OctoPNP block: {e}"))?;
+        match event {
+            Event::Eof => break,
+            Event::Start(e) | Event::Empty(e) => match e.local_name().as_ref() {
+                "part" => {
+                    let name = attr(&e, "name").ok_or("OctoPNP block: a <part> has no name")?;
+                    let id = attr_f64(&e, "id").unwrap_or(0.0) as u32;
+                    current = Some((
+                        OctoPart {
+                            id,
+                            name,
+                            height: 0.0,
+                            shape: Vec::new(),
+                            destination: [0.0; 3],
+                            orientation: 0.0,
+                        },
+                        false,
+                    ));
+                }
+                "size" => {
+                    if let Some((p, _)) = &mut current {
+                        p.height = attr_f64(&e, "height").unwrap_or(0.0);
+                    }
+                }
+                "point" => {
+                    if let (Some((p, _)), Some(x), Some(y)) =
+                        (&mut current, attr_f64(&e, "x"), attr_f64(&e, "y"))
+                    {
+                        p.shape.push([x, y]);
+                    }
+                }
+                "destination" => {
+                    if let Some((p, has)) = &mut current {
+                        let xyz = ["x", "y", "z"].map(|k| attr_f64(&e, k));
+                        if let [Some(x), Some(y), Some(z)] = xyz {
+                            p.destination = [x, y, z];
+                            p.orientation = attr_f64(&e, "orientation").unwrap_or(0.0);
+                            *has = true;
+                        }
+                    }
+                }
+                _ => {}
+            },
+            Event::End(e) if e.local_name().as_ref() == "part" => {
+                if let Some((p, has)) = current.take() {
+                    if !has {
+                        return Err(format!(
+                            "OctoPNP block: part {} has no complete <destination>",
+                            p.name
+                        ));
+                    }
+                    parts.push(p);
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(parts)
+}
+
 /// What OctoPNP collects from one line of a G-code file: the text from its first `<` to its
 /// last `>`, or `None` when the line has no `>` after a `<`.
 ///

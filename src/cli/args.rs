@@ -52,6 +52,10 @@ pub enum Command {
     /// Place a circuit in models and route its nets, without G-code: a report and one SVG per
     /// layer (material, cavities, channels, traces).
     Route(RouteArgs),
+    /// Show G-code in 3D in the browser: one self-contained HTML page with a layer slider,
+    /// colours by feature, tool, speed, width or layer time, and the model and circuit when
+    /// given.
+    View(ViewArgs),
     /// Write a placement (TOML to edit) for a circuit in a model: an EAGLE board's layout moved
     /// into the object (`--from-brd`), or the parts packed inside its solid (`--auto`); every
     /// part is checked against the solid and the others.
@@ -599,6 +603,37 @@ pub struct ConvertArgs {
     pub ascii: bool,
     /// Print one JSON document on stdout summarising what was done (outputs written, counts,
     /// key figures) instead of the text summary on stderr.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `conduit view`.
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// G-code files to show (conduit's or another slicer's); the page switches between them.
+    #[arg(value_name = "FILE", required = true)]
+    pub files: Vec<PathBuf>,
+    /// The HTML page to write (default: the first file with `.html` for its extension).
+    #[arg(short = 'o', long = "output", value_name = "view.html")]
+    pub output: Option<PathBuf>,
+    /// Open the page in the desktop's browser when it is written.
+    #[arg(long)]
+    pub open: bool,
+    /// Show the model too (STL, 3MF, OBJ, OFF, PLY), placed on the bed as `conduit slice`
+    /// places it with the same config.
+    #[arg(long, value_name = "MODEL")]
+    pub model: Option<PathBuf>,
+    /// Show the circuit (EAGLE `.sch`/`.brd`): parts as labelled boxes, cavities, and the
+    /// wires the first file's traces do not connect.
+    #[arg(long, value_name = "FILE", requires = "placement")]
+    pub circuit: Option<PathBuf>,
+    /// Where the circuit's parts sit (`.toml` or `.3de`), as given to slice.
+    #[arg(long, value_name = "FILE", requires = "circuit")]
+    pub placement: Option<PathBuf>,
+    /// Printer settings (firmware flavour, bed, tools, the time model) as for `conduit check`.
+    #[command(flatten)]
+    pub config: ConfigSource,
+    /// Print one JSON document on stdout summarising what was done.
     #[arg(long)]
     pub json: bool,
 }

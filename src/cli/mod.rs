@@ -80,6 +80,7 @@ mod progress;
 mod place;
 mod route;
 mod slice;
+mod view;
 
 use clap::Parser;
 use std::io::Write;
@@ -234,6 +235,7 @@ pub fn run() -> ExitCode {
         args::Command::Config(a) => config::run(a),
         args::Command::Preview(a) => preview::run(a),
         args::Command::Route(a) => route::run(a),
+        args::Command::View(a) => view::run(a),
         args::Command::Place(a) => place::run(a),
         args::Command::Postprocess(a) => postprocess::run(a),
         args::Command::Conform(a) => conform::run(a),

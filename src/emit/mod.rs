@@ -12,3 +12,4 @@ pub mod gcode;
 pub mod preview;
 pub mod robot;
 pub mod route_svg;
+pub mod view;

@@ -1,0 +1,154 @@
+//! `conduit view`: G-code files (with the model and circuit when given) drawn in 3D in one
+//! self-contained HTML page.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::{Failure, args::ViewArgs, config::resolve};
+use anyhow::Context;
+use conduit::check::{ElectricalParams, Frame, check, check_electrical, moves, place_in_frame};
+use conduit::circuit::{Circuit, Electronics, Placement};
+use conduit::emit::preview::layered_by_markers;
+use conduit::emit::view::{ViewData, circuit_view, job_view, mesh_views, page};
+use conduit::pipeline::{model_bboxes, place_on_bed_with_offsets};
+use conduit::scene::{LoadOptions, load_scene, write_atomically};
+
+pub(crate) fn run(args: ViewArgs) -> Result<(), Failure> {
+    let cfg = resolve(&args.config)?;
+    let params = cfg.check_params();
+    let mut jobs = Vec::with_capacity(args.files.len());
+    let mut first_gcode = None;
+    for file in &args.files {
+        let bytes = super::check::read_gcode_file(file)?;
+        let gcode = conduit_gcode::parse(&bytes).with_context(|| format!("{}", file.display()))?;
+        let replay = layered_by_markers(&gcode, moves(&gcode, params.flavor));
+        if replay.moves.iter().all(|m| !m.has_xy) {
+            return Err(anyhow::anyhow!(
+                "{}: no move with X or Y: nothing to show",
+                file.display()
+            )
+            .into());
+        }
+        let report = check(&gcode, &params);
+        let name = file.file_name().map_or_else(
+            || file.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        jobs.push(job_view(&name, &gcode, &replay, &report));
+        if first_gcode.is_none() {
+            first_gcode = Some(gcode);
+        }
+    }
+
+    let mut models = Vec::new();
+    let mut frame = Frame::Printed;
+    if let Some(model) = &args.model {
+        let (scene, _) = load_scene(model, &LoadOptions::default())
+            .with_context(|| format!("{}", model.display()))?;
+        let (meshes, offsets) = place_on_bed_with_offsets(&scene, &cfg);
+        models = mesh_views(&meshes);
+        frame = Frame::Objects {
+            bboxes: model_bboxes(&scene),
+            offsets,
+        };
+    }
+
+    let mut circuit = None;
+    if let (Some(c), Some(p), Some(gcode)) = (&args.circuit, &args.placement, &first_gcode) {
+        let e = Electronics {
+            circuit: Circuit::load(c).map_err(anyhow::Error::from)?,
+            placement: Placement::load(p).map_err(anyhow::Error::from)?,
+        };
+        let stage = cfg.electronics_params();
+        let eparams = ElectricalParams::of(&stage);
+        let placed = place_in_frame(gcode, params.flavor, &e, &frame, &stage, &eparams)
+            .with_context(|| format!("{}", p.display()))?;
+        let report = check_electrical(gcode, params.flavor, &e, &frame, &stage, &eparams)
+            .with_context(|| format!("{}", p.display()))?;
+        circuit = Some(circuit_view(&placed, Some(&report), stage.cavity_offset));
+    }
+
+    let data = ViewData {
+        jobs,
+        models,
+        circuit,
+    };
+    let title = format!(
+        "{} — conduit view",
+        data.jobs
+            .iter()
+            .map(|j| j.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let html = page(&data, &title).context("serialising the view")?;
+    let out = output_path(&args);
+    write_atomically(&out, |f| f.write_all(html.as_bytes()))
+        .with_context(|| format!("{}", out.display()))?;
+
+    let layers: usize = data.jobs.iter().map(|j| j.layers.len()).sum();
+    let segments: usize = data
+        .jobs
+        .iter()
+        .flat_map(|j| &j.groups)
+        .filter(|g| !g.travel)
+        .map(|g| g.segments)
+        .sum();
+    if args.json {
+        super::print_json(&serde_json::json!({
+            "output": out.display().to_string(),
+            "bytes": html.len(),
+            "jobs": data.jobs.iter().map(|j| serde_json::json!({
+                "name": j.name,
+                "layers": j.layers.len(),
+                "extrusion_segments": j.groups.iter().filter(|g| !g.travel).map(|g| g.segments).sum::<usize>(),
+                "travel_segments": j.groups.iter().filter(|g| g.travel).map(|g| g.segments).sum::<usize>(),
+                "events": j.events.len(),
+            })).collect::<Vec<_>>(),
+            "model_triangles": data.models.iter().map(|m| m.triangles).sum::<usize>(),
+            "unrouted_wires": data.circuit.as_ref().map(|c| c.unrouted.len()),
+        }))?;
+    } else {
+        infoln!(
+            "{}: {} file(s), {layers} layers, {segments} extrusion segments, {:.1} MB",
+            out.display(),
+            data.jobs.len(),
+            html.len() as f64 / 1e6
+        );
+    }
+    if args.open {
+        open_in_browser(&out);
+    }
+    Ok(())
+}
+
+/// `-o`, else the first file with `.html` for its extension.
+fn output_path(args: &ViewArgs) -> PathBuf {
+    args.output.clone().unwrap_or_else(|| {
+        args.files
+            .first()
+            .map_or_else(|| PathBuf::from("view.html"), |f| f.with_extension("html"))
+    })
+}
+
+/// Opens `page` with the desktop's opener; says so when there is none (the page is written).
+fn open_in_browser(page: &Path) {
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(target_os = "windows") {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    if let Err(e) = std::process::Command::new(opener)
+        .arg(page)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+    {
+        warnln!(
+            "{}: written, but could not open it with {opener} ({e}); open it in a browser",
+            page.display()
+        );
+    }
+}
