@@ -245,6 +245,61 @@ impl Browser {
     }
 }
 
+impl Browser {
+    /// Drags with the left mouse button from `from` to `to` (CSS px in the viewport) in `steps`
+    /// moves, as a person would.
+    pub fn drag(&self, from: (f64, f64), to: (f64, f64), steps: u32) {
+        use fantoccini::actions::{InputSource, MOUSE_BUTTON_LEFT, MouseActions, PointerAction};
+        let step = Some(Duration::from_millis(20));
+        let mut mouse = MouseActions::new("mouse".into()).then(PointerAction::MoveTo {
+            duration: step,
+            x: from.0.round(),
+            y: from.1.round(),
+        });
+        mouse = mouse.then(PointerAction::Down {
+            button: MOUSE_BUTTON_LEFT,
+        });
+        for k in 1..=steps {
+            let f = f64::from(k) / f64::from(steps);
+            mouse = mouse.then(PointerAction::MoveTo {
+                duration: step,
+                x: (from.0 + (to.0 - from.0) * f).round(),
+                y: (from.1 + (to.1 - from.1) * f).round(),
+            });
+        }
+        mouse = mouse.then(PointerAction::Up {
+            button: MOUSE_BUTTON_LEFT,
+        });
+        self.rt
+            .block_on(self.client().perform_actions(mouse))
+            .expect("the drag runs");
+    }
+
+    /// Replaces the value of the input matching `css` with `text` and leaves it (a change
+    /// event).
+    pub fn retype(&self, css: &str, text: &str) {
+        let el = self.find(css);
+        self.rt
+            .block_on(async {
+                el.clear().await?;
+                el.send_keys(&format!("{text}\u{E004}")).await
+            })
+            .unwrap_or_else(|e| panic!("cannot type into {css}: {e}"));
+    }
+
+    /// Polls `condition` (a script returning a boolean) until it holds or `timeout` passes.
+    pub fn wait_for(&self, condition: &str, timeout: Duration) -> bool {
+        let start = Instant::now();
+        while start.elapsed() < timeout {
+            if self.eval(condition) == Value::Bool(true) {
+                return true;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        false
+    }
+}
+
 impl Drop for Browser {
     fn drop(&mut self) {
         if let Some(client) = self.client.take() {

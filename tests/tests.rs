@@ -36,6 +36,7 @@ mod roundtrip;
 mod route_help;
 mod route_limits;
 mod slice;
+mod studio;
 mod support;
 mod three_de;
 mod view;

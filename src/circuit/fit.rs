@@ -178,6 +178,8 @@ pub struct FitFindings {
     pub problems: Vec<String>,
     /// Cavities closer than `wall_clearance` to the object's surface or to another cavity.
     pub notes: Vec<String>,
+    /// Names of the parts a problem is about, in the order of `parts`.
+    pub flagged: Vec<String>,
 }
 
 /// Checks a layout: everything [`part_problems`] checks, then per part its body (the
@@ -203,12 +205,23 @@ pub fn placement_problems(
     found
         .problems
         .extend(collided.iter().map(|(_, _, m)| m.clone()));
+    let mut flagged = vec![false; parts.len()];
+    for (i, seat) in seated.iter().enumerate() {
+        flagged[i] |= seat.is_some();
+    }
+    for (i, j, _) in &collided {
+        flagged[*i] = true;
+        flagged[*j] = true;
+    }
     for (part, seat) in parts.iter().zip(&seated) {
         if seat.is_some() {
             continue;
         }
         if let Some(problem) = body_problem(part, islands, zs, last) {
             found.problems.push(problem);
+            if let Some(i) = parts.iter().position(|p| std::ptr::eq(*p, *part)) {
+                flagged[i] = true;
+            }
             continue;
         }
         let layer = seat_layer(zs, part.position.z);
@@ -238,6 +251,8 @@ pub fn placement_problems(
             }
             let gap = ring_gap(&a.footprint, &b.footprint);
             if gap < params.cavity_offset - 1e-6 {
+                flagged[i] = true;
+                flagged[j] = true;
                 found.problems.push(format!(
                     "parts {} and {} are {gap:.2} mm apart: each reaches into the other's \
                      cavity (route.cavity_offset {:.2} mm)",
@@ -255,6 +270,12 @@ pub fn placement_problems(
             }
         }
     }
+    found.flagged = parts
+        .iter()
+        .zip(&flagged)
+        .filter(|(_, f)| **f)
+        .map(|(p, _)| p.name.clone())
+        .collect();
     found
 }
 

@@ -56,6 +56,9 @@ pub enum Command {
     /// colours by feature, tool, speed, width or layer time, and the model and circuit when
     /// given.
     View(ViewArgs),
+    /// Place a circuit's parts by hand in a 3D view in the browser, served on 127.0.0.1: drag
+    /// parts, see the checks and rubberbands follow, route, save the placement TOML.
+    Studio(StudioArgs),
     /// Write a placement (TOML to edit) for a circuit in a model: an EAGLE board's layout moved
     /// into the object (`--from-brd`), or the parts packed inside its solid (`--auto`); every
     /// part is checked against the solid and the others.
@@ -636,4 +639,33 @@ pub struct ViewArgs {
     /// Print one JSON document on stdout summarising what was done.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Arguments of `conduit studio`.
+#[derive(Debug, Args)]
+pub struct StudioArgs {
+    /// The model the parts go into (STL, 3MF, OBJ, OFF, PLY).
+    #[arg(value_name = "MODEL")]
+    pub model: PathBuf,
+    /// The circuit (EAGLE `.sch` or `.brd`).
+    #[arg(long, value_name = "FILE")]
+    pub circuit: PathBuf,
+    /// The placement to start from (`.toml` or `.3de`); without it the parts are laid out as
+    /// the `.brd` has them, else packed inside the solid (`conduit place`), else put in a row
+    /// beside the model.
+    #[arg(long, value_name = "FILE")]
+    pub placement: Option<PathBuf>,
+    /// Where *Save* writes the placement TOML (default: `--placement` when it is a `.toml`,
+    /// else the model's name with `.placement.toml`).
+    #[arg(long, value_name = "FILE")]
+    pub save: Option<PathBuf>,
+    /// The port on 127.0.0.1 (0: any free port). The address is printed.
+    #[arg(long, default_value_t = 0)]
+    pub port: u16,
+    /// Open the page in the desktop's browser.
+    #[arg(long)]
+    pub open: bool,
+    /// Printer and routing settings, as for `conduit slice`.
+    #[command(flatten)]
+    pub config: ConfigSource,
 }

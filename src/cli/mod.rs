@@ -80,6 +80,7 @@ mod progress;
 mod place;
 mod route;
 mod slice;
+mod studio;
 mod view;
 
 use clap::Parser;
@@ -236,6 +237,7 @@ pub fn run() -> ExitCode {
         args::Command::Preview(a) => preview::run(a),
         args::Command::Route(a) => route::run(a),
         args::Command::View(a) => view::run(a),
+        args::Command::Studio(a) => studio::run(a),
         args::Command::Place(a) => place::run(a),
         args::Command::Postprocess(a) => postprocess::run(a),
         args::Command::Conform(a) => conform::run(a),

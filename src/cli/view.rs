@@ -72,6 +72,7 @@ pub(crate) fn run(args: ViewArgs) -> Result<(), Failure> {
         jobs,
         models,
         circuit,
+        studio: None,
     };
     let title = format!(
         "{} — conduit view",
@@ -132,7 +133,12 @@ fn output_path(args: &ViewArgs) -> PathBuf {
 }
 
 /// Opens `page` with the desktop's opener; says so when there is none (the page is written).
-fn open_in_browser(page: &Path) {
+pub(crate) fn open_in_browser(page: &Path) {
+    open_url(&page.to_string_lossy());
+}
+
+/// Opens `target` (a path or URL) with the desktop's opener; warns when there is none.
+pub(crate) fn open_url(target: &str) {
     let opener = if cfg!(target_os = "macos") {
         "open"
     } else if cfg!(target_os = "windows") {
@@ -141,14 +147,11 @@ fn open_in_browser(page: &Path) {
         "xdg-open"
     };
     if let Err(e) = std::process::Command::new(opener)
-        .arg(page)
+        .arg(target)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
         .spawn()
     {
-        warnln!(
-            "{}: written, but could not open it with {opener} ({e}); open it in a browser",
-            page.display()
-        );
+        warnln!("could not open {target} with {opener} ({e}); open it in a browser");
     }
 }

@@ -138,22 +138,27 @@ pub enum PlaceError {
 }
 
 /// The model as the checks see it: object 0 on the bed, sliced.
-struct Solid {
+#[derive(Debug, Clone)]
+pub struct Solid {
     /// Model-space bounding box of object 0.
     bbox: BoundingBox,
     /// Object 0's move from model to bed coordinates.
     offset: [f64; 3],
     /// Model-space bounding boxes of every object (the placement frame).
-    bboxes: Vec<BoundingBox>,
+    pub bboxes: Vec<BoundingBox>,
     /// Every object's move to the bed.
-    offsets: Vec<[f64; 3]>,
+    pub offsets: Vec<[f64; 3]>,
     /// Object 0's layers (bed coordinates) and their islands.
     zs: Vec<LayerZ>,
     islands: Vec<Vec<ExPolygon>>,
 }
 
 impl Solid {
-    fn of(scene: &Scene, cfg: &Config) -> Result<Self, PipelineError> {
+    /// Object 0 of `scene` put on the bed and sliced as `conduit slice` would with `cfg`.
+    ///
+    /// # Errors
+    /// An empty scene, or layer settings the slicer refuses.
+    pub fn of(scene: &Scene, cfg: &Config) -> Result<Self, PipelineError> {
         if scene.triangle_count() == 0 {
             return Err(PipelineError::EmptyScene);
         }
@@ -459,15 +464,27 @@ fn describe_part(part: &crate::circuit::Part, side: &str) -> String {
     s
 }
 
-/// Reads `toml` back, places it and checks it against the solid.
-fn check(
+/// A placement placed on the bed and checked against the solid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Checked {
+    /// The parts and wires on the bed.
+    pub placed: crate::circuit::stage::PlacedCircuit,
+    /// What the checks found (see [`placement_problems`]).
+    pub findings: crate::circuit::fit::FitFindings,
+}
+
+/// Places `placement` of `circuit` on the bed and checks its parts in object 0 against the
+/// solid: what `conduit place` checks before it writes, and what the studio shows as a part
+/// is moved.
+///
+/// # Errors
+/// The placement does not fit the circuit or the scene's objects.
+pub fn check_placement(
     solid: &Solid,
     cfg: &Config,
     circuit: &Circuit,
-    toml: String,
-    planes: Vec<f64>,
-) -> Result<PlaceOutcome, PlaceError> {
-    let placement = Placement::from_toml(&toml)?;
+    placement: &Placement,
+) -> Result<Checked, PlaceError> {
     let electronics = Electronics {
         circuit: circuit.clone(),
         placement: placement.clone(),
@@ -484,7 +501,7 @@ fn check(
     })?;
     let mine: Vec<&crate::circuit::PlacedPart> =
         placed.parts.iter().filter(|p| p.object == 0).collect();
-    let found = placement_problems(
+    let findings = placement_problems(
         &mine,
         &solid.islands,
         &solid.zs,
@@ -493,6 +510,24 @@ fn check(
             wall_clearance: cfg.route.wall_clearance,
         },
     );
+    Ok(Checked { placed, findings })
+}
+
+/// Reads `toml` back, places it and checks it against the solid.
+fn check(
+    solid: &Solid,
+    cfg: &Config,
+    circuit: &Circuit,
+    toml: String,
+    planes: Vec<f64>,
+) -> Result<PlaceOutcome, PlaceError> {
+    let placement = Placement::from_toml(&toml)?;
+    let Checked {
+        placed,
+        findings: found,
+    } = check_placement(solid, cfg, circuit, &placement)?;
+    let mine: Vec<&crate::circuit::PlacedPart> =
+        placed.parts.iter().filter(|p| p.object == 0).collect();
     let closest_pads = closest_foreign_pads(&mine);
     let span =
         crate::circuit::board_layout::bounds(mine.iter().flat_map(|p| p.footprint.points_mm()))

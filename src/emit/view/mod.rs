@@ -10,12 +10,14 @@
 //! - [`overlay`]: the model's meshes and the circuit (parts, pads, cavities, unrouted wires).
 //! - [`encode`]: the compact number streams the page carries (µm varint deltas in base64).
 //! - [`page`]: the HTML with three.js and the page's modules (`web/`) inlined.
+//! - [`studio`]: the placement the studio edits, its poses and the parts the checks flag.
 
 pub mod encode;
 pub mod job;
 pub mod overlay;
 pub mod page;
+pub mod studio;
 
 pub use job::{JobView, job_view};
 pub use overlay::{CircuitView, MeshView, circuit_view, mesh_views};
-pub use page::{ViewData, page};
+pub use page::{Entry, ViewData, page, page_for};

@@ -29,6 +29,17 @@ const MODULES: &[(&str, &str)] = &[
     ("conduit/panel", include_str!("web/panel.js")),
     ("conduit/main", include_str!("web/main.js")),
 ];
+/// The studio's own module, only in studio pages.
+const STUDIO_MODULE: (&str, &str) = ("conduit/studio", include_str!("web/studio.js"));
+
+/// Which page: the view of files, or the studio served by `conduit studio`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Entry {
+    /// `conduit view`: a page that opens from disk.
+    View,
+    /// `conduit studio`: the view plus part editing against the local server.
+    Studio,
+}
 const TEMPLATE: &str = include_str!("web/index.html");
 const STYLE: &str = include_str!("web/style.css");
 
@@ -41,6 +52,9 @@ pub struct ViewData {
     pub models: Vec<MeshView>,
     /// The circuit, when given.
     pub circuit: Option<CircuitView>,
+    /// The studio's editable placement (studio pages only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub studio: Option<super::studio::StudioView>,
 }
 
 /// The page of `data`, titled `title`, as HTML text.
@@ -48,9 +62,19 @@ pub struct ViewData {
 /// # Errors
 /// The data cannot be serialised (a non-finite number where JSON has none).
 pub fn page(data: &ViewData, title: &str) -> Result<String, serde_json::Error> {
+    page_for(data, title, Entry::View)
+}
+
+/// The page of `data` for `entry`.
+///
+/// # Errors
+/// As [`page`].
+pub fn page_for(data: &ViewData, title: &str, entry: Entry) -> Result<String, serde_json::Error> {
     let json = serde_json::to_string(data)?.replace('<', "\\u003c");
+    let studio = (entry == Entry::Studio).then_some(&STUDIO_MODULE);
     let imports: serde_json::Map<String, serde_json::Value> = MODULES
         .iter()
+        .chain(studio)
         .map(|(name, source)| {
             let source = if *name == "three" {
                 source.replace("from\"./three.core.min.js\"", "from\"three/core\"")
@@ -78,7 +102,10 @@ pub fn page(data: &ViewData, title: &str) -> Result<String, serde_json::Error> {
             "STYLE" => out.push_str(STYLE),
             "IMPORTMAP" => out.push_str(&import_map),
             "DATA" => out.push_str(&json),
-            "ENTRY" => out.push_str("main"),
+            "ENTRY" => out.push_str(match entry {
+                Entry::View => "main",
+                Entry::Studio => "studio",
+            }),
             other => {
                 out.push_str("{{");
                 out.push_str(other);
@@ -109,6 +136,7 @@ mod tests {
             jobs: Vec::new(),
             models: Vec::new(),
             circuit: None,
+            studio: None,
         };
         let html = page(&data, "a <b> & c").expect("serialises");
         assert!(html.contains("<title>a &lt;b&gt; &amp; c</title>"));

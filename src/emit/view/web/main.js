@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/OrbitControls';
 import { buildToolpaths, colourBy, ramp, rgb, setLayerRange, toolColour } from 'conduit/toolpaths';
-import { buildMarkers, buildMeshes, buildPart, buildRubberbands, centre, setMarkerRange } from 'conduit/overlays';
+import { FLAGGED_COLOUR, buildMarkers, buildMeshes, buildPart, buildRubberbands, centre, setMarkerRange } from 'conduit/overlays';
 import { el, featureLegend, figures, list, rampLegend, section } from 'conduit/panel';
 
 const data = JSON.parse(document.getElementById('conduit-data').textContent);
@@ -32,11 +32,45 @@ scene.add(models);
 const circuitParts = new THREE.Group();
 scene.add(circuitParts);
 let rubberbands = null;
-if (data.circuit) {
-  for (const p of data.circuit.parts) circuitParts.add(buildPart(p));
-  rubberbands = buildRubberbands(data.circuit.unrouted);
+
+/** Draws `circuit` (parts, cavities, unrouted wires), replacing what was drawn; `flagged` names
+ * parts to draw in the warning colour. */
+function setCircuit(circuit, flagged = []) {
+  data.circuit = circuit;
+  for (const c of [...circuitParts.children]) {
+    circuitParts.remove(c);
+    c.traverse((o) => o.geometry && o.geometry.dispose());
+  }
+  if (rubberbands) {
+    scene.remove(rubberbands);
+    rubberbands.geometry.dispose();
+    rubberbands = null;
+  }
+  if (!circuit) return;
+  for (const p of circuit.parts) {
+    const part = buildPart(p);
+    if (flagged.includes(p.name)) {
+      const box = part.getObjectByName('box');
+      if (box) box.material.color.setHex(FLAGGED_COLOUR);
+      part.userData.flagged = true;
+    }
+    circuitParts.add(part);
+  }
+  rubberbands = buildRubberbands(circuit.unrouted);
   scene.add(rubberbands);
+  if (current) applyToggles();
 }
+
+/** A job with nothing in it: the studio before its first route. */
+function emptyJob() {
+  const none = { count: 0, positions: '', layers: '' };
+  return {
+    name: 'not routed yet', layers: [{ z: 0, time: 0 }], groups: [], retractions: none, zhops: none,
+    events: [], parts: [], warnings: [], bounds: [0, 0, 0, 0, 0, 0],
+    figures: { lines: 0, layers: 0, time_s: 0, tools: [], print_mm: 0, travel_mm: 0, retractions: 0, tool_changes: 0, errors: 0, warnings: 0 },
+  };
+}
+if (!data.jobs.length) data.jobs.push(emptyJob());
 
 const state = {
   job: 0,
@@ -47,14 +81,28 @@ const state = {
   toggles: { travel: false, retractions: false, zhops: false, model: true, parts: true, grid: true },
 };
 let current = null; // { job, groups, layerCount, retractions, zhops, parts, grid, bounds }
+setCircuit(data.circuit, data.studio ? data.studio.flagged : []);
 
 function boundsOf(job) {
   let b = job.bounds;
-  if (b.every((v) => v === 0) && data.models && data.models.length) b = [-10, -10, 0, 10, 10, 10];
+  if (b.every((v) => v === 0)) {
+    const box = new THREE.Box3().setFromObject(models);
+    b = box.isEmpty() ? [-10, -10, 0, 10, 10, 10] : [...box.min.toArray(), ...box.max.toArray()];
+  }
   return b;
 }
 
-function loadJob(index) {
+/** Shows `job` (replacing the empty one, else added), e.g. after the studio's Route. */
+function addJob(job) {
+  if (data.jobs.length === 1 && data.jobs[0].groups.length === 0) data.jobs[0] = job;
+  else data.jobs.push(job);
+  loadJob(data.jobs.length - 1, false);
+}
+
+/** Extra panel sections (the studio's), kept when the panel is rebuilt. */
+const extraSections = [];
+
+function loadJob(index, reframe = true) {
   if (current) {
     for (const g of current.groups) scene.remove(g.lines);
     scene.remove(current.retractions.points, current.zhops.points, current.parts, current.grid);
@@ -63,7 +111,7 @@ function loadJob(index) {
   const { groups, layerCount } = buildToolpaths(job);
   for (const g of groups) scene.add(g.lines);
   // A file that never extrudes (a CNC program) is all travel: show it.
-  if (groups.every((g) => g.info.travel)) state.toggles.travel = true;
+  if (groups.length && groups.every((g) => g.info.travel)) state.toggles.travel = true;
   const retractions = buildMarkers(job.retractions, layerCount, 0xff40ff, 5);
   const zhops = buildMarkers(job.zhops, layerCount, 0x40ffff, 5);
   scene.add(retractions.points, zhops.points);
@@ -93,7 +141,8 @@ function loadJob(index) {
   applyToggles();
   applyColour();
   applyLayers();
-  setView('iso');
+  if (reframe) setView('iso');
+  else render();
 }
 
 function outlineOnBed(p) {
@@ -110,7 +159,8 @@ function buildPanel() {
   const job = current.job;
   const n = current.layerCount;
   panel.replaceChildren();
-  panel.append(el('h1', {}, 'conduit view'));
+  panel.append(el('h1', {}, data.studio ? 'conduit studio' : 'conduit view'));
+  for (const s of extraSections) panel.append(s);
   if (data.jobs.length > 1) {
     const select = el('select', { id: 'job', onchange: (e) => loadJob(Number(e.target.value)) },
       ...data.jobs.map((j, i) => el('option', { value: i, selected: i === state.job }, j.name)));
@@ -200,7 +250,7 @@ function applyLayers() {
     ? `layer ${state.to + 1} of ${layerCount} · z ${z(state.to)} mm`
     : `layers ${state.from + 1}–${state.to + 1} of ${layerCount} · z ${z(state.from)}–${z(state.to)} mm`;
   // Parts show from the layer they are placed in.
-  const top = job.layers[state.to] ? job.layers[state.to].z : Infinity;
+  const top = job.groups.length && job.layers[state.to] ? job.layers[state.to].z : Infinity;
   for (const p of [...circuitParts.children, ...current.parts.children]) {
     p.visible = state.toggles.parts && p.userData.part.z <= top + 1e-6;
   }
@@ -295,7 +345,7 @@ function updateLabels() {
     const [sx, sy, sz] = project([x, y, part.z + part.height]);
     if (sz > 1) continue;
     const rect = view.getBoundingClientRect();
-    items.push(el('div', { class: 'label', 'data-part': part.name, style: `left:${sx - rect.left}px;top:${sy - rect.top}px` }, part.name));
+    items.push(el('div', { class: p.userData.flagged ? 'label flagged' : 'label', 'data-part': part.name, style: `left:${sx - rect.left}px;top:${sy - rect.top}px` }, part.name));
   }
   labels.replaceChildren(...items);
 }
@@ -321,8 +371,57 @@ window.addEventListener('keydown', (e) => {
   }
 });
 
+/** The layers (0-based) holding segments of `role`: [first, last], or null. */
+function layersOf(role) {
+  let first = Infinity;
+  let last = -1;
+  for (const g of current.groups) {
+    if (g.info.role !== role || g.segments === 0) continue;
+    first = Math.min(first, g.segLayer[0]);
+    last = Math.max(last, g.segLayer[g.segments - 1]);
+  }
+  return last < 0 ? null : [first, last];
+}
+
+/**
+ * Settings from the address's fragment, so a view can be shared as a link:
+ * `#layers=1-20&view=top&colour=speed&show=travel,retractions&hide=model`.
+ */
+function applyHash() {
+  const params = new URLSearchParams(window.location.hash.slice(1));
+  const layers = params.get('layers');
+  if (layers) {
+    const [a, b] = layers.split('-').map(Number);
+    if (Number.isFinite(a)) {
+      state.from = a - 1;
+      state.to = Number.isFinite(b) ? b - 1 : a - 1;
+      state.single = !Number.isFinite(b);
+      ui.single.checked = state.single;
+    }
+  }
+  for (const [key, on] of [['show', true], ['hide', false]]) {
+    for (const t of (params.get(key) || '').split(',')) {
+      if (t in state.toggles) {
+        state.toggles[t] = on;
+        const box = document.getElementById(`show-${t}`);
+        if (box) box.checked = on;
+      }
+    }
+  }
+  const colour = params.get('colour');
+  if (['feature', 'tool', 'speed', 'width', 'time'].includes(colour)) {
+    state.mode = colour;
+    ui.mode.value = colour;
+  }
+  applyToggles();
+  applyColour();
+  const preset = params.get('view');
+  if (['top', 'front', 'iso'].includes(preset)) setView(preset);
+}
+
 resize();
 loadJob(0);
+applyHash();
 
 window.conduitView = {
   /** True once the first frame is drawn. */
@@ -351,5 +450,15 @@ window.conduitView = {
   render,
   scene,
   camera,
+  controls,
+  canvas: renderer.domElement,
+  circuitParts,
+  data,
+  setCircuit,
+  addJob,
+  layersOf,
+  /** Adds a panel section shown above the others. */
+  addSection: (section) => { extraSections.push(section); buildPanel(); applyColour(); applyLayers(); },
 };
-document.body.dataset.ready = 'true';
+// The studio's module says when it is ready.
+if (!data.studio) document.body.dataset.ready = 'true';
