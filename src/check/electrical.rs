@@ -63,6 +63,7 @@ use serde::Serialize;
 
 use conduit_gcode::{Gcode, Move, moves};
 
+use crate::circuit::events::part_event;
 use crate::circuit::stage::{
     Electronics, ElectronicsError, ElectronicsParams, PlacedCircuit, place_circuit,
 };
@@ -987,18 +988,13 @@ fn event_problems(
     let mut seen: Vec<&str> = Vec::new();
     let mut problems = Vec::new();
     for (index, line) in gcode.lines.iter().enumerate() {
-        let Some(text) = line.comment_text() else {
+        let Some(event) = line
+            .comment_text()
+            .and_then(|text| part_event(text, index + 1))
+        else {
             continue;
         };
-        let (rest, auto) = if let Some(r) = text.strip_prefix("PICK_AND_PLACE PART=") {
-            (r, true)
-        } else if let Some(r) = text.strip_prefix("MANUAL_INSERT PART=") {
-            (r, false)
-        } else {
-            continue;
-        };
-        let mut words = rest.split_whitespace();
-        let Some(name) = words.next() else { continue };
+        let name = event.part.as_str();
         let Some(part) = parts.iter().find(|p| p.name.replace(' ', "_") == name) else {
             continue;
         };
@@ -1036,15 +1032,9 @@ fn event_problems(
                 ),
             });
         }
-        if auto {
-            let mut at = [None; 3];
-            for w in words {
-                for (k, axis) in ["X=", "Y=", "Z="].iter().enumerate() {
-                    if let Some(v) = w.strip_prefix(axis) {
-                        at[k] = v.parse::<f64>().ok();
-                    }
-                }
-            }
+        if event.machine {
+            // A coordinate missing or not a number is off.
+            let at = event.at;
             let want = [part.position.x, part.position.y, part.position.z];
             let off = at
                 .iter()

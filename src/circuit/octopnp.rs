@@ -261,3 +261,36 @@ fn attr(s: &str) -> String {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BLOCK: &str = ";<object name=\"block\">\n;<part id=\"2\" name=\"R1\">\n\
+        ;  <position box=\"1\"/>\n;  <size height=\"0.6\"/>\n;  <shape>\n\
+        ;    <point x=\"-1.45\" y=\"-0.65\"/>\n;    <point x=\"1.45\" y=\"-0.65\"/>\n\
+        ;    <point x=\"1.45\" y=\"0.65\"/>\n;  </shape>\n\
+        ;  <destination x=\"137\" y=\"118\" z=\"4\" orientation=\"90\"/>\n;</part>\n;</object>\n";
+
+    #[test]
+    fn the_block_reads_back_with_its_outline_on_the_bed() {
+        let lines: Vec<&[u8]> = BLOCK.lines().map(str::as_bytes).collect();
+        let parts = read_block(lines.iter().copied()).expect("well-formed");
+        assert_eq!(parts.len(), 1);
+        let r1 = &parts[0];
+        assert_eq!((r1.id, r1.name.as_str(), r1.height), (2, "R1", 0.6));
+        assert_eq!(r1.destination, [137.0, 118.0, 4.0]);
+        assert_eq!(r1.shape.len(), 3);
+        // A quarter turn: package (1.45, -0.65) lands at (137 + 0.65, 118 + 1.45).
+        let on_bed = r1.outline_on_bed();
+        assert!((on_bed[1][0] - 137.65).abs() < 1e-9 && (on_bed[1][1] - 119.45).abs() < 1e-9);
+        assert_eq!(read_block(std::iter::empty()), Ok(Vec::new()));
+        let broken = [&b";<object><part name=\"X\"></object>"[..]];
+        assert!(read_block(broken.iter().copied()).is_err());
+        let no_destination = [&b";<object><part name=\"X\"></part></object>"[..]];
+        assert!(
+            read_block(no_destination.iter().copied())
+                .is_err_and(|e| e.contains("part X has no complete <destination>"))
+        );
+    }
+}

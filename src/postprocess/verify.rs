@@ -496,11 +496,8 @@ impl Problems {
 /// PART=<name>`, or the comment of a part that is not placed by the machine.
 fn event_part(line: &Line) -> Option<String> {
     let text = line.comment_text()?;
-    if let Some(rest) = text
-        .strip_prefix("PICK_AND_PLACE PART=")
-        .or_else(|| text.strip_prefix("MANUAL_INSERT PART="))
-    {
-        return rest.split_whitespace().next().map(str::to_owned);
+    if let Some(event) = crate::circuit::events::part_event(text, line.number) {
+        return Some(event.part);
     }
     text.strip_prefix("part ")
         .and_then(|rest| rest.strip_suffix(" is not placed by the machine (method none)"))

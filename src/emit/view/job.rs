@@ -445,3 +445,56 @@ fn events(gcode: &Gcode, moves: &Moves) -> Vec<EventView> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::{CheckParams, check};
+    use conduit_gcode::{Firmware, moves};
+
+    /// Two layers of a 10 mm square (perimeter, then T1 infill on layer 2), a retraction, a
+    /// z-hop that comes back down, and a pick-and-place marker before layer 2.
+    const GCODE: &str = "G28\nG90\nM82\nG92 E0\nG1 Z0.2 F600\nG1 X10 Y10 F6000\n\
+        ;TYPE:Perimeter\n;WIDTH:0.45\nG1 X20 Y10 E1 F1200\nG1 X20 Y20 E2\nG1 X10 Y20 E3\n\
+        G1 E2 F2400\nG1 Z0.6 F600\nG1 X10 Y10 F6000\nG1 Z0.4 F600\n\
+        ;PICK_AND_PLACE PART=R1 X=15 Y=15 Z=0.4 ROTATION=90\nT1\nG1 E3 F2400\n\
+        ;TYPE:Internal infill\nG1 X20 Y20 E4 F1200\n";
+
+    #[test]
+    fn groups_layers_markers_and_events_follow_the_file() {
+        let g = conduit_gcode::parse(GCODE.as_bytes()).expect("parses");
+        let m = moves(&g, Firmware::Marlin);
+        let report = check(&g, &CheckParams::default());
+        let job = job_view("t.gcode", &g, &m, &report);
+        assert_eq!(
+            job.layers.iter().map(|l| l.z).collect::<Vec<_>>(),
+            [0.2, 0.4]
+        );
+        let groups: Vec<(&str, usize, bool, usize)> = job
+            .groups
+            .iter()
+            .map(|g| (g.role.as_str(), g.tool, g.travel, g.segments))
+            .collect();
+        assert_eq!(
+            groups,
+            [
+                ("Perimeter", 0, false, 3),
+                ("Internal infill", 1, false, 1),
+                ("Travel", 0, true, 2)
+            ]
+        );
+        assert_eq!(job.groups[0].colour, "#e6b800");
+        // Layer times add up to the estimate (no dwells here).
+        let sum: f64 = job.layers.iter().map(|l| l.time).sum();
+        assert!((sum - report.stats.estimated_time_s).abs() < 1e-9, "{sum}");
+        assert!(job.layers.iter().all(|l| l.time > 0.0));
+        assert_eq!((job.retractions.count, job.zhops.count), (1, 1));
+        assert_eq!(job.events.len(), 1);
+        assert_eq!(
+            (job.events[0].event.part.as_str(), job.events[0].layer),
+            ("R1", 1)
+        );
+        assert_eq!(job.bounds, [10.0, 10.0, 0.2, 20.0, 20.0, 0.4]);
+        assert_eq!(job.figures.layers, 2);
+    }
+}
