@@ -269,6 +269,7 @@ fn studio_drag_saves_the_move_flags_a_part_outside_and_routes() {
             .is_some_and(|s| s.starts_with("routed: 4 of 4 wires connected")),
         "{status}"
     );
-    browser.keep_screenshot("studio_routed");
+    let shot = browser.keep_screenshot("studio_routed");
+    crate::view::write_picture("studio.png", || shot.encode_png().expect("encodes"));
     assert_eq!(browser.console_errors(), Vec::<String>::new());
 }

@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::Duration;
 
 use conduit::check::{Firmware, moves};
 use conduit::emit::preview::layered_by_markers;
@@ -247,4 +248,127 @@ fn every_corpus_gcode_and_sample_output_loads_without_console_errors() {
         counts[0], counts[1], counts[2]
     );
     assert!(counts[0] >= 15, "{counts:?}");
+}
+
+/// Writes `shot` as a guide picture when `CONDUIT_WRITE_PICTURES=1`.
+pub fn write_picture(name: &str, png_of: impl FnOnce() -> Vec<u8>) {
+    if std::env::var_os("CONDUIT_WRITE_PICTURES").is_some_and(|v| v == "1") {
+        let path = root().join("docs/src/images").join(name);
+        std::fs::create_dir_all(path.parent().expect("a folder")).expect("the folder is made");
+        std::fs::write(&path, png_of()).expect("the picture is written");
+        println!("picture: {}", path.display());
+    }
+}
+
+#[test]
+fn demo_view_shows_the_traces_in_their_own_colour_and_the_parts_labelled() {
+    let Some(browser) = Browser::start() else {
+        return;
+    };
+    let dir = temp_dir();
+    let gcode = dir.path().join("demo.gcode");
+    let html = dir.path().join("demo.html");
+    let (g, h) = (gcode.to_string_lossy(), html.to_string_lossy());
+    let s = |p: &str| sample(p).to_string_lossy().into_owned();
+    let (block, sch, placement) = (
+        s("circuit_demo/block.stl"),
+        s("circuit_demo/led_coin.sch"),
+        s("circuit_demo/placement.toml"),
+    );
+    view(&[
+        "slice",
+        &block,
+        "--circuit",
+        &sch,
+        "--placement",
+        &placement,
+        "-o",
+        &g,
+    ]);
+    view(&[
+        "view",
+        &g,
+        "--model",
+        &block,
+        "--circuit",
+        &sch,
+        "--placement",
+        &placement,
+        "-o",
+        &h,
+    ]);
+    // The layers up to the traces, from the top: the traces lie in the open channels.
+    let abs = std::fs::canonicalize(&html).expect("the page exists");
+    browser
+        .open(
+            &format!(
+                "file://{}#layers=1-21&view=top&hide=grid,model",
+                abs.display()
+            ),
+            Duration::from_secs(60),
+        )
+        .expect("the page loads");
+    assert_eq!(browser.console_errors(), Vec::<String>::new());
+    let state = browser.eval("return window.conduitView.state();");
+    assert_eq!(
+        (state["from"].clone(), state["to"].clone()),
+        (0.into(), 20.into())
+    );
+    let mut labels: Vec<String> = state["labels"]
+        .as_array()
+        .expect("labels")
+        .iter()
+        .map(|v| v.as_str().unwrap_or_default().to_owned())
+        .collect();
+    labels.sort();
+    assert_eq!(labels, ["BAT1", "LED1", "R1"], "the parts are labelled");
+    // The trace colour is used by no other group, and it is on screen.
+    let colours = browser.eval(
+        "return JSON.parse(document.getElementById('conduit-data').textContent).jobs[0].groups \
+         .map((g) => [g.role, g.colour]);",
+    );
+    let colours: Vec<(String, String)> = colours
+        .as_array()
+        .expect("groups")
+        .iter()
+        .map(|v| {
+            (
+                v[0].as_str().unwrap_or_default().to_owned(),
+                v[1].as_str().unwrap_or_default().to_owned(),
+            )
+        })
+        .collect();
+    let trace = colours
+        .iter()
+        .find(|(r, _)| r == "Conductive trace")
+        .map(|(_, c)| c.clone())
+        .expect("the demo has traces");
+    assert!(
+        colours
+            .iter()
+            .filter(|(r, _)| r != "Conductive trace")
+            .all(|(_, c)| *c != trace),
+        "{colours:?}"
+    );
+    let hex = |c: &str| {
+        let n = u32::from_str_radix(c.trim_start_matches('#'), 16).expect("hex");
+        [(n >> 16) as u8, (n >> 8) as u8, n as u8]
+    };
+    let want = hex(&trace);
+    let img = browser.keep_screenshot("view_demo_traces");
+    let near = (0..img.height())
+        .flat_map(|y| (0..img.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let c = rgb(&img, f64::from(x), f64::from(y));
+            (0..3).all(|k| (i32::from(c[k]) - i32::from(want[k])).abs() <= 24)
+        })
+        .count();
+    assert!(near >= 50, "{near} pixels of the trace colour {trace}");
+    assert_eq!(browser.console_errors(), Vec::<String>::new());
+    // The guide's picture: the same view from the front-left.
+    browser.eval("window.conduitView.setView('iso'); return 0;");
+    write_picture("view.png", || {
+        let img = browser.keep_screenshot("view_demo_iso");
+        img.encode_png().expect("encodes")
+    });
 }

@@ -223,7 +223,8 @@ view.addSection(el('section', { id: 'studio' },
     el('button', { id: 'route', onclick: route }, 'Route'),
     el('button', { id: 'save', onclick: save }, 'Save')),
   status,
-  el('div', { class: 'hint' }, `Drag a part on its plane, or type its pose (${studio.origin} frame). Save writes ${studio.save_path}.`),
+  el('div', { class: 'hint', title: studio.save_path },
+    `Drag a part on its plane, or type its pose (${studio.origin} frame). Save writes ${studio.save_path.split(/[\\/]/).pop()}.`),
   rows,
   problems));
 
