@@ -930,6 +930,17 @@ mod tests {
             pixel(&img, 12, 76 + 4 + 12 + 4),
             tint(role_colour("Perimeter", 1), 1)
         );
+        // A role name of any length keeps the sheet's size in bounds: labels are cut.
+        let long = format!(
+            "G1 Z0.2\nG1 X0 Y0\n;TYPE:{}\nG1 X10 Y0 E1\n",
+            "x".repeat(100_000)
+        );
+        let g = conduit_gcode::parse(long.as_bytes()).expect("parses");
+        let lp = Preview::from_moves(&moves(&g, Firmware::Marlin)).expect("extrudes");
+        let sheet = png::contact_sheet(&lp, 1, 64).expect("the sheet renders");
+        let sheet = tiny_skia::Pixmap::decode_png(&sheet).expect("decodes");
+        // A margin, the swatch, 40 characters.
+        assert_eq!(sheet.width(), 8 + 24 + 40 * 8 + 8);
         for row in [0, 12] {
             let text = (32..216)
                 .flat_map(|x| (80 + row..88 + row).map(move |y| (x, y)))

@@ -52,23 +52,121 @@ pub fn grid(tiles: usize) -> (usize, usize) {
     (cols, tiles.div_ceil(cols).max(1))
 }
 
-/// The contact sheet's legend: (colour, label, outline only) entries.
-fn legend(preview: &Preview) -> Vec<([u8; 3], String, bool)> {
-    let mut entries: Vec<([u8; 3], String, bool)> = preview
-        .styles
-        .iter()
-        .map(|&(role, tool)| {
-            (
-                preview.colour(role, tool),
-                preview.style_label(role, tool),
-                false,
-            )
-        })
-        .collect();
-    if preview.has_placed_parts() {
-        entries.push((PART_COLOUR, "Part outline".to_owned(), true));
+/// Longest legend label on the contact sheet, characters (longer role names are cut).
+const LEGEND_LABEL_CHARS: usize = 40;
+
+/// The contact sheet's legend: entries of a swatch (2 glyphs wide, a frame only for the part
+/// outline), a glyph's gap and the label, in columns as wide as the longest entry, as many as
+/// fit the sheet.
+struct Legend {
+    /// (colour, label, outline only).
+    entries: Vec<([u8; 3], String, bool)>,
+    /// Font scale.
+    fs: u32,
+    /// Width of one entry with the gap after it, pixels.
+    entry_w: u32,
+}
+
+impl Legend {
+    fn new(preview: &Preview, fs: u32) -> Self {
+        let mut entries: Vec<([u8; 3], String, bool)> = preview
+            .styles
+            .iter()
+            .map(|&(role, tool)| {
+                let mut label = preview.style_label(role, tool);
+                if label.chars().count() > LEGEND_LABEL_CHARS {
+                    label = label
+                        .chars()
+                        .take(LEGEND_LABEL_CHARS - 3)
+                        .collect::<String>()
+                        + "...";
+                }
+                (preview.colour(role, tool), label, false)
+            })
+            .collect();
+        if preview.has_placed_parts() {
+            entries.push((PART_COLOUR, "Part outline".to_owned(), true));
+        }
+        let entry_w = entries
+            .iter()
+            .map(|(_, label, _)| 4 * GLYPH * fs + text::width(label, fs))
+            .max()
+            .unwrap_or(0);
+        Self {
+            entries,
+            fs,
+            entry_w,
+        }
     }
-    entries
+
+    /// The margin around the legend, pixels.
+    fn gap(&self) -> u64 {
+        u64::from(GLYPH * self.fs)
+    }
+
+    /// The narrowest sheet that holds one column, pixels.
+    fn min_width(&self) -> u64 {
+        u64::from(self.entry_w) + self.gap()
+    }
+
+    /// Columns on a sheet `width` pixels wide.
+    fn columns(&self, width: u64) -> u64 {
+        (width.saturating_sub(self.gap()) / u64::from(self.entry_w.max(1))).max(1)
+    }
+
+    /// Height of a legend row, pixels.
+    fn row_h(&self) -> u64 {
+        u64::from((GLYPH + 4) * self.fs)
+    }
+
+    /// Height on a sheet `width` pixels wide, pixels.
+    fn height(&self, width: u64) -> u64 {
+        (self.entries.len() as u64).div_ceil(self.columns(width)) * self.row_h() + self.gap()
+    }
+
+    /// Draws the legend on white from `top` across a sheet `width` pixels wide.
+    fn draw(&self, pixmap: &mut Pixmap, top: u64, width: u64) {
+        let mut paint = Paint::default();
+        paint.set_color(colour(BACKGROUND));
+        let area = Rect::from_xywh(0.0, top as f32, width as f32, self.height(width) as f32);
+        if let Some(r) = area {
+            pixmap.fill_rect(r, &paint, Transform::identity(), None);
+        }
+        let (fs, columns) = (self.fs, self.columns(width));
+        for (k, (rgb, label, outline)) in self.entries.iter().enumerate() {
+            let k = k as u64;
+            let x = self.gap() + (k % columns) * u64::from(self.entry_w);
+            let y = top + self.gap() / 2 + (k / columns) * self.row_h();
+            let swatch = Rect::from_xywh(
+                x as f32,
+                y as f32,
+                (2 * GLYPH * fs) as f32,
+                (GLYPH * fs) as f32,
+            );
+            if let Some(r) = swatch {
+                paint.set_color(colour(*rgb));
+                if *outline {
+                    let stroke = Stroke {
+                        width: fs as f32,
+                        ..Stroke::default()
+                    };
+                    let path = PathBuilder::from_rect(r);
+                    pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+                } else {
+                    pixmap.fill_rect(r, &paint, Transform::identity(), None);
+                }
+            }
+            text::draw(
+                pixmap,
+                (x + u64::from(3 * GLYPH * fs)) as i64,
+                y as i64,
+                fs,
+                width as i64,
+                TEXT,
+                label,
+            );
+        }
+    }
 }
 
 /// The PNG bytes of the contact sheet of layers 0, `every`, 2·`every`… with `tile` × `tile`
@@ -79,21 +177,9 @@ pub fn contact_sheet(preview: &Preview, every: usize, tile: u32) -> Result<Vec<u
     let (cols, rows) = grid(shown.len());
     let fs = font_scale(tile);
     let cell_h = tile + label_strip(tile);
-    // Legend: entries of a swatch (2 glyphs wide), a gap, the label, in columns as wide as the
-    // longest entry, as many as fit the grid's width (the sheet widens for one when none does).
-    let entries = legend(preview);
-    let gap = GLYPH * fs;
-    let entry_w = entries
-        .iter()
-        .map(|(_, label, _)| 3 * GLYPH * fs + text::width(label, fs) + gap)
-        .max()
-        .unwrap_or(0);
-    let grid_w = cols as u64 * u64::from(tile);
-    let width = grid_w.max(u64::from(entry_w) + u64::from(gap));
-    let legend_cols = ((width - u64::from(gap)) / u64::from(entry_w.max(1))).max(1);
-    let row_h = u64::from((GLYPH + 4) * fs);
-    let legend_h = (entries.len() as u64).div_ceil(legend_cols) * row_h + u64::from(gap);
-    let height = rows as u64 * u64::from(cell_h) + legend_h;
+    let legend = Legend::new(preview, fs);
+    let width = (cols as u64 * u64::from(tile)).max(legend.min_width());
+    let height = rows as u64 * u64::from(cell_h) + legend.height(width);
     let too_large = PreviewError::SheetTooLarge { width, height };
     // Keep the sheet below 2^28 pixels (1 GiB of RGBA).
     if width * height > 1 << 28 {
@@ -162,45 +248,7 @@ pub fn contact_sheet(preview: &Preview, every: usize, tile: u32) -> Result<Vec<u
             &tile_label(index, preview.layers[index].z),
         );
     }
-    // The legend, under the grid on the frame colour's sheet: on white.
-    let top = rows as u64 * u64::from(cell_h);
-    paint.set_color(colour(BACKGROUND));
-    if let Some(r) = Rect::from_xywh(0.0, top as f32, width as f32, legend_h as f32) {
-        pixmap.fill_rect(r, &paint, Transform::identity(), None);
-    }
-    for (k, (rgb, label, outline)) in entries.iter().enumerate() {
-        let k = k as u64;
-        let x = u64::from(gap) + (k % legend_cols) * u64::from(entry_w);
-        let y = top + u64::from(gap) / 2 + (k / legend_cols) * row_h;
-        let swatch = Rect::from_xywh(
-            x as f32,
-            y as f32,
-            (2 * GLYPH * fs) as f32,
-            (GLYPH * fs) as f32,
-        );
-        if let Some(r) = swatch {
-            paint.set_color(colour(*rgb));
-            if *outline {
-                let stroke = Stroke {
-                    width: fs as f32,
-                    ..Stroke::default()
-                };
-                let path = PathBuilder::from_rect(r);
-                pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
-            } else {
-                pixmap.fill_rect(r, &paint, Transform::identity(), None);
-            }
-        }
-        text::draw(
-            &mut pixmap,
-            (x + u64::from(3 * GLYPH * fs)) as i64,
-            y as i64,
-            fs,
-            width as i64,
-            TEXT,
-            label,
-        );
-    }
+    legend.draw(&mut pixmap, rows as u64 * u64::from(cell_h), width);
     pixmap
         .encode_png()
         .map_err(|e| PreviewError::Png(Box::new(e)))
