@@ -50,7 +50,7 @@ fn preview_of_a_prusaslicer_cube_writes_100_svgs_and_a_sheet() {
     // Sized for a screen (the legend makes it taller than wide), the millimetres kept in the
     // view box, and a 2 mm scale bar for the 19.55 mm cube.
     assert!(
-        svg.contains(r#"width="702" height="1000" viewBox="113.225 -138.275 23.550 33.550""#),
+        svg.contains(r#"width="811" height="1000" viewBox="113.225 -137.953 23.550 29.045""#),
         "{svg}"
     );
     assert!(svg.contains(">2 mm</text>"));

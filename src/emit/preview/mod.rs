@@ -710,11 +710,11 @@ mod tests {
                 r##"<g class="travels" fill="none" stroke="#999999" stroke-width="0.050""##
             )
         );
-        // View box: extrusions (10..20 both ways, y flipped) plus the 2 mm margin, a 1.5 mm
-        // heading row above (rows are 1 mm at this size), then the legend: 20 mm tall, drawn
+        // View box: extrusions (10..20 both ways, y flipped) plus the 2 mm margin, a heading
+        // row above (1.5 rows of 14/30 mm: 0.7 mm), then the legend: 16.333 mm tall, drawn
         // 1000 px tall.
         assert!(
-            svg.contains(r#"width="700" height="1000" viewBox="8.000 -23.500 14.000 20.000""#),
+            svg.contains(r#"width="857" height="1000" viewBox="8.000 -22.700 14.000 16.333""#),
             "{svg}"
         );
         assert!(svg.contains(">Layer 1 of 2, z 0.200 mm</text>"), "{svg}");
@@ -1049,9 +1049,10 @@ mod tests {
         // 10 mm across: a 2 mm bar.
         let svg = svg::layer(&p, 0);
         assert!(svg.contains(r##"<g class="scale-bar" fill="#000000" data-length="2.000">"##));
-        // Under the drawing (SVG y −8 is its bottom edge with the margin), from its left edge.
+        // Under the drawing (SVG y −8 is its bottom edge with the margin; 0.4 rows of 14/30 mm
+        // lower), from its left edge, 0.2 rows thick.
         assert!(
-            svg.contains(r#"<rect x="10.000" y="-7.600" width="2.000" height="0.200"/>"#),
+            svg.contains(r#"<rect x="10.000" y="-7.813" width="2.000" height="0.093"/>"#),
             "{svg}"
         );
         assert!(svg.contains(">2 mm</text>"));
@@ -1100,7 +1101,7 @@ mod tests {
             ),
             "{second}"
         );
-        assert!(second.contains(r#"<text data-part="R1" x="15.000" y="-17.350">R1</text>"#));
+        assert!(second.contains(r#"<text data-part="R1" x="15.000" y="-17.163">R1</text>"#));
         assert!(second.contains(">Inserted by hand before this layer: BAT1</text>"));
         assert!(second.contains(">Part outline</text>"));
         // Side view onto XZ: 14..16 across, from Z 0.2 up 1 mm.

@@ -233,7 +233,9 @@ pub fn layer(preview: &Preview, index: usize) -> String {
     // Heading row above the drawing; below it the scale bar row, the role/tool entries (and
     // travel, and parts when the file places any) in columns across the width, and a row
     // naming the parts inserted by hand before this layer.
-    let row = (w.max(h) / 30.0).max(1.0);
+    // Text scales with the drawing: the file is shown SCREEN_PX wide or tall whatever its size
+    // in mm, so a row is always about 1/30 of that on screen.
+    let row = w.max(h) / 30.0;
     let font = row * 0.7;
     let col_w = row * 12.0;
     let columns = ((w / col_w).floor() as usize).max(1);
@@ -265,13 +267,15 @@ pub fn layer(preview: &Preview, index: usize) -> String {
         num(w),
         num(vh)
     );
+    // The heading fits the width of a narrow print (a bold sans-serif glyph is about 0.6 em).
+    let heading = layer_heading(index, preview.layers.len(), layer.z);
+    let head_font = (row * 0.9).min((w - MARGIN) / (heading.len() as f64 * 0.6));
     let _ = writeln!(
         s,
-        r##"<text class="heading" x="{}" y="{}" font-family="sans-serif" font-size="{}" font-weight="bold" fill="#000000">{}</text>"##,
+        r##"<text class="heading" x="{}" y="{}" font-family="sans-serif" font-size="{}" font-weight="bold" fill="#000000">{heading}</text>"##,
         num(x0),
         num(vy + row * 1.05),
-        num(row * 0.9),
-        layer_heading(index, preview.layers.len(), layer.z)
+        num(head_font)
     );
     write_strokes(&mut s, preview, layer);
     write_parts(&mut s, preview.parts_on(index), row, |[x, y]| [x, -y]);
@@ -356,7 +360,7 @@ pub const SIDE_STROKE: f64 = 0.1;
 pub fn side(preview: &Preview, axis: SideAxis) -> String {
     let [a0, z0, a1, z1] = preview.side_bounds(axis).unwrap_or([0.0, 0.0, 1.0, 1.0]);
     let (w, h) = (a1 - a0 + 2.0 * MARGIN, z1 - z0 + 2.0 * MARGIN);
-    let row = (w.max(h) / 30.0).max(1.0);
+    let row = w.max(h) / 30.0;
     let foot_h = row * 1.5;
     let (vx, vy, vh) = (a0 - MARGIN, -z1 - MARGIN, h + foot_h);
     let mut s = String::new();
