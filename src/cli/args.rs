@@ -540,8 +540,10 @@ pub struct PreviewArgs {
     /// G-code file to draw.
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
-    /// Folder for `layer_0001.svg`... and `contact_sheet.png` (made when missing). `-o` is
-    /// taken as an older spelling.
+    /// Folder for `layer_0001.svg`..., `contact_sheet.png` and the side views (made when
+    /// missing). Layer views there that this run does not write (`layer_NNNN.svg` of an
+    /// earlier run with more layers) are removed; other files are left alone. `-o` is taken as
+    /// an older spelling.
     #[arg(long = "out-dir", short_alias = 'o', value_name = "DIR")]
     pub out_dir: PathBuf,
     /// Contact sheet: every Nth layer (default: the smallest N giving at most 36 tiles).

@@ -1,32 +1,49 @@
-//! Previews of a G-code file: one SVG per printed layer and a PNG contact sheet.
+//! Previews of a G-code file: one SVG per printed layer, a PNG contact sheet and side views.
 //!
 //! Place in the pipeline: the end of the line, beside `check`. It reads the [`Moves`] that
 //! [`conduit_gcode::moves`] replays from any G-code (conduit's own or another
-//! slicer's) and never reaches back into the pipeline.
+//! slicer's), and the part events and part description in its comments ([`parts`]), and never
+//! reaches back into the pipeline.
 //!
 //! - [`Preview::from_moves`] groups the moves of each layer into polylines: extrusions by
 //!   feature role (the latest `;TYPE:` / `; FEATURE:` comment), tool and width (the latest
 //!   `;WIDTH:` comment, else [`DEFAULT_WIDTH`]), and travels (XY moves that do not extrude).
-//! - [`svg`] draws one layer: the view box covers the extrusions of every layer so the files
-//!   line up, +Y is up, extrusions are stroked at their width in a colour per role (a darker or
-//!   lighter tint per tool), travels as [`TRAVEL_WIDTH`] grey lines, with a legend below.
+//!   [`Preview::with_parts`] adds the parts [`placed_parts`] reads, each on the layer printed
+//!   over it.
+//! - Colours: one per role ([`role_colour`]: PrusaSlicer's where it has the role, conduit's
+//!   conductive traces in a magenta no other role has), a darker or lighter tint per tool
+//!   ([`tint`]); parts in [`PART_COLOUR`]. The legends name each (role, tool) pair as
+//!   [`Preview::style_label`] does: `External perimeter (T0)`.
+//! - [`svg`] draws one layer: a heading with the layer's number and Z ([`layer_heading`]),
+//!   the drawing (its view box covers the extrusions of every layer so the files line up, +Y
+//!   up, extrusions stroked at their width, travels as [`TRAVEL_WIDTH`] grey lines, the parts
+//!   placed before the layer outlined and named), then a scale bar and the legend. The view
+//!   box is in millimetres; `width` and `height` are in pixels, [`SCREEN_PX`] on the longer
+//!   side, and the scale bar ([`scale_bar_length`]) keeps the millimetres readable.
 //! - [`png`] rasterises every Nth layer into a grid of square tiles with `tiny-skia`
-//!   (extrusions only; a bar under each tile shows how far up the print the layer is).
+//!   (extrusions and parts; travels left out), each labelled in a strip under it
+//!   ([`tile_label`]: `L12  z 2.400`), with the legend under the grid. Text is an 8 × 8 bitmap
+//!   font (`font8x8`), so the pixels are the same everywhere.
 //! - Side views ([`SIDE_VIEWS`]): every extrusion of the print projected onto the XZ and YZ
-//!   planes, planar layers in grey and non-planar (curved) extrusions highlighted, as SVG
-//!   ([`svg::side`]) and PNG ([`png::side`]). An extrusion is curved when a point of it lies off
-//!   its layer's Z; [`layered_by_markers`] keeps curved extrusions in the layer they are printed
+//!   planes, planar layers in grey and non-planar (curved) extrusions highlighted, each part a
+//!   labelled box from its seating plane up its height, as SVG ([`svg::side`], with a scale
+//!   bar) and PNG ([`png::side`]). An extrusion is curved when a point of it lies off its
+//!   layer's Z; [`layered_by_markers`] keeps curved extrusions in the layer they are printed
 //!   in (by the `;LAYER_CHANGE` markers) instead of making a layer of every height.
 //! - [`render`] draws `layer_0001.svg`…, [`CONTACT_SHEET`] and the side views as named files
-//!   for the caller to write.
+//!   for the caller to write; [`is_layer_file_name`] tells the caller which files in the
+//!   folder are layer views, so that those of an earlier run with more layers can go.
 //!
-//! Output bytes depend only on the input: SVG numbers have a fixed 3 decimals and the PNG
-//! encoder writes no timestamp.
+//! Output bytes depend only on the input: SVG numbers have a fixed 3 decimals, pixel sizes
+//! are whole numbers, and the PNG encoder writes no timestamp.
 
+pub mod parts;
 pub mod png;
 pub mod svg;
+mod text;
 
 use conduit_gcode::Moves;
+pub use parts::{PartMark, PartMethod, placed_parts};
 
 /// Stroke width of extrusions without a `;WIDTH:` comment, mm.
 pub const DEFAULT_WIDTH: f64 = 0.4;
@@ -42,8 +59,13 @@ pub const CONTACT_SHEET: &str = "contact_sheet.png";
 const CUSTOM_ROLE: &str = "Custom";
 /// Role name of extrusions before any role comment.
 pub const UNNAMED_ROLE: &str = "Extrusion";
+/// Colour of part outlines, boxes and names, RGB.
+pub const PART_COLOUR: [u8; 3] = [0x1a, 0x1a, 0x1a];
+/// Size of the longer side of the SVGs on screen, pixels (`width`/`height`; the view box stays
+/// in millimetres).
+pub const SCREEN_PX: f64 = 1000.0;
 
-/// Options of [`write()`].
+/// Options of [`render`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PreviewParams {
     /// Contact sheet: every Nth layer (layers 1, 1 + N, 1 + 2N…). `None`: the smallest N that
@@ -137,6 +159,9 @@ pub struct Preview {
     pub styles: Vec<(usize, usize)>,
     /// Extent of the extrusions of all layers: [min X, min Y, max X, max Y], mm.
     pub bounds: [f64; 4],
+    /// The parts the file places, in file order (see [`placed_parts`]); none unless given with
+    /// [`Preview::with_parts`].
+    pub parts: Vec<PartMark>,
 }
 
 impl Preview {
@@ -234,7 +259,35 @@ impl Preview {
             roles,
             styles,
             bounds,
+            parts: Vec::new(),
         })
+    }
+
+    /// The preview with `parts` to label: each drawn on its layer's view and tile and in the
+    /// side views. Parts whose layer is not a layer of the preview are left out.
+    pub fn with_parts(mut self, parts: &[PartMark]) -> Self {
+        self.parts = parts
+            .iter()
+            .filter(|p| p.layer < self.layers.len())
+            .cloned()
+            .collect();
+        self
+    }
+
+    /// The parts placed before layer `index` (0-based).
+    pub fn parts_on(&self, index: usize) -> impl Iterator<Item = &PartMark> {
+        self.parts.iter().filter(move |p| p.layer == index)
+    }
+
+    /// Whether any part has a position to draw (machine-placed parts).
+    pub fn has_placed_parts(&self) -> bool {
+        self.parts.iter().any(|p| p.position.is_some())
+    }
+
+    /// The legend's name of extrusions of `role` by `tool`: `External perimeter (T0)`.
+    pub fn style_label(&self, role: usize, tool: usize) -> String {
+        let name = self.roles.get(role).map_or(UNNAMED_ROLE, String::as_str);
+        format!("{name} (T{tool})")
     }
 
     /// The colour of extrusions of `role` (an index into [`Preview::roles`]) by `tool`, RGB.
@@ -252,6 +305,12 @@ impl Preview {
             .max(1)
     }
 }
+
+/// Colour of conductive traces, RGB: a magenta no other role uses.
+pub const TRACE_COLOUR: [u8; 3] = [0xff, 0x00, 0xcc];
+/// Colour of conductive drops (dots of paste on pads), RGB: a darker tint of
+/// [`TRACE_COLOUR`].
+pub const TRACE_DROP_COLOUR: [u8; 3] = [0xa6, 0x00, 0x85];
 
 /// The colour of a role, RGB: PrusaSlicer's preview colours for its roles and the matching
 /// Cura and OrcaSlicer names (a darker yellow for perimeters, to show on white), conduit's own
@@ -284,8 +343,9 @@ pub fn role_colour(name: &str, index: usize) -> [u8; 3] {
         "wipe tower" | "prime-tower" | "prime tower" => [0xb3, 0xe3, 0xab],
         "ironing" => [0xff, 0x8c, 0x69],
         "custom" => [0x5e, 0xd1, 0x94],
-        "conductive trace" => [0x00, 0xa0, 0xe0],
-        "conductive drop" => [0x00, 0x50, 0xa0],
+        // Magenta: far from every other role here (and from the blue of bridges).
+        "conductive trace" => TRACE_COLOUR,
+        "conductive drop" => TRACE_DROP_COLOUR,
         "scaffold" => [0xa0, 0xa0, 0xa0],
         "buffer" => [0xc8, 0xa0, 0xc8],
         _ => PALETTE[index % PALETTE.len()],
@@ -442,9 +502,70 @@ impl Preview {
     }
 }
 
+/// Rows for labels spanning `spans` ([left, right] each, in order) so that labels in one row do
+/// not overlap: each takes the lowest row (0 nearest its box) free over its span.
+pub fn label_rows(spans: &[[f64; 2]]) -> Vec<usize> {
+    let mut rows: Vec<usize> = Vec::with_capacity(spans.len());
+    for (i, a) in spans.iter().enumerate() {
+        let mut row = 0;
+        while spans[..i]
+            .iter()
+            .zip(&rows)
+            .any(|(b, &r)| r == row && a[0] < b[1] && b[0] < a[1])
+        {
+            row += 1;
+        }
+        rows.push(row);
+    }
+    rows
+}
+
 /// File name of layer `index` (0-based): `layer_0001.svg` for index 0.
 pub fn layer_file_name(index: usize) -> String {
     format!("layer_{:04}.svg", index + 1)
+}
+
+/// Whether `name` is a layer view's file name as [`layer_file_name`] writes them: `layer_`,
+/// four or more ASCII digits, `.svg` (exactly). The CLI removes such files that a run did not
+/// write (left by an earlier run with more layers) and nothing else.
+pub fn is_layer_file_name(name: &str) -> bool {
+    name.strip_prefix("layer_")
+        .and_then(|r| r.strip_suffix(".svg"))
+        .is_some_and(|digits| digits.len() >= 4 && digits.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// The label of layer `index` (0-based) at height `z` on its contact-sheet tile:
+/// `L12  z 2.400`.
+pub fn tile_label(index: usize, z: f64) -> String {
+    format!("L{}  z {}", index + 1, svg::num(z))
+}
+
+/// The heading of layer `index`'s (0-based) SVG, of `layers` layers, at height `z`:
+/// `Layer 12 of 40, z 2.400 mm`.
+pub fn layer_heading(index: usize, layers: usize, z: f64) -> String {
+    format!("Layer {} of {layers}, z {} mm", index + 1, svg::num(z))
+}
+
+/// A round length for the scale bar of a drawing `extent` mm across: the longest 1, 2 or 5 ×
+/// 10ⁿ mm that is at most a fifth of it (1 mm for an empty or invalid extent).
+pub fn scale_bar_length(extent: f64) -> f64 {
+    let target = extent / 5.0;
+    if !(target.is_finite() && target > 0.0) {
+        return 1.0;
+    }
+    let decade = 10f64.powi(target.log10().floor() as i32);
+    [5.0, 2.0, 1.0]
+        .into_iter()
+        .map(|m| m * decade)
+        .find(|&l| l <= target * (1.0 + 1e-9))
+        .unwrap_or(decade)
+}
+
+/// The scale bar's label for `length` mm: `20 mm`, `0.5 mm` (no trailing zeros).
+pub fn scale_bar_label(length: f64) -> String {
+    let s = svg::num(length);
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    format!("{s} mm")
 }
 
 /// What [`render`] drew: every file of the preview, named, in the order they are written.
@@ -461,9 +582,14 @@ pub struct PreviewFiles {
     pub tiles: usize,
 }
 
-/// Draws the preview of `moves`: one SVG per layer ([`layer_file_name`]), [`CONTACT_SHEET`]
-/// and the side views ([`SIDE_VIEWS`]), as named files for the caller to write.
-pub fn render(moves: &Moves, params: &PreviewParams) -> Result<PreviewFiles, PreviewError> {
+/// Draws the preview of `moves` with `parts` labelled (see [`placed_parts`]; empty for none):
+/// one SVG per layer ([`layer_file_name`]), [`CONTACT_SHEET`] and the side views
+/// ([`SIDE_VIEWS`]), as named files for the caller to write.
+pub fn render(
+    moves: &Moves,
+    parts: &[PartMark],
+    params: &PreviewParams,
+) -> Result<PreviewFiles, PreviewError> {
     if params.every == Some(0) {
         return Err(PreviewError::InvalidParams("every must be at least 1"));
     }
@@ -472,7 +598,7 @@ pub fn render(moves: &Moves, params: &PreviewParams) -> Result<PreviewFiles, Pre
             "tile size must be at least 1 pixel",
         ));
     }
-    let preview = Preview::from_moves(moves)?;
+    let preview = Preview::from_moves(moves)?.with_parts(parts);
     // Render the sheet first: a sheet that is too large fails before anything else is drawn.
     let every = preview.every(params);
     let sheet = png::contact_sheet(&preview, every, params.tile_px)?;
@@ -584,8 +710,14 @@ mod tests {
                 r##"<g class="travels" fill="none" stroke="#999999" stroke-width="0.050""##
             )
         );
-        // View box: extrusions (10..20 both ways, y flipped) plus the 2 mm margin, then legend.
-        assert!(svg.contains(r#"viewBox="8.000 -22.000 14.000 "#), "{svg}");
+        // View box: extrusions (10..20 both ways, y flipped) plus the 2 mm margin, a heading
+        // row above (1.5 rows of 14/30 mm: 0.7 mm), then the legend: 16.333 mm tall, drawn
+        // 1000 px tall.
+        assert!(
+            svg.contains(r#"width="857" height="1000" viewBox="8.000 -22.700 14.000 16.333""#),
+            "{svg}"
+        );
+        assert!(svg.contains(">Layer 1 of 2, z 0.200 mm</text>"), "{svg}");
         assert!(svg.contains("<title>layer 1 of 2, Z 0.200 mm</title>"));
         assert!(svg.contains(">External perimeter (T0)</text>"));
         assert!(svg.contains(">Perimeter (T1)</text>"));
@@ -616,7 +748,10 @@ mod tests {
         let p = preview();
         let bytes = png::contact_sheet(&p, 1, 64).expect("the sheet renders");
         let img = tiny_skia::Pixmap::decode_png(&bytes).expect("the PNG decodes");
-        assert_eq!((img.width(), img.height()), (128, 64));
+        // Two 64 px tiles, each with a 12 px label strip, and a legend (8 px font) of two
+        // entries in one column, wider than the grid: a margin, the swatch (3 glyphs with its
+        // gap), 23 characters and a gap, so 8 + 24 + 184 + 8 px wide; 2 · 12 + 8 px tall.
+        assert_eq!((img.width(), img.height()), (224, 64 + 12 + 32));
         let rgb = |x: u32, y: u32| {
             let c = img.pixel(x, y).expect("inside the image").demultiply();
             [c.red(), c.green(), c.blue()]
@@ -651,8 +786,8 @@ mod tests {
             every: None,
             tile_px: 64,
         };
-        let runs =
-            [render(&m, &params), render(&m, &params)].map(|r| r.expect("the preview is drawn"));
+        let runs = [render(&m, &[], &params), render(&m, &[], &params)]
+            .map(|r| r.expect("the preview is drawn"));
         let files = &runs[0];
         assert_eq!(files.layers, 2);
         assert_eq!((files.every, files.tiles), (1, 2));
@@ -744,5 +879,260 @@ mod tests {
         assert_eq!(layered_by_markers(&g, planar.clone()), planar);
         let png = png::side(&p, SideAxis::Y, 64).expect("renders");
         assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    }
+    /// The contact sheet's pixel (x, y), RGB.
+    fn pixel(img: &tiny_skia::Pixmap, x: u32, y: u32) -> [u8; 3] {
+        let c = img.pixel(x, y).expect("inside the image").demultiply();
+        [c.red(), c.green(), c.blue()]
+    }
+
+    #[test]
+    fn layers_are_labelled_with_number_and_z_on_tiles_and_in_svgs() {
+        let p = preview();
+        assert_eq!(tile_label(1, p.layers[1].z), "L2  z 0.400");
+        assert_eq!(layer_heading(1, 2, 0.4), "Layer 2 of 2, z 0.400 mm");
+        let svg = svg::layer(&p, 1);
+        assert!(
+            svg.contains(r##"font-weight="bold" fill="#000000">Layer 2 of 2, z 0.400 mm</text>"##),
+            "{svg}"
+        );
+        let bytes = png::contact_sheet(&p, 1, 64).expect("the sheet renders");
+        let img = tiny_skia::Pixmap::decode_png(&bytes).expect("the PNG decodes");
+        // Each tile's label strip (y 64..76) has text pixels; the drawing above its bottom
+        // padding has none of the text colour.
+        for tile in [0, 64] {
+            let dark = (tile..tile + 64)
+                .flat_map(|x| (64..76).map(move |y| (x, y)))
+                .filter(|&(x, y)| pixel(&img, x, y) == png::TEXT)
+                .count();
+            assert!(dark > 30, "tile at {tile}: {dark} text pixels");
+        }
+        // Different labels: the two strips differ.
+        let strip = |tile: u32| -> Vec<[u8; 3]> {
+            (0..64)
+                .flat_map(|x| (64..76).map(move |y| (x, y)))
+                .map(|(x, y)| pixel(&img, tile + x, y))
+                .collect()
+        };
+        assert_ne!(strip(0), strip(64));
+    }
+
+    #[test]
+    fn contact_sheet_has_a_legend_of_roles_and_tools() {
+        let p = preview();
+        assert_eq!(p.style_label(0, 0), "External perimeter (T0)");
+        let bytes = png::contact_sheet(&p, 1, 64).expect("the sheet renders");
+        let img = tiny_skia::Pixmap::decode_png(&bytes).expect("the PNG decodes");
+        // Legend under the 76 px row of tiles, from a 4 px half-gap: swatches 16 × 8 px at x 8,
+        // one entry per 12 px row, labels from x 32.
+        assert_eq!(pixel(&img, 12, 76 + 4 + 4), [0xff, 0x7d, 0x38]);
+        assert_eq!(
+            pixel(&img, 12, 76 + 4 + 12 + 4),
+            tint(role_colour("Perimeter", 1), 1)
+        );
+        // A role name of any length keeps the sheet's size in bounds: labels are cut.
+        let long = format!(
+            "G1 Z0.2\nG1 X0 Y0\n;TYPE:{}\nG1 X10 Y0 E1\n",
+            "x".repeat(100_000)
+        );
+        let g = conduit_gcode::parse(long.as_bytes()).expect("parses");
+        let lp = Preview::from_moves(&moves(&g, Firmware::Marlin)).expect("extrudes");
+        let sheet = png::contact_sheet(&lp, 1, 64).expect("the sheet renders");
+        let sheet = tiny_skia::Pixmap::decode_png(&sheet).expect("decodes");
+        // A margin, the swatch, 40 characters.
+        assert_eq!(sheet.width(), 8 + 24 + 40 * 8 + 8);
+        for row in [0, 12] {
+            let text = (32..216)
+                .flat_map(|x| (80 + row..88 + row).map(move |y| (x, y)))
+                .filter(|&(x, y)| pixel(&img, x, y) == png::TEXT)
+                .count();
+            assert!(text > 50, "legend row {row}: {text} text pixels");
+        }
+    }
+
+    #[test]
+    fn traces_have_a_colour_no_other_role_has() {
+        const NAMED: [&str; 16] = [
+            "External perimeter",
+            "Perimeter",
+            "Overhang perimeter",
+            "Internal infill",
+            "Solid infill",
+            "Top solid infill",
+            "Bridge infill",
+            "Gap fill",
+            "Skirt/Brim",
+            "Support material",
+            "Support material interface",
+            "Wipe tower",
+            "Ironing",
+            "Custom",
+            "Scaffold",
+            "Buffer",
+        ];
+        let distance = |a: [u8; 3], b: [u8; 3]| {
+            a.iter()
+                .zip(b)
+                .map(|(&x, y)| (f64::from(x) - f64::from(y)).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let trace = role_colour("Conductive trace", 0);
+        assert_eq!(trace, TRACE_COLOUR);
+        assert_eq!(role_colour("conductive drop", 5), TRACE_DROP_COLOUR);
+        for name in NAMED {
+            let other = role_colour(name, 0);
+            assert!(
+                distance(trace, other) > 120.0,
+                "{name}: {other:?} is {} from the trace colour",
+                distance(trace, other)
+            );
+        }
+        // The drop is a darker tint of the trace: the same hue, about two thirds as bright.
+        assert_eq!(TRACE_DROP_COLOUR, tint(TRACE_COLOUR, 1));
+        // In a layer view the trace is stroked in its colour.
+        let g = conduit_gcode::parse(
+            b"G1 Z0.2\nG1 X0 Y0\n;TYPE:Conductive trace\nG1 X10 Y0 E1\nG1 X10 Y5 E2\n",
+        )
+        .expect("parses");
+        let p = Preview::from_moves(&moves(&g, Firmware::Marlin)).expect("extrudes");
+        let svg = svg::layer(&p, 0);
+        assert!(
+            svg.contains(r##"data-role="Conductive trace" data-tool="0" stroke="#ff00cc""##),
+            "{svg}"
+        );
+    }
+
+    #[test]
+    fn layer_file_names_are_recognised_exactly() {
+        for name in ["layer_0001.svg", "layer_0009.svg", "layer_12345.svg"] {
+            assert!(is_layer_file_name(name), "{name}");
+        }
+        for name in [
+            "layer_001.svg",
+            "layer_0001.svg.bak",
+            "layer_00a1.svg",
+            "Layer_0001.svg",
+            "layer_0001.SVG",
+            "notes.txt",
+            "layer_.svg",
+            "xlayer_0001.svg",
+            "layer_+001.svg",
+        ] {
+            assert!(!is_layer_file_name(name), "{name}");
+        }
+        assert!(is_layer_file_name(&layer_file_name(41)));
+    }
+
+    #[test]
+    fn scale_bars_have_round_lengths() {
+        let cases = [
+            (14.0, 2.0),
+            (60.0, 10.0),
+            (100.0, 20.0),
+            (99.0, 10.0),
+            (250.0, 50.0),
+            (3.0, 0.5),
+            (0.0, 1.0),
+            (f64::NAN, 1.0),
+        ];
+        for (extent, length) in cases {
+            assert!(
+                (scale_bar_length(extent) - length).abs() < 1e-12,
+                "{extent}: {}",
+                scale_bar_length(extent)
+            );
+        }
+        assert_eq!(scale_bar_label(20.0), "20 mm");
+        assert_eq!(scale_bar_label(0.5), "0.5 mm");
+        let p = preview();
+        // 10 mm across: a 2 mm bar.
+        let svg = svg::layer(&p, 0);
+        assert!(svg.contains(r##"<g class="scale-bar" fill="#000000" data-length="2.000">"##));
+        // Under the drawing (SVG y −8 is its bottom edge with the margin; 0.4 rows of 14/30 mm
+        // lower), from its left edge, 0.2 rows thick.
+        assert!(
+            svg.contains(r#"<rect x="10.000" y="-7.813" width="2.000" height="0.093"/>"#),
+            "{svg}"
+        );
+        assert!(svg.contains(">2 mm</text>"));
+        let side = svg::side(&p, SideAxis::X);
+        assert!(side.contains(r#"data-length="2.000""#), "{side}");
+        assert!(side.contains(r#" width="1000" height=""#), "{side}");
+    }
+
+    /// A grey darker than the side views' planar grey: the part colour, anti-aliased.
+    fn is_dark_grey(c: [u8; 3]) -> bool {
+        let (lo, hi) = (c.iter().min(), c.iter().max());
+        matches!((lo, hi), (Some(&lo), Some(&hi)) if hi < 0x90 && hi - lo < 8)
+    }
+
+    /// [`TWO_LAYERS`] with R1 placed before layer 2 (a 4 × 2 mm outline turned by 90° about
+    /// (15, 15), 1 mm tall) and BAT1 inserted by hand before it.
+    fn with_parts() -> (Preview, Vec<PartMark>) {
+        let text = TWO_LAYERS.replace(
+            "G1 Z0.4\n",
+            "G1 Z0.4\n;PICK_AND_PLACE PART=R1 X=15 Y=15 Z=0.2 ROTATION=90\n;MANUAL_INSERT PART=BAT1\n",
+        ) + ";<object name=\"o\">\n;<part id=\"1\" name=\"R1\">\n;  <size height=\"1\"/>\n\
+            ;  <shape>\n;    <point x=\"-2\" y=\"-1\"/>\n;    <point x=\"2\" y=\"-1\"/>\n\
+            ;    <point x=\"2\" y=\"1\"/>\n;    <point x=\"-2\" y=\"1\"/>\n;  </shape>\n\
+            ;  <destination x=\"15\" y=\"15\" z=\"0.2\" orientation=\"90\"/>\n;</part>\n;</object>\n";
+        let g = conduit_gcode::parse(text.as_bytes()).expect("parses");
+        let m = moves(&g, Firmware::Marlin);
+        let parts = placed_parts(&g, &m);
+        let p = Preview::from_moves(&m)
+            .expect("extrudes")
+            .with_parts(&parts);
+        (p, parts)
+    }
+
+    #[test]
+    fn placed_parts_are_outlined_and_named_on_their_layer() {
+        let (p, parts) = with_parts();
+        assert_eq!(parts.len(), 2);
+        assert_eq!((parts[0].name.as_str(), parts[0].layer), ("R1", 1));
+        assert_eq!((parts[1].name.as_str(), parts[1].layer), ("BAT1", 1));
+        let first = svg::layer(&p, 0);
+        assert!(!first.contains("data-part"), "{first}");
+        let second = svg::layer(&p, 1);
+        assert!(
+            second.contains(
+                r#"<polygon data-part="R1" points="16.000,-13.000 16.000,-17.000 14.000,-17.000 14.000,-13.000"/>"#
+            ),
+            "{second}"
+        );
+        assert!(second.contains(r#"<text data-part="R1" x="15.000" y="-17.163">R1</text>"#));
+        assert!(second.contains(">Inserted by hand before this layer: BAT1</text>"));
+        assert!(second.contains(">Part outline</text>"));
+        // Side view onto XZ: 14..16 across, from Z 0.2 up 1 mm.
+        let side = svg::side(&p, SideAxis::X);
+        assert!(
+            side.contains(
+                r#"<rect data-part="R1" data-layer="2" x="14.000" y="-1.200" width="2.000" height="1.000"/>"#
+            ),
+            "{side}"
+        );
+        assert!(side.contains(">R1</text>"));
+        assert!(!side.contains("BAT1"));
+        // On the second tile the outline (x 14 to 16 mm: 26.4 to 37.6 px) is drawn in the
+        // part colour, anti-aliased: dark grey pixels the extrusions' colours never give; the
+        // first tile has none.
+        let bytes = png::contact_sheet(&p, 1, 64).expect("the sheet renders");
+        let img = tiny_skia::Pixmap::decode_png(&bytes).expect("the PNG decodes");
+        let part_pixels = |tile: u32| {
+            (tile..tile + 64)
+                .flat_map(|x| (0..64).map(move |y| (x, y)))
+                .filter(|&(x, y)| is_dark_grey(pixel(&img, x, y)))
+                .count()
+        };
+        assert_eq!(part_pixels(0), 0);
+        assert!(part_pixels(64) > 20, "{}", part_pixels(64));
+        let side_png = png::side(&p, SideAxis::X, 256).expect("renders");
+        let side_img = tiny_skia::Pixmap::decode_png(&side_png).expect("decodes");
+        let dark = (0..side_img.width())
+            .flat_map(|x| (0..side_img.height()).map(move |y| (x, y)))
+            .filter(|&(x, y)| is_dark_grey(pixel(&side_img, x, y)))
+            .count();
+        assert!(dark > 20, "{dark}");
     }
 }
