@@ -16,9 +16,13 @@
 //! follows it in the file (the layer of the next extruding move: the one printed over the
 //! part), with its outline turned by its rotation about its position into bed coordinates.
 //! Names in events have their spaces written as `_`; the description's names are matched so.
+//! The comments are read by [`crate::circuit::events`] and [`crate::circuit::octopnp::read_block`].
 //! Malformed comments are skipped, never an error: the previews draw what they can read.
 
 use conduit_gcode::{Gcode, Moves};
+
+use crate::circuit::events::part_events;
+use crate::circuit::octopnp::read_block;
 
 /// How a part gets into the print.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -69,52 +73,11 @@ impl PartMark {
     }
 }
 
-/// One `<part>` of OctoPNP's description: name, outline in the package frame, height.
-#[derive(Debug, Default)]
-struct Described {
-    name: String,
-    shape: Vec<[f64; 2]>,
-    height: Option<f64>,
-}
-
-/// The value of attribute `key` in a tag written as `key="value"`, with XML's five entities
-/// unescaped.
-fn attr(tag: &str, key: &str) -> Option<String> {
-    let pattern = format!(" {key}=\"");
-    let start = tag.find(&pattern)? + pattern.len();
-    let len = tag.get(start..)?.find('"')?;
-    let raw = tag.get(start..start + len)?;
-    Some(
-        raw.replace("&lt;", "<")
-            .replace("&gt;", ">")
-            .replace("&quot;", "\"")
-            .replace("&apos;", "'")
-            .replace("&amp;", "&"),
-    )
-}
-
-fn attr_num(tag: &str, key: &str) -> Option<f64> {
-    attr(tag, key)?
-        .trim()
-        .parse()
-        .ok()
-        .filter(|v: &f64| v.is_finite())
-}
-
-/// The value after `KEY=` among the event's words.
-fn word(words: &[&str], key: &str) -> Option<f64> {
-    words
-        .iter()
-        .find_map(|w| w.strip_prefix(key))
-        .and_then(|v| v.parse().ok())
-        .filter(|v: &f64| v.is_finite())
-}
-
 /// The part events of `gcode`, in file order, each on the layer of `moves` it is placed before
 /// (see the module doc). `moves` must be the replay of `gcode` (its move lines index `gcode`).
 pub fn placed_parts(gcode: &Gcode, moves: &Moves) -> Vec<PartMark> {
-    let mut marks = Vec::new();
-    let mut described: Vec<Described> = Vec::new();
+    // A description that is not well-formed XML gives no outlines; the events are still drawn.
+    let described = read_block(gcode.lines.iter().map(|l| &l.text[..])).unwrap_or_default();
     let last_layer = moves.layer_z.len().saturating_sub(1);
     let layer_after = |line: usize| {
         let from = moves.moves.partition_point(|m| m.line <= line);
@@ -123,73 +86,45 @@ pub fn placed_parts(gcode: &Gcode, moves: &Moves) -> Vec<PartMark> {
             .find(|m| m.extruding)
             .map_or(last_layer, |m| m.layer)
     };
-    for line in &gcode.lines {
-        let Some(text) = line.comment_text() else {
-            continue;
-        };
-        let (rest, method) = if let Some(r) = text.strip_prefix("PICK_AND_PLACE PART=") {
-            (r, PartMethod::Machine)
-        } else if let Some(r) = text.strip_prefix("MANUAL_INSERT PART=") {
-            (r, PartMethod::Hand)
+    let mut marks = Vec::new();
+    for event in part_events(gcode) {
+        let (method, position, rotation_deg) = if event.machine {
+            let [Some(x), Some(y), Some(z)] = event.at else {
+                continue;
+            };
+            (
+                PartMethod::Machine,
+                Some([x, y, z]),
+                event.rotation.unwrap_or(0.0),
+            )
         } else {
-            if text.starts_with("<part ") {
-                described.push(Described {
-                    name: attr(text, "name").unwrap_or_default(),
-                    ..Described::default()
-                });
-            } else if let Some(d) = described.last_mut() {
-                if text.starts_with("<point ") {
-                    if let (Some(x), Some(y)) = (attr_num(text, "x"), attr_num(text, "y")) {
-                        d.shape.push([x, y]);
-                    }
-                } else if text.starts_with("<size ") {
-                    d.height = attr_num(text, "height");
-                }
-            }
-            continue;
+            (PartMethod::Hand, None, 0.0)
         };
-        let words: Vec<&str> = rest.split_whitespace().collect();
-        let Some(name) = words.first() else {
-            continue;
-        };
-        let (position, rotation_deg) = match method {
-            PartMethod::Machine => {
-                let xyz = [word(&words, "X="), word(&words, "Y="), word(&words, "Z=")];
-                let [Some(x), Some(y), Some(z)] = xyz else {
-                    continue;
-                };
-                (Some([x, y, z]), word(&words, "ROTATION=").unwrap_or(0.0))
-            }
-            PartMethod::Hand => (None, 0.0),
-        };
-        marks.push(PartMark {
-            name: (*name).to_owned(),
+        let mut mark = PartMark {
+            layer: layer_after(event.line),
+            line: event.line,
+            name: event.part,
             method,
-            layer: layer_after(line.number),
-            line: line.number,
             position,
             rotation_deg,
             outline: Vec::new(),
             height: None,
-        });
-    }
-    for mark in &mut marks {
-        let Some([x, y, _]) = mark.position else {
-            continue;
         };
-        let Some(d) = described
-            .iter()
-            .find(|d| d.name.replace(' ', "_") == mark.name)
-        else {
-            continue;
-        };
-        let (s, c) = mark.rotation_deg.to_radians().sin_cos();
-        mark.outline = d
-            .shape
-            .iter()
-            .map(|&[u, v]| [x + u * c - v * s, y + u * s + v * c])
-            .collect();
-        mark.height = d.height;
+        if let (Some([x, y, _]), Some(d)) = (
+            mark.position,
+            described
+                .iter()
+                .find(|d| d.name.replace(' ', "_") == mark.name),
+        ) {
+            let (s, c) = mark.rotation_deg.to_radians().sin_cos();
+            mark.outline = d
+                .shape
+                .iter()
+                .map(|&[u, v]| [x + u * c - v * s, y + u * s + v * c])
+                .collect();
+            mark.height = Some(d.height).filter(|h| *h > 0.0);
+        }
+        marks.push(mark);
     }
     marks
 }
@@ -241,14 +176,5 @@ mod tests {
             ("BAT1", PartMethod::Hand, 1, None)
         );
         assert!(bat.outline.is_empty() && bat.extent().is_none());
-    }
-
-    #[test]
-    fn attributes_are_unescaped_and_bad_numbers_skipped() {
-        let tag = r#"<part id="2" name="A&amp;B &quot;x&quot;" h="nan"/>"#;
-        assert_eq!(attr(tag, "name").as_deref(), Some(r#"A&B "x""#));
-        assert_eq!(attr(tag, "id").as_deref(), Some("2"));
-        assert_eq!(attr_num(tag, "h"), None);
-        assert_eq!(attr(tag, "missing"), None);
     }
 }

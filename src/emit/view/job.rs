@@ -81,7 +81,7 @@ pub struct EventView {
     /// The event as the file gives it.
     #[serde(flatten)]
     pub event: PartEvent,
-    /// 0-based layer: the layer of the next move after the marker.
+    /// 0-based layer it is placed before: the layer of the next extruding move.
     pub layer: usize,
 }
 
@@ -433,14 +433,18 @@ fn markers(moves: &Moves) -> (MarkerView, MarkerView) {
     (view(retract), view(hop))
 }
 
-/// Part events with the layer of the move after each.
+/// Part events with the layer each is placed before: the layer of the next extruding move
+/// (the one printed over the part), as the previews place them.
 fn events(gcode: &Gcode, moves: &Moves) -> Vec<EventView> {
     let last = moves.layer_z.len().saturating_sub(1);
     part_events(gcode)
         .into_iter()
         .map(|event| {
             let next = moves.moves.partition_point(|m| m.line <= event.line);
-            let layer = moves.moves.get(next).map_or(last, |m| m.layer);
+            let layer = moves.moves[next..]
+                .iter()
+                .find(|m| m.extruding)
+                .map_or(last, |m| m.layer);
             EventView { event, layer }
         })
         .collect()
