@@ -211,6 +211,32 @@ fn studio_drag_saves_the_move_flags_a_part_outside_and_routes() {
         browser.eval("return window.conduitStudio.status();")
     );
     let (x1, y1) = r1(&std::fs::read_to_string(&placement).expect("saved"));
+    // The same placement as Electronic Slic3r's .3de, from the block's centre (40 × 30 mm; the
+    // TOML rounds to the micrometre).
+    browser.click("#export-3de");
+    assert!(
+        browser.wait_for(
+            "return window.conduitStudio.exports === 1;",
+            Duration::from_secs(20)
+        ),
+        "exported: {}",
+        browser.eval("return window.conduitStudio.status();")
+    );
+    let three_de = conduit::circuit::Placement::from_3de(
+        &std::fs::read_to_string(placement.with_extension("3de")).expect("the .3de is written"),
+    )
+    .expect("the .3de reads back");
+    let r1_3de = three_de
+        .parts
+        .iter()
+        .find(|p| p.name == "R1")
+        .expect("R1 in the .3de");
+    assert!(
+        (r1_3de.x - (x1 - 20.0)).abs() < 1e-3 && (r1_3de.y - (y1 - 15.0)).abs() < 1e-3,
+        "R1 in the .3de at ({}, {})",
+        r1_3de.x,
+        r1_3de.y
+    );
     let want = drag_px / px_per_mm;
     assert!(
         (x1 - x0 - want).abs() < 0.25 && (y1 - y0).abs() < 0.25,

@@ -161,6 +161,131 @@ impl Placement {
     }
 }
 
+impl Placement {
+    /// The placement as Electronic Slic3r's `.3de` XML (the layout [`Placement::from_3de`]
+    /// reads), for `circuit` in an object whose model-space bounding box is `bbox`.
+    ///
+    /// `.3de` positions are from the object's bounding-box centre (z from its bottom), so a
+    /// placement in model coordinates is moved by the box; one in that frame already is written
+    /// as it is. The file has no room for a bottom-side mirror or a body outline: a mirrored
+    /// part is written turned only. Parts in other objects than `bbox`'s are written in its
+    /// frame too (a `.3de` file describes one object).
+    pub fn to_3de(&self, circuit: &super::Circuit, bbox: &crate::geom::BoundingBox) -> String {
+        use std::fmt::Write as _;
+        let shift = match self.origin {
+            Origin::Model => [
+                (bbox.min[0] + bbox.max[0]) / 2.0,
+                (bbox.min[1] + bbox.max[1]) / 2.0,
+                bbox.min[2],
+            ],
+            Origin::BboxCenter => [0.0; 3],
+        };
+        let xyz = |x: f64, y: f64, z: f64| {
+            format!(
+                "X=\"{}\" Y=\"{}\" Z=\"{}\"",
+                num(x - shift[0]),
+                num(y - shift[1]),
+                num(z - shift[2])
+            )
+        };
+        let mut out = String::from("<?xml version=\"1.0\"?>\n<electronics version=\"1\">\n");
+        if let Some(source) = &self.source {
+            let _ = writeln!(out, "  <filename source=\"{}\"/>", attr(source));
+        }
+        out.push_str("  <parts>\n");
+        for p in &self.parts {
+            let package = circuit
+                .part(&p.name)
+                .map_or(String::new(), |c| c.package.clone());
+            let _ = writeln!(
+                out,
+                "    <part name=\"{}\" package=\"{}\">",
+                attr(&p.name),
+                attr(&package)
+            );
+            let method = match p.method {
+                PlacingMethod::Auto => "Automatic",
+                PlacingMethod::Manual => "Manual",
+                PlacingMethod::None => "None",
+            };
+            let connection = match p.connection {
+                Connection::None => "None",
+                Connection::Layer => "Layer",
+                Connection::Part => "Part",
+            };
+            let _ = writeln!(
+                out,
+                "      <attributes partHeight=\"{}\" footprintHeight=\"{}\" placed=\"1\" \
+                 placingMethod=\"{method}\" connectionMethod=\"{connection}\"/>",
+                num(p.body_height),
+                num(p.footprint_height)
+            );
+            let _ = writeln!(out, "      <position {}/>", xyz(p.x, p.y, p.z));
+            let _ = writeln!(
+                out,
+                "      <rotation X=\"{}\" Y=\"{}\" Z=\"{}\"/>",
+                num(p.tilt[0]),
+                num(p.tilt[1]),
+                num(p.rotation)
+            );
+            out.push_str("    </part>\n");
+        }
+        out.push_str("  </parts>\n  <nets>\n");
+        for net in &self.nets {
+            let _ = writeln!(out, "    <net name=\"{}\">", attr(&net.name));
+            out.push_str("      <waypoints>\n");
+            for w in &net.waypoints {
+                let _ = writeln!(
+                    out,
+                    "        <waypoint key=\"{}\"><position {}/></waypoint>",
+                    attr(&w.name),
+                    xyz(w.x, w.y, w.z)
+                );
+            }
+            out.push_str("      </waypoints>\n      <wires>\n");
+            for [a, b] in &net.wires {
+                let end = |tag: &str, e: &Endpoint| match e {
+                    Endpoint::Pin(pin) => format!(
+                        "<{tag} type=\"part\"><part name=\"{}\" pin=\"{}\"/></{tag}>",
+                        attr(&pin.part),
+                        attr(&pin.pad)
+                    ),
+                    Endpoint::Waypoint(key) => format!(
+                        "<{tag} type=\"waypoint\"><waypoint key=\"{}\"/></{tag}>",
+                        attr(key)
+                    ),
+                };
+                let _ = writeln!(
+                    out,
+                    "        <wire>{}{}</wire>",
+                    end("endpoint_a", a),
+                    end("endpoint_b", b)
+                );
+            }
+            out.push_str("      </wires>\n    </net>\n");
+        }
+        out.push_str("  </nets>\n</electronics>\n");
+        out
+    }
+}
+
+/// A number as the `.3de` writer writes it: shortest form that reads back exactly, `-0` as `0`.
+fn num(v: f64) -> String {
+    if v == 0.0 {
+        "0".to_owned()
+    } else {
+        format!("{v}")
+    }
+}
+
+/// `s` for a double-quoted XML attribute.
+fn attr(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
 /// `pugixml`'s boolean reading, which Electronic Slic3r writes `placed` with: true when the
 /// value starts with `1`, `t`, `T`, `y` or `Y`.
 fn xml_bool(v: &str) -> bool {
@@ -488,5 +613,38 @@ pub(crate) mod tests {
         }
         let deep = "<a>".repeat(100);
         assert!(err_text(parse_xml(&deep)).contains("nested too deep"));
+    }
+
+    #[test]
+    fn written_3de_reads_back_as_the_same_placement() {
+        let mut p = Placement::from_3de(THREE_DE).expect("reads");
+        p.skipped.clear();
+        let circuit = sample();
+        let bbox = crate::geom::BoundingBox {
+            min: [0.0, 0.0, 0.0],
+            max: [40.0, 30.0, 8.0],
+        };
+        // Already in the bounding-box frame: written as it is.
+        let xml = p.to_3de(&circuit, &bbox);
+        assert!(
+            xml.contains(r#"<part name="LED1" package="LED-0805">"#),
+            "{xml}"
+        );
+        assert_eq!(Placement::from_3de(&xml).expect("reads back"), p);
+        // In model coordinates: moved by the box's centre and bottom.
+        let mut model = p.clone();
+        model.origin = Origin::Model;
+        for part in &mut model.parts {
+            part.x += 20.0;
+            part.y += 15.0;
+        }
+        for w in model.nets.iter_mut().flat_map(|n| &mut n.waypoints) {
+            w.x += 20.0;
+            w.y += 15.0;
+        }
+        assert_eq!(
+            Placement::from_3de(&model.to_3de(&circuit, &bbox)).expect("reads back"),
+            p
+        );
     }
 }

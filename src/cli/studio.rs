@@ -1,6 +1,7 @@
 //! `conduit studio`: the 3D view served on 127.0.0.1, where a circuit's parts are placed by
 //! hand, checked against the solid as they move, routed by the same walk as `conduit slice
-//! --circuit`, and saved as the placement TOML that `--placement` reads.
+//! --circuit`, and saved as the placement TOML that `--placement` reads (or exported as
+//! Electronic Slic3r's `.3de`).
 //!
 //! The server listens on loopback only, answers only requests whose `Host` (and `Origin`, when
 //! sent) is its own address, and answers a malformed request with a 4xx and a JSON
@@ -124,6 +125,7 @@ pub(crate) fn run(args: StudioArgs) -> Result<(), Failure> {
             .route("/api/route", post(route))
             .route("/api/progress", get(progress))
             .route("/api/save", post(save))
+            .route("/api/export-3de", post(export_3de))
             .fallback(|| async { ApiError(StatusCode::NOT_FOUND, "no such page".into()) })
             .layer(middleware::from_fn_with_state(studio.clone(), guard))
             .with_state(studio);
@@ -422,4 +424,30 @@ async fn save(State(s): State<Shared>, Json(body): Json<Poses>) -> Result<Respon
     })?;
     store(&s, placement);
     Ok(Json(json!({ "path": s.save_path.display().to_string() })).into_response())
+}
+
+/// Writes the placement as Electronic Slic3r's `.3de` beside the save file (same name,
+/// `.3de`), positions from object 0's bounding-box centre.
+async fn export_3de(
+    State(s): State<Shared>,
+    Json(body): Json<Poses>,
+) -> Result<Response, ApiError> {
+    let (placement, _) = checked(&s, &body)?;
+    let bbox = s
+        .solid
+        .bboxes
+        .first()
+        .copied()
+        .ok_or_else(|| bad_request("the model has no object"))?;
+    let xml = placement.to_3de(&s.circuit, &bbox);
+    let path = s.save_path.with_extension("3de");
+    write_atomically(&path, |f| std::io::Write::write_all(f, xml.as_bytes())).map_err(
+        |e: std::io::Error| {
+            ApiError(
+                StatusCode::INTERNAL_SERVER_ERROR,
+                format!("{}: {e}", path.display()),
+            )
+        },
+    )?;
+    Ok(Json(json!({ "path": path.display().to_string() })).into_response())
 }

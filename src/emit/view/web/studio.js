@@ -133,6 +133,16 @@ async function route() {
   }
 }
 
+async function export3de() {
+  try {
+    const answer = await post('api/export-3de', { parts: poses() });
+    status.textContent = `exported ${answer.path}`;
+    window.conduitStudio.exports += 1;
+  } catch (e) {
+    status.textContent = `export failed: ${e.message}`;
+  }
+}
+
 async function save() {
   try {
     const answer = await post('api/save', { parts: poses() });
@@ -221,7 +231,8 @@ view.addSection(el('section', { id: 'studio' },
   el('h2', {}, 'Parts'),
   el('div', { class: 'buttons' },
     el('button', { id: 'route', onclick: route }, 'Route'),
-    el('button', { id: 'save', onclick: save }, 'Save')),
+    el('button', { id: 'save', onclick: save }, 'Save'),
+    el('button', { id: 'export-3de', onclick: export3de }, 'Export .3de')),
   status,
   el('div', { class: 'hint', title: studio.save_path },
     `Drag a part on its plane, or type its pose (${studio.origin} frame). Save writes ${studio.save_path.split(/[\\/]/).pop()}.`),
@@ -235,6 +246,7 @@ window.conduitStudio = {
   checks: 0,
   routes: 0,
   saves: 0,
+  exports: 0,
   flagged: () => studio.flagged.slice(),
   status: () => status.textContent,
 };
