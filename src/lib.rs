@@ -40,6 +40,7 @@
 //! - [`emit`]: writers — G-code (Marlin, RepRapFirmware, Klipper), robot programs, previews,
 //!   routing views.
 //! - [`check`]: replaying any G-code to find problems and measure it.
+//! - [`view`]: the 3D page of G-code, model and circuit (`conduit view`, `conduit studio`).
 //! - [`postprocess`]: slicer plugin mode — another slicer's G-code read into layers, the circuit
 //!   planned on them, the file rewritten, verified and reported.
 //!
@@ -72,6 +73,7 @@ pub mod robot;
 pub mod jet;
 pub mod emit;
 pub mod check;
+pub mod view;
 pub mod postprocess;
 
 // Walks.

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use crate::support::root;
 
 /// The stage modules: what `program/` must not name.
-const STAGES: [&str; 12] = [
+const STAGES: [&str; 13] = [
     "slice",
     "region",
     "circuit",
@@ -28,6 +28,7 @@ const STAGES: [&str; 12] = [
     "check",
     "pipeline",
     "postprocess",
+    "view",
 ];
 
 /// Every `.rs` file under `dir`, sorted.

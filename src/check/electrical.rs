@@ -63,7 +63,6 @@ use serde::Serialize;
 
 use conduit_gcode::{Gcode, Move, moves};
 
-use crate::circuit::events::part_event;
 use crate::circuit::stage::{
     Electronics, ElectronicsError, ElectronicsParams, PlacedCircuit, place_circuit,
 };
@@ -74,6 +73,7 @@ use crate::geom::{
 };
 use crate::program::Role;
 use crate::program::machine::Flavor;
+use conduit_gcode::events::part_event;
 
 /// What the electrical check is configured with.
 #[derive(Debug, Clone, PartialEq)]

@@ -13,7 +13,6 @@
 //! [`Circuit`] the pipeline uses.
 
 pub mod board_layout;
-pub mod events;
 pub mod fit;
 mod placed;
 mod placement;

@@ -29,10 +29,6 @@ use conduit::circuit::placement_toml::placement_toml;
 use conduit::circuit::{Circuit, Electronics, Placement};
 use conduit::config::Config;
 use conduit::emit::preview::layered_by_markers;
-use conduit::emit::view::studio::{PartPose, StudioView, apply_poses, poses};
-use conduit::emit::view::{
-    CircuitView, Entry, MeshView, ViewData, circuit_view, job_view, mesh_views, page_for,
-};
 use conduit::pipeline::place::{
     Auto, BottomChoice, Checked, FromBoard, PlaneChoice, Solid, check_placement, place_auto,
     place_from_board,
@@ -40,6 +36,10 @@ use conduit::pipeline::place::{
 use conduit::pipeline::{place_on_bed_with_offsets, slice_scene_watched};
 use conduit::route::RouteProgress;
 use conduit::scene::{Scene, write_atomically};
+use conduit::view::studio::{PartPose, StudioView, apply_poses, poses};
+use conduit::view::{
+    CircuitView, Entry, MeshView, ViewData, circuit_view, job_view, mesh_views, page_for,
+};
 
 /// Everything the server holds.
 struct Studio {

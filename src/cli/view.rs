@@ -9,9 +9,9 @@ use anyhow::Context;
 use conduit::check::{ElectricalParams, Frame, check, check_electrical, moves, place_in_frame};
 use conduit::circuit::{Circuit, Electronics, Placement};
 use conduit::emit::preview::layered_by_markers;
-use conduit::emit::view::{ViewData, circuit_view, job_view, mesh_views, page};
 use conduit::pipeline::{model_bboxes, place_on_bed_with_offsets};
 use conduit::scene::{LoadOptions, load_scene, write_atomically};
+use conduit::view::{ViewData, circuit_view, job_view, mesh_views, page};
 
 pub(crate) fn run(args: ViewArgs) -> Result<(), Failure> {
     let cfg = resolve(&args.config)?;

@@ -12,4 +12,3 @@ pub mod gcode;
 pub mod preview;
 pub mod robot;
 pub mod route_svg;
-pub mod view;

@@ -496,7 +496,7 @@ impl Problems {
 /// PART=<name>`, or the comment of a part that is not placed by the machine.
 fn event_part(line: &Line) -> Option<String> {
     let text = line.comment_text()?;
-    if let Some(event) = crate::circuit::events::part_event(text, line.number) {
+    if let Some(event) = conduit_gcode::events::part_event(text, line.number) {
         return Some(event.part);
     }
     text.strip_prefix("part ")

@@ -46,6 +46,7 @@
 //! # Ok::<(), conduit_gcode::GcodeError>(())
 //! ```
 
+pub mod events;
 mod line;
 pub mod machine;
 mod number;

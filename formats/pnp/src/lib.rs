@@ -9,6 +9,7 @@
 //!   importer's row pattern.
 //! - [`write_kicad_csv`] / [`read_kicad_csv`]: the same in KiCad's CSV layout
 //!   (`NAME-pos.csv`, `Ref,Val,Package,PosX,PosY,Rot,Side`).
+//! - [`octopnp::read_block`]: OctoPNP's part description in a G-code file's comments.
 //! - [`write_openpnp_board`] / [`read_openpnp_board`]: an OpenPnP `NAME.board.xml`
 //!   (`<openpnp-board version="1.1">`, placements version 1.4), parts the machine does not
 //!   place marked `enabled="false"`, each part's height in a comment.
@@ -35,6 +36,7 @@
 //! ```
 
 mod kicad;
+pub mod octopnp;
 mod openpnp;
 #[cfg(test)]
 mod tests;

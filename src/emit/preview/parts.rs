@@ -16,13 +16,13 @@
 //! follows it in the file (the layer of the next extruding move: the one printed over the
 //! part), with its outline turned by its rotation about its position into bed coordinates.
 //! Names in events have their spaces written as `_`; the description's names are matched so.
-//! The comments are read by [`crate::circuit::events`] and [`crate::circuit::octopnp::read_block`].
+//! The comments are read by [`conduit_gcode::events`] and [`conduit_pnp::octopnp::read_block`].
 //! Malformed comments are skipped, never an error: the previews draw what they can read.
 
 use conduit_gcode::{Gcode, Moves};
 
-use crate::circuit::events::part_events;
-use crate::circuit::octopnp::read_block;
+use conduit_gcode::events::part_events;
+use conduit_pnp::octopnp::read_block;
 
 /// How a part gets into the print.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,4 +1,4 @@
-// Decoding of the number streams the page carries (see src/emit/view/encode.rs): base64,
+// Decoding of the number streams the page carries (see src/view/encode.rs): base64,
 // LEB128 varints, zigzag deltas in micrometres, run-length pairs.
 
 /** Bytes of a base64 string. */

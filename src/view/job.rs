@@ -21,9 +21,9 @@ use serde::Serialize;
 
 use super::encode::{PositionStream, RunStream, varints_base64};
 use crate::check::{CheckReport, Severity};
-use crate::circuit::events::{PartEvent, part_events};
-use crate::circuit::octopnp::{OctoPart, read_block};
 use crate::emit::preview::{UNNAMED_ROLE, role_colour, tint};
+use conduit_gcode::events::{PartEvent, part_events};
+use conduit_pnp::octopnp::{OctoPart, read_block};
 
 /// Role name of the travel groups.
 pub const TRAVEL_ROLE: &str = "Travel";

@@ -1,12 +1,12 @@
 //! Part events as a G-code file carries them: the comment markers conduit writes where a part
 //! goes in, read back by the checks, post-processing and the previews.
 //!
-//! Place in the pipeline: the reader side of the markers `crate::emit::gcode` writes:
+//! The reader side of the markers conduit's G-code writer puts in:
 //! `;PICK_AND_PLACE PART=<name> X=<x> Y=<y> Z=<z> ROTATION=<deg>` before a machine placement
 //! and `;MANUAL_INSERT PART=<name>` before a pause for a person. Part names have their spaces
 //! written as `_`.
 
-use conduit_gcode::Gcode;
+use crate::Gcode;
 
 /// One part event of a G-code file.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -72,7 +72,7 @@ mod tests {
 
     #[test]
     fn both_markers_are_read_with_their_values() {
-        let g = conduit_gcode::parse(
+        let g = crate::parse(
             b"G1 X1\n;PICK_AND_PLACE PART=R1 X=137 Y=118.5 Z=4 ROTATION=90\nM0\n\
               ;MANUAL_INSERT PART=BAT_1\n; part R2 something else\n",
         )

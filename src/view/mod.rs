@@ -1,9 +1,10 @@
 //! The 3D view of a job: one self-contained HTML page that draws G-code toolpaths in 3D with
 //! three.js, with the model and the circuit when given.
 //!
-//! Place in the pipeline: the end of the line, beside `check` and `preview`. It reads G-code
-//! (conduit's or any other slicer's, planar, curved, conformal or jetted), replayed as
-//! `conduit check` replays it, and never reaches back into slicing.
+//! Place in the pipeline: the end of the line, after `check`. It reads G-code (conduit's or any
+//! other slicer's, planar, curved, conformal or jetted) replayed and measured by [`crate::check`],
+//! the placed circuit ([`crate::circuit`]) and meshes, and never reaches back into slicing or
+//! the config: the walks (`cli/`) hand it what it draws.
 //!
 //! - [`job`]: one G-code file as line buffers per feature role and tool, layers with times,
 //!   retraction and z-hop markers, part events, figures and warnings.
