@@ -319,3 +319,8 @@ pub fn rgb(img: &tiny_skia::Pixmap, x: f64, y: f64) -> [u8; 3] {
         .demultiply();
     [c.red(), c.green(), c.blue()]
 }
+
+/// A JSON number from the page.
+pub fn number(v: &Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}

@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use serde_json::Value;
 
-use crate::browser::Browser;
+use crate::browser::{Browser, number};
 use crate::support::{sample, temp_dir};
 
 /// The running server, stopped when dropped.
@@ -135,10 +135,6 @@ fn studio_refuses_other_hosts_origins_and_malformed_requests() {
         std::fs::read_to_string(&placement).expect("readable"),
         std::fs::read_to_string(sample("circuit_demo/placement.toml")).expect("readable")
     );
-}
-
-fn number(v: &Value) -> f64 {
-    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
 /// R1's pose in a placement TOML.

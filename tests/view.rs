@@ -10,7 +10,7 @@ use conduit::check::{Firmware, moves};
 use conduit::emit::preview::layered_by_markers;
 use serde_json::Value;
 
-use crate::browser::{Browser, rgb};
+use crate::browser::{Browser, number, rgb};
 use crate::support::{conduit, corpus, root, sample, stderr, temp_dir};
 
 /// Background of the 3D view (`renderer.setClearColor`).
@@ -33,10 +33,6 @@ fn segments_per_layer(gcode: &Path) -> Vec<usize> {
 fn view(args: &[&str]) {
     let out = conduit(args);
     assert!(out.status.success(), "conduit {args:?}: {}", stderr(&out));
-}
-
-fn number(v: &Value) -> f64 {
-    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
 #[test]

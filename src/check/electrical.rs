@@ -296,13 +296,16 @@ pub fn place_in_frame(
     params: &ElectricalParams,
 ) -> Result<PlacedCircuit, ElectronicsError> {
     let replay = moves(gcode, flavor);
-    let plastic: Vec<&Move> = replay
-        .moves
+    let (bboxes, offsets) = frame_boxes(frame, &plastic_of(&replay.moves, params), params);
+    place_circuit(e, &bboxes, &offsets, stage)
+}
+
+/// The plastic moves of a replay (see `is_plastic`).
+fn plastic_of<'a>(moves: &'a [Move], params: &ElectricalParams) -> Vec<&'a Move> {
+    moves
         .iter()
         .filter(|m| is_plastic(m, params.conductive_tool))
-        .collect();
-    let (bboxes, offsets) = frame_boxes(frame, &plastic, params);
-    place_circuit(e, &bboxes, &offsets, stage)
+        .collect()
 }
 
 /// Replays `gcode` (with the firmware of `flavor`) and checks the circuit of `e` in it, placed
@@ -320,11 +323,7 @@ pub fn check_electrical(
 ) -> Result<ElectricalReport, ElectronicsError> {
     let replay = moves(gcode, flavor);
     let heights = layer_heights(&replay.layer_z);
-    let plastic: Vec<&Move> = replay
-        .moves
-        .iter()
-        .filter(|m| is_plastic(m, params.conductive_tool))
-        .collect();
+    let plastic = plastic_of(&replay.moves, params);
     let (bboxes, offsets) = frame_boxes(frame, &plastic, params);
     let placed = place_circuit(e, &bboxes, &offsets, stage)?;
     let nets: Vec<String> = e.circuit.nets.iter().map(|n| n.name.clone()).collect();
