@@ -26,13 +26,21 @@ impl Drop for Server {
 }
 
 fn start(placement: &std::path::Path) -> Server {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_conduit"))
+    start_with("circuit_demo/led_coin.sch", Some(placement))
+}
+
+/// The studio of the demo block with `circuit` (a sample) and, when given, `placement`.
+fn start_with(circuit: &str, placement: Option<&std::path::Path>) -> Server {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_conduit"));
+    command
         .arg("studio")
         .arg(sample("circuit_demo/block.stl"))
         .arg("--circuit")
-        .arg(sample("circuit_demo/led_coin.sch"))
-        .arg("--placement")
-        .arg(placement)
+        .arg(sample(circuit));
+    if let Some(p) = placement {
+        command.arg("--placement").arg(p);
+    }
+    let mut child = command
         .args(["--port", "0"])
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
@@ -294,4 +302,44 @@ fn studio_drag_saves_the_move_flags_a_part_outside_and_routes() {
     let shot = browser.keep_screenshot("studio_routed");
     crate::view::write_picture("studio.png", || shot.encode_png().expect("encodes"));
     assert_eq!(browser.console_errors(), Vec::<String>::new());
+}
+
+/// The studio's data in its page.
+fn page_data(page: &str) -> Value {
+    let start = page
+        .find(r#"<script type="application/json" id="conduit-data">"#)
+        .expect("the data element")
+        + r#"<script type="application/json" id="conduit-data">"#.len();
+    let end = start + page[start..].find("</script>").expect("its end");
+    serde_json::from_str(&page[start..end]).expect("the data is JSON")
+}
+
+#[test]
+fn studio_starts_from_the_board_layout_or_packs_the_parts() {
+    for circuit in ["circuit_demo/led_coin.brd", "circuit_demo/led_coin.sch"] {
+        let server = start_with(circuit, None);
+        let (status, page) = request(server.port, "GET", "/", &[], "");
+        assert_eq!(status, 200, "{circuit}");
+        let data = page_data(&page);
+        let mut names: Vec<&str> = data["studio"]["parts"]
+            .as_array()
+            .expect("parts")
+            .iter()
+            .map(|p| p["name"].as_str().unwrap_or_default())
+            .collect();
+        names.sort_unstable();
+        assert_eq!(names, ["BAT1", "LED1", "R1"], "{circuit}");
+        assert_eq!(
+            data["studio"]["flagged"],
+            Value::Array(Vec::new()),
+            "{circuit}: every part fits: {}",
+            data["studio"]["problems"]
+        );
+        // Every wire is a rubberband before the first route.
+        assert_eq!(
+            data["circuit"]["unrouted"].as_array().map(Vec::len),
+            data["circuit"]["wires"].as_u64().map(|n| n as usize),
+            "{circuit}"
+        );
+    }
 }
