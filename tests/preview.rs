@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::support::{conduit, corpus, files_in, sample, stderr, stdout, temp_dir};
+use crate::support::{conduit, corpus, files_in, slice_circuit_demo, stderr, stdout, temp_dir};
 
 #[test]
 fn preview_of_a_prusaslicer_cube_writes_100_svgs_and_a_sheet() {
@@ -293,18 +293,7 @@ fn preview_of_the_circuit_demo_labels_its_parts_and_draws_traces_in_their_colour
     use conduit::emit::preview::{TRACE_COLOUR, tint};
     let tmp = temp_dir();
     let gcode = tmp.path().join("demo.gcode");
-    let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
-    let run = conduit([
-        "slice".as_ref(),
-        demo("block.stl").as_os_str(),
-        "--circuit".as_ref(),
-        demo("led_coin.sch").as_os_str(),
-        "--placement".as_ref(),
-        demo("placement.toml").as_os_str(),
-        "-o".as_ref(),
-        gcode.as_os_str(),
-    ]);
-    assert!(run.status.success(), "{}", stderr(&run));
+    slice_circuit_demo(&gcode, &[]);
     let out = tmp.path().join("preview");
     let run = preview(&gcode, &out);
     assert!(run.status.success(), "{}", stderr(&run));

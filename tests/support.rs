@@ -49,6 +49,29 @@ where
         .expect("the conduit binary runs")
 }
 
+/// Slices the circuit demo (block, LED coin circuit, its placement) into `gcode`, with `extra`
+/// arguments; panics with conduit's message when it fails.
+pub fn slice_circuit_demo(gcode: &Path, extra: &[&str]) {
+    let demo = |f: &str| sample(&format!("circuit_demo/{f}"));
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "slice".into(),
+        demo("block.stl").into(),
+        "--circuit".into(),
+        demo("led_coin.sch").into(),
+        "--placement".into(),
+        demo("placement.toml").into(),
+        "-o".into(),
+        gcode.into(),
+    ];
+    args.extend(extra.iter().map(Into::into));
+    let out = conduit(&args);
+    assert!(
+        out.status.success(),
+        "slicing the circuit demo: {}",
+        stderr(&out)
+    );
+}
+
 /// Stdout of a run as text.
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()

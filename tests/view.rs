@@ -11,7 +11,7 @@ use conduit::emit::preview::layered_by_markers;
 use serde_json::Value;
 
 use crate::browser::{Browser, number, rgb};
-use crate::support::{conduit, corpus, root, sample, stderr, temp_dir};
+use crate::support::{conduit, corpus, root, sample, slice_circuit_demo, stderr, temp_dir};
 
 /// Background of the 3D view (`renderer.setClearColor`).
 const BACKGROUND: [u8; 3] = [0x26, 0x2a, 0x31];
@@ -271,16 +271,7 @@ fn demo_view_shows_the_traces_in_their_own_colour_and_the_parts_labelled() {
         s("circuit_demo/led_coin.sch"),
         s("circuit_demo/placement.toml"),
     );
-    view(&[
-        "slice",
-        &block,
-        "--circuit",
-        &sch,
-        "--placement",
-        &placement,
-        "-o",
-        &g,
-    ]);
+    slice_circuit_demo(&gcode, &[]);
     view(&[
         "view",
         &g,
