@@ -58,9 +58,14 @@ function buildGroup(g, layerCount) {
   lines.frustumCulled = false;
   lines.visible = !g.travel;
   lines.userData = { group: g };
+  // Conductive beads are few and are what an electronics job is about: they are also drawn at
+  // their true width as flat ribbons, so a trace reads at any zoom, not as a 1 px line.
+  const ribbon = /conductive/i.test(g.role) ? buildRibbon(pos, width, s, g.colour) : null;
+  if (ribbon) lines.add(ribbon);
   return {
     info: g,
     lines,
+    ribbon,
     segments: s,
     segLayer,
     layerStart,
@@ -70,12 +75,33 @@ function buildGroup(g, layerCount) {
   };
 }
 
+/** Two triangles per segment, `width` µm wide (0.4 mm when not given), at the segment's z. */
+function buildRibbon(pos, width, count, colour) {
+  const tri = new Float32Array(count * 18);
+  for (let i = 0; i < count; i++) {
+    const [ax, ay, az, bx, by, bz] = pos.subarray(i * 6, i * 6 + 6);
+    const len = Math.hypot(bx - ax, by - ay) || 1;
+    const half = (width[i] > 0 ? width[i] / 1000 : 0.4) / 2;
+    const nx = (-(by - ay) / len) * half;
+    const ny = ((bx - ax) / len) * half;
+    tri.set([ax + nx, ay + ny, az, ax - nx, ay - ny, az, bx + nx, by + ny, bz,
+      bx + nx, by + ny, bz, ax - nx, ay - ny, az, bx - nx, by - ny, bz], i * 18);
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(tri, 3));
+  const mesh = new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({ color: colour, side: THREE.DoubleSide }));
+  mesh.frustumCulled = false;
+  mesh.name = 'ribbon';
+  return mesh;
+}
+
 /** Sets the drawn layers [from, to] (0-based, inclusive) of every group. */
 export function setLayerRange(groups, from, to) {
   for (const g of groups) {
     const a = g.layerStart[Math.min(from, g.layerStart.length - 1)];
     const b = g.layerStart[Math.min(to + 1, g.layerStart.length - 1)];
     g.lines.geometry.setDrawRange(a * 2, Math.max(0, b - a) * 2);
+    if (g.ribbon) g.ribbon.geometry.setDrawRange(a * 6, Math.max(0, b - a) * 6);
     g.drawn = Math.max(0, b - a);
   }
 }
@@ -149,6 +175,11 @@ export function colourBy(groups, mode, layerTimes) {
       c.set(col, i * 6 + 3);
     }
     attr.needsUpdate = true;
+    if (g.ribbon) {
+      // The ribbons carry the feature or tool colour; in the ramp modes the lines alone do.
+      g.ribbon.visible = mode === 'feature' || mode === 'tool';
+      g.ribbon.material.color.set(mode === 'tool' ? toolColour(g.info.tool) : g.info.colour);
+    }
   }
   return range;
 }
