@@ -90,6 +90,22 @@ fn cube_view_draws_the_cube_and_the_slider_shows_layer_one() {
         let (x, y) = (cx + dx * 14.0, cy + dy * 14.0);
         assert_eq!(at(x, y), BACKGROUND, "nothing is drawn at ({x:.1}, {y:.1})");
     }
+    // The drawing uses the legend's colours exactly (no gamma shift): the outer walls' orange.
+    let outer = browser.eval(
+        "return JSON.parse(document.getElementById('conduit-data').textContent).jobs[0].groups \
+         .find((g) => g.role === 'External perimeter').colour;",
+    );
+    let hex = u32::from_str_radix(
+        outer.as_str().expect("a colour").trim_start_matches('#'),
+        16,
+    )
+    .expect("hex");
+    let want = [(hex >> 16) as u8, (hex >> 8) as u8, hex as u8];
+    let exact = (0..img.height())
+        .flat_map(|y| (0..img.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| rgb(&img, f64::from(x), f64::from(y)) == want)
+        .count();
+    assert!(exact >= 200, "{exact} pixels of {outer}");
 
     // The "to" slider moved to its start by the keyboard: layer 1 alone.
     let per_layer = segments_per_layer(&gcode);

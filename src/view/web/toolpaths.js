@@ -46,8 +46,9 @@ function buildGroup(g, layerCount) {
 
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-  const colour = new Uint8Array(s * 6);
-  geometry.setAttribute('color', new THREE.BufferAttribute(colour, 3, true));
+  // Linear colours (three.js works in linear light and encodes the output as sRGB).
+  const colour = new Float32Array(s * 6);
+  geometry.setAttribute('color', new THREE.BufferAttribute(colour, 3));
   geometry.computeBoundingSphere();
   const material = new THREE.LineBasicMaterial({
     vertexColors: true,
@@ -171,8 +172,9 @@ export function colourBy(groups, mode, layerTimes) {
           col = v > 0 ? ramp((v - range.min) / (range.max - range.min || 1)) : [0x80, 0x80, 0x80];
         }
       }
-      c.set(col, i * 6);
-      c.set(col, i * 6 + 3);
+      const lin = linear(col);
+      c.set(lin, i * 6);
+      c.set(lin, i * 6 + 3);
     }
     attr.needsUpdate = true;
     if (g.ribbon) {
@@ -182,6 +184,20 @@ export function colourBy(groups, mode, layerTimes) {
     }
   }
   return range;
+}
+
+const linearCache = new Map();
+
+/** An sRGB colour [r, g, b] (0–255) in three.js's linear working space, [r, g, b] in 0–1. */
+function linear(col) {
+  const key = (col[0] << 16) | (col[1] << 8) | col[2];
+  let v = linearCache.get(key);
+  if (!v) {
+    const c = new THREE.Color().setRGB(col[0] / 255, col[1] / 255, col[2] / 255, THREE.SRGBColorSpace);
+    v = [c.r, c.g, c.b];
+    linearCache.set(key, v);
+  }
+  return v;
 }
 
 function value(g, i, mode, layerTimes) {
