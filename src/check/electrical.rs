@@ -221,6 +221,10 @@ pub struct ElectricalReport {
     pub floating_beads: usize,
     /// Net pins on parts the placement does not place (`NET: PART.PAD`): not checked.
     pub unplaced_pins: Vec<String>,
+    /// The circuit as the check placed it: parts and wires in bed coordinates (the 3D view
+    /// draws them). Not serialised.
+    #[serde(skip)]
+    pub placed: PlacedCircuit,
 }
 
 impl ElectricalReport {
@@ -282,24 +286,6 @@ fn frame_boxes(
     }
 }
 
-/// The circuit of `e` placed on the bed as [`check_electrical`] places it in `frame`: parts
-/// and rubberbands in bed coordinates.
-///
-/// # Errors
-/// The placement does not fit the circuit or the frame ([`ElectronicsError`]).
-pub fn place_in_frame(
-    gcode: &Gcode,
-    flavor: Flavor,
-    e: &Electronics,
-    frame: &Frame,
-    stage: &ElectronicsParams,
-    params: &ElectricalParams,
-) -> Result<PlacedCircuit, ElectronicsError> {
-    let replay = moves(gcode, flavor);
-    let (bboxes, offsets) = frame_boxes(frame, &plastic_of(&replay.moves, params), params);
-    place_circuit(e, &bboxes, &offsets, stage)
-}
-
 /// The plastic moves of a replay (see `is_plastic`).
 fn plastic_of<'a>(moves: &'a [Move], params: &ElectricalParams) -> Vec<&'a Move> {
     moves
@@ -348,6 +334,7 @@ pub fn check_electrical(
             .iter()
             .map(|(net, pin)| format!("{net}: {pin}"))
             .collect(),
+        placed: PlacedCircuit::default(),
     };
     let labels = graph.labels(&terminals, beads.len());
     report.floating_beads = labels[..beads.len()].iter().filter(|l| l.is_none()).count();
@@ -363,6 +350,7 @@ pub fn check_electrical(
     let (problems, found) = event_problems(gcode, &placed.parts, &plastic, &heights, params);
     report.events = problems;
     report.events_found = found;
+    report.placed = placed;
     Ok(report)
 }
 
@@ -1113,18 +1101,19 @@ fn lid_before(part: &PlacedPart, top: f64, before: &[&Move], heights: &[f64]) ->
     })
 }
 
-impl fmt::Display for ElectricalReport {
-    /// The text summary: one line per problem, then the counts.
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl ElectricalReport {
+    /// One line per problem (open nets, shorts, conductive material outside the solid, event
+    /// problems, and how many more were found than listed), as `conduit check` prints them.
+    pub fn problem_lines(&self) -> Vec<String> {
+        let mut lines = Vec::new();
         for n in self.open_nets() {
             let groups: Vec<String> = n.groups.iter().map(|g| g.join(" ")).collect();
-            writeln!(
-                f,
+            lines.push(format!(
                 "open: net {} is in {} pieces: {}",
                 n.net,
                 n.groups.len(),
                 groups.join(" | ")
-            )?;
+            ));
         }
         for s in &self.shorts {
             let what = if s.touching {
@@ -1132,8 +1121,7 @@ impl fmt::Display for ElectricalReport {
             } else {
                 format!("are {:.3} mm apart", s.gap)
             };
-            writeln!(
-                f,
+            lines.push(format!(
                 "short: nets {} and {} {what} at ({:.3}, {:.3}, z {:.3}){}",
                 s.nets[0],
                 s.nets[1],
@@ -1145,18 +1133,16 @@ impl fmt::Display for ElectricalReport {
                 } else {
                     String::new()
                 }
-            )?;
+            ));
         }
         if self.short_count > self.shorts.len() {
-            writeln!(
-                f,
+            lines.push(format!(
                 "... and {} more shorts",
                 self.short_count - self.shorts.len()
-            )?;
+            ));
         }
         for r in &self.outside {
-            writeln!(
-                f,
+            lines.push(format!(
                 "outside: {:.2} mm of conductive material {} from ({:.3}, {:.3}, z {:.3}), line {}",
                 r.length,
                 if r.above_top {
@@ -1168,17 +1154,26 @@ impl fmt::Display for ElectricalReport {
                 r.at[1],
                 r.at[2],
                 r.line
-            )?;
+            ));
         }
         if self.outside_count > self.outside.len() {
-            writeln!(
-                f,
+            lines.push(format!(
                 "... and {} more runs outside",
                 self.outside_count - self.outside.len()
-            )?;
+            ));
         }
         for e in &self.events {
-            writeln!(f, "event: {}", e.message)?;
+            lines.push(format!("event: {}", e.message));
+        }
+        lines
+    }
+}
+
+impl fmt::Display for ElectricalReport {
+    /// The text summary: one line per problem, then the counts.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for line in self.problem_lines() {
+            writeln!(f, "{line}")?;
         }
         if !self.unplaced_pins.is_empty() {
             writeln!(

@@ -63,7 +63,7 @@ mod machine;
 mod time;
 
 pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves};
-pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical, place_in_frame};
+pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical};
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -89,10 +89,13 @@ impl Planner {
         let a = self.accel;
         let b = &self.blocks;
         if !(a > 0.0 && a.is_finite()) {
+            let mut t = 0.0;
             for k in b {
-                self.times.push((k.line, k.length / k.speed));
+                let dt = k.length / k.speed;
+                self.times.push((k.line, dt));
+                t += dt;
             }
-            self.total += b.iter().map(|k| k.length / k.speed).sum::<f64>();
+            self.total += t;
             self.blocks.clear();
             return;
         }

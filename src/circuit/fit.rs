@@ -205,23 +205,18 @@ pub fn placement_problems(
     found
         .problems
         .extend(collided.iter().map(|(_, _, m)| m.clone()));
-    let mut flagged = vec![false; parts.len()];
-    for (i, seat) in seated.iter().enumerate() {
-        flagged[i] |= seat.is_some();
-    }
+    let mut flagged: Vec<bool> = seated.iter().map(Option::is_some).collect();
     for (i, j, _) in &collided {
         flagged[*i] = true;
         flagged[*j] = true;
     }
-    for (part, seat) in parts.iter().zip(&seated) {
+    for (i, (part, seat)) in parts.iter().zip(&seated).enumerate() {
         if seat.is_some() {
             continue;
         }
         if let Some(problem) = body_problem(part, islands, zs, last) {
             found.problems.push(problem);
-            if let Some(i) = parts.iter().position(|p| std::ptr::eq(*p, *part)) {
-                flagged[i] = true;
-            }
+            flagged[i] = true;
             continue;
         }
         let layer = seat_layer(zs, part.position.z);

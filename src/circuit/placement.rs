@@ -27,7 +27,7 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use super::{Circuit, PinRef};
 
@@ -48,7 +48,7 @@ pub const MAX_PART_SIZE_MM: f64 = 1_000.0;
 pub const MAX_ANGLE_DEG: f64 = 3_600.0;
 
 /// What part and waypoint coordinates are relative to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Origin {
     /// Model coordinates of the part's object (the frame of its mesh file).
@@ -61,7 +61,7 @@ pub enum Origin {
 }
 
 /// How a part gets into the object when the print pauses for it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PlacingMethod {
     /// Picked and placed by the machine.

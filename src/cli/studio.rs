@@ -24,11 +24,10 @@ use serde::Deserialize;
 use serde_json::json;
 
 use super::{Failure, args::StudioArgs, config::resolve};
-use conduit::check::{ElectricalParams, Frame, check, check_electrical, moves};
+use conduit::check::Frame;
 use conduit::circuit::placement_toml::placement_toml;
 use conduit::circuit::{Circuit, Electronics, Placement};
 use conduit::config::Config;
-use conduit::emit::preview::layered_by_markers;
 use conduit::pipeline::place::{
     Auto, BottomChoice, Checked, FromBoard, PlaneChoice, Solid, check_placement, place_auto,
     place_from_board,
@@ -38,7 +37,7 @@ use conduit::route::RouteProgress;
 use conduit::scene::{Scene, write_atomically};
 use conduit::view::studio::{PartPose, StudioView, apply_poses, poses};
 use conduit::view::{
-    CircuitView, Entry, MeshView, ViewData, circuit_view, job_view, mesh_views, page_for,
+    CircuitView, Entry, MeshView, ViewData, circuit_of, circuit_view, job_of, mesh_views, page_for,
 };
 
 /// Everything the server holds.
@@ -266,10 +265,7 @@ fn unrouted_view(s: &Studio, c: &Checked) -> CircuitView {
 fn studio_view(s: &Studio, placement: &Placement, c: &Checked) -> StudioView {
     StudioView {
         parts: poses(placement),
-        origin: match placement.origin {
-            conduit::circuit::Origin::Model => "model",
-            conduit::circuit::Origin::BboxCenter => "bbox_center",
-        },
+        origin: placement.origin,
         flagged: c.findings.flagged.clone(),
         problems: c.findings.problems.clone(),
         notes: c.findings.notes.clone(),
@@ -287,19 +283,12 @@ async fn index(State(s): State<Shared>) -> Result<Html<String>, ApiError> {
     };
     let title = format!(
         "{} in {} — conduit studio",
-        file_name(&s.circuit_path),
-        file_name(&s.model_path)
+        super::view::file_name(&s.circuit_path),
+        super::view::file_name(&s.model_path)
     );
     page_for(&data, &title, Entry::Studio)
         .map(Html)
         .map_err(|e| ApiError(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))
-}
-
-fn file_name(p: &Path) -> String {
-    p.file_name().map_or_else(
-        || p.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    )
 }
 
 async fn place(State(s): State<Shared>, Json(body): Json<Poses>) -> Result<Response, ApiError> {
@@ -374,21 +363,20 @@ fn route_now(s: &Studio, placement: Placement) -> Result<serde_json::Value, ApiE
         .map_err(|e| ApiError(StatusCode::UNPROCESSABLE_ENTITY, format!("{e:#}")))?;
     let parsed = conduit_gcode::parse(&gcode).map_err(bad_request)?;
     let params = s.cfg.check_params();
-    let replay = layered_by_markers(&parsed, moves(&parsed, params.flavor));
-    let report = check(&parsed, &params);
-    let job = job_view("routed.gcode", &parsed, &replay, &report);
+    let job = job_of("routed.gcode", &parsed, &params)
+        .ok_or_else(|| bad_request("the routed G-code has no move with X or Y"))?;
     let frame = Frame::Objects {
         bboxes: s.solid.bboxes.clone(),
         offsets: s.solid.offsets.clone(),
     };
-    let stage = s.cfg.electronics_params();
-    let eparams = ElectricalParams::of(&stage);
-    let placed =
-        conduit::check::place_in_frame(&parsed, params.flavor, &e, &frame, &stage, &eparams)
-            .map_err(bad_request)?;
-    let electrical = check_electrical(&parsed, params.flavor, &e, &frame, &stage, &eparams)
-        .map_err(bad_request)?;
-    let circuit = circuit_view(&placed, Some(&electrical), stage.cavity_offset);
+    let circuit = circuit_of(
+        &parsed,
+        params.flavor,
+        &e,
+        &frame,
+        &s.cfg.electronics_params(),
+    )
+    .map_err(bad_request)?;
     let summary = format!(
         "routed: {} of {} wires connected, {} layers",
         circuit.wires - circuit.unrouted.len(),
@@ -402,8 +390,8 @@ async fn save(State(s): State<Shared>, Json(body): Json<Poses>) -> Result<Respon
     let (placement, found) = checked(&s, &body)?;
     let mut header = vec![format!(
         "placement of {} in {}, placed by hand in conduit studio",
-        file_name(&s.circuit_path),
-        file_name(&s.model_path)
+        super::view::file_name(&s.circuit_path),
+        super::view::file_name(&s.model_path)
     )];
     header.extend(
         found
@@ -413,17 +401,9 @@ async fn save(State(s): State<Shared>, Json(body): Json<Poses>) -> Result<Respon
             .map(|p| format!("problem: {p}")),
     );
     let toml = placement_toml(&placement, &header, |_| None);
-    write_atomically(&s.save_path, |f| {
-        std::io::Write::write_all(f, toml.as_bytes())
-    })
-    .map_err(|e: std::io::Error| {
-        ApiError(
-            StatusCode::INTERNAL_SERVER_ERROR,
-            format!("{}: {e}", s.save_path.display()),
-        )
-    })?;
+    let answer = write_file(&s.save_path, toml.as_bytes())?;
     store(&s, placement);
-    Ok(Json(json!({ "path": s.save_path.display().to_string() })).into_response())
+    Ok(answer)
 }
 
 /// Writes the placement as Electronic Slic3r's `.3de` beside the save file (same name,
@@ -440,8 +420,12 @@ async fn export_3de(
         .copied()
         .ok_or_else(|| bad_request("the model has no object"))?;
     let xml = placement.to_3de(&s.circuit, &bbox);
-    let path = s.save_path.with_extension("3de");
-    write_atomically(&path, |f| std::io::Write::write_all(f, xml.as_bytes())).map_err(
+    write_file(&s.save_path.with_extension("3de"), xml.as_bytes())
+}
+
+/// Writes `bytes` to `path` whole or not at all; the answer names the file.
+fn write_file(path: &Path, bytes: &[u8]) -> Result<Response, ApiError> {
+    write_atomically(path, |f| std::io::Write::write_all(f, bytes)).map_err(
         |e: std::io::Error| {
             ApiError(
                 StatusCode::INTERNAL_SERVER_ERROR,

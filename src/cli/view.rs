@@ -6,12 +6,10 @@ use std::path::{Path, PathBuf};
 
 use super::{Failure, args::ViewArgs, config::resolve};
 use anyhow::Context;
-use conduit::check::{ElectricalParams, Frame, check, check_electrical, moves, place_in_frame};
-use conduit::circuit::{Circuit, Electronics, Placement};
-use conduit::emit::preview::layered_by_markers;
+use conduit::check::Frame;
 use conduit::pipeline::{model_bboxes, place_on_bed_with_offsets};
 use conduit::scene::{LoadOptions, load_scene, write_atomically};
-use conduit::view::{ViewData, circuit_view, job_view, mesh_views, page};
+use conduit::view::{ViewData, circuit_of, job_of, mesh_views, page};
 
 pub(crate) fn run(args: ViewArgs) -> Result<(), Failure> {
     let cfg = resolve(&args.config)?;
@@ -21,20 +19,10 @@ pub(crate) fn run(args: ViewArgs) -> Result<(), Failure> {
     for file in &args.files {
         let bytes = super::check::read_gcode_file(file)?;
         let gcode = conduit_gcode::parse(&bytes).with_context(|| format!("{}", file.display()))?;
-        let replay = layered_by_markers(&gcode, moves(&gcode, params.flavor));
-        if replay.moves.iter().all(|m| !m.has_xy) {
-            return Err(anyhow::anyhow!(
-                "{}: no move with X or Y: nothing to show",
-                file.display()
-            )
-            .into());
-        }
-        let report = check(&gcode, &params);
-        let name = file.file_name().map_or_else(
-            || file.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
-        jobs.push(job_view(&name, &gcode, &replay, &report));
+        let job = job_of(&file_name(file), &gcode, &params).ok_or_else(|| {
+            anyhow::anyhow!("{}: no move with X or Y: nothing to show", file.display())
+        })?;
+        jobs.push(job);
         if first_gcode.is_none() {
             first_gcode = Some(gcode);
         }
@@ -55,17 +43,11 @@ pub(crate) fn run(args: ViewArgs) -> Result<(), Failure> {
 
     let mut circuit = None;
     if let (Some(c), Some(p), Some(gcode)) = (&args.circuit, &args.placement, &first_gcode) {
-        let e = Electronics {
-            circuit: Circuit::load(c).map_err(anyhow::Error::from)?,
-            placement: Placement::load(p).map_err(anyhow::Error::from)?,
-        };
-        let stage = cfg.electronics_params();
-        let eparams = ElectricalParams::of(&stage);
-        let placed = place_in_frame(gcode, params.flavor, &e, &frame, &stage, &eparams)
-            .with_context(|| format!("{}", p.display()))?;
-        let report = check_electrical(gcode, params.flavor, &e, &frame, &stage, &eparams)
-            .with_context(|| format!("{}", p.display()))?;
-        circuit = Some(circuit_view(&placed, Some(&report), stage.cavity_offset));
+        let e = super::slice::load_electronics(c, p)?;
+        circuit = Some(
+            circuit_of(gcode, params.flavor, &e, &frame, &cfg.electronics_params())
+                .with_context(|| format!("{}", p.display()))?,
+        );
     }
 
     let data = ViewData {
@@ -121,6 +103,14 @@ pub(crate) fn run(args: ViewArgs) -> Result<(), Failure> {
         open_in_browser(&out);
     }
     Ok(())
+}
+
+/// The file name of `path` (the whole path when it has none).
+pub(crate) fn file_name(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
 }
 
 /// `-o`, else the first file with `.html` for its extension.

@@ -20,8 +20,8 @@ use conduit_gcode::{Gcode, Move, Moves};
 use serde::Serialize;
 
 use super::encode::{PositionStream, RunStream, varints_base64};
-use crate::check::{CheckReport, Severity};
-use crate::emit::preview::{UNNAMED_ROLE, role_colour, tint};
+use crate::check::{CheckParams, CheckReport, Severity, check, moves};
+use crate::emit::preview::{CUSTOM_ROLE, UNNAMED_ROLE, layered_by_markers, role_colour, tint};
 use conduit_gcode::events::{PartEvent, part_events};
 use conduit_pnp::octopnp::{OctoPart, read_block};
 
@@ -85,6 +85,30 @@ pub struct EventView {
     pub layer: usize,
 }
 
+/// A part of the file's OctoPNP block, as the page draws it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BlockPart {
+    /// Part name.
+    pub name: String,
+    /// Outline on the bed, mm.
+    pub outline: Vec<[f64; 2]>,
+    /// Seating plane, mm.
+    pub z: f64,
+    /// Body height, mm.
+    pub height: f64,
+}
+
+impl BlockPart {
+    fn of(p: &OctoPart) -> Self {
+        Self {
+            name: p.name.clone(),
+            outline: p.outline_on_bed(),
+            z: p.destination[2],
+            height: p.height,
+        }
+    }
+}
+
 /// Tool usage line of the figures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ToolFigure {
@@ -137,7 +161,7 @@ pub struct JobView {
     /// Part events, in file order.
     pub events: Vec<EventView>,
     /// Parts of the file's OctoPNP block (conduit's G-code with machine-placed parts).
-    pub parts: Vec<OctoPart>,
+    pub parts: Vec<BlockPart>,
     /// Figures for the side panel.
     pub figures: Figures,
     /// Findings and notes to list: `line N: message` (errors first).
@@ -163,10 +187,22 @@ struct GroupBuild {
     runs: Vec<Run>,
 }
 
+/// The view of `gcode` replayed as `conduit check` replays it with `params` (layers numbered
+/// as the previews number them), or `None` when no move has X or Y: nothing to draw.
+pub fn job_of(name: &str, gcode: &Gcode, params: &CheckParams) -> Option<JobView> {
+    let replay = layered_by_markers(gcode, moves(gcode, params.flavor));
+    if replay.moves.iter().all(|m| !m.has_xy) {
+        return None;
+    }
+    Some(job_view(name, gcode, &replay, &check(gcode, params)))
+}
+
 /// Builds the view of one file. `moves` are the replayed moves of `gcode` (layered as the
 /// previews layer them), `report` its check.
 pub fn job_view(name: &str, gcode: &Gcode, moves: &Moves, report: &CheckReport) -> JobView {
     let mut keys: Vec<(Option<String>, usize)> = Vec::new();
+    // Extrusion roles in order of first appearance: the index picks a palette colour.
+    let mut roles: Vec<String> = Vec::new();
     let mut groups: Vec<GroupBuild> = Vec::new();
     let mut last_group: Option<usize> = None;
     let mut part_box: Option<[f64; 6]> = None;
@@ -176,15 +212,11 @@ pub fn job_view(name: &str, gcode: &Gcode, moves: &Moves, report: &CheckReport) 
             last_group = None;
             continue;
         };
-        if !m.has_xy {
-            last_group = None;
-            continue;
-        }
         let role = m
             .extruding
             .then(|| m.role.as_deref().unwrap_or(UNNAMED_ROLE).to_owned());
         if let Some(r) = &role {
-            let frame = if r == "Custom" {
+            let frame = if r == CUSTOM_ROLE {
                 &mut custom_box
             } else {
                 &mut part_box
@@ -196,6 +228,9 @@ pub fn job_view(name: &str, gcode: &Gcode, moves: &Moves, report: &CheckReport) 
                     b[k + 3] = b[k + 3].max(p[k]);
                 }
             }
+        }
+        if let Some(r) = role.as_ref().filter(|r| !roles.contains(r)) {
+            roles.push(r.clone());
         }
         let key = (role, m.tool);
         let g = match keys.iter().position(|k| *k == key) {
@@ -236,17 +271,6 @@ pub fn job_view(name: &str, gcode: &Gcode, moves: &Moves, report: &CheckReport) 
     // Extrusions first in role order of appearance, travels last; then by tool.
     let mut order: Vec<usize> = (0..keys.len()).collect();
     order.sort_by_key(|&i| (keys[i].0.is_none(), i));
-    let role_index = |name: &str| -> usize {
-        let mut seen: Vec<&str> = Vec::new();
-        for (r, _) in &keys {
-            if let Some(r) = r.as_deref()
-                && !seen.contains(&r)
-            {
-                seen.push(r);
-            }
-        }
-        seen.iter().position(|r| *r == name).unwrap_or(0)
-    };
     let mut group_views = Vec::with_capacity(keys.len());
     for i in order {
         let (role, tool) = &keys[i];
@@ -257,7 +281,10 @@ pub fn job_view(name: &str, gcode: &Gcode, moves: &Moves, report: &CheckReport) 
         }
         runs.sort_by_key(|r| r.layer);
         let colour = match role {
-            Some(name) => tint(role_colour(name, role_index(name)), *tool),
+            Some(name) => tint(
+                role_colour(name, roles.iter().position(|r| r == name).unwrap_or(0)),
+                *tool,
+            ),
             None => crate::emit::preview::TRAVEL_COLOUR,
         };
         group_views.push(encode_group(
@@ -274,7 +301,7 @@ pub fn job_view(name: &str, gcode: &Gcode, moves: &Moves, report: &CheckReport) 
     let events = events(gcode, moves);
     let mut warnings: Vec<String> = Vec::new();
     let parts = match read_block(gcode.lines.iter().map(|l| &l.text[..])) {
-        Ok(parts) => parts,
+        Ok(parts) => parts.iter().map(BlockPart::of).collect(),
         Err(e) => {
             warnings.push(e);
             Vec::new()
@@ -329,9 +356,12 @@ pub fn job_view(name: &str, gcode: &Gcode, moves: &Moves, report: &CheckReport) 
     }
 }
 
-/// The move's path with every coordinate known (Z the layer's where the file leaves it
-/// unknown), or `None` when X or Y is unknown somewhere.
+/// The path of a move with X or Y, every coordinate known (Z the layer's where the file leaves
+/// it unknown); `None` for a move without X or Y, or when X or Y is unknown somewhere.
 fn known_path(m: &Move, moves: &Moves) -> Option<Vec<[f64; 3]>> {
+    if !m.has_xy {
+        return None;
+    }
     let layer_z = moves.layer_z.get(m.layer).copied().unwrap_or(0.0);
     let points: Option<Vec<[f64; 3]>> = m
         .path
@@ -436,16 +466,11 @@ fn markers(moves: &Moves) -> (MarkerView, MarkerView) {
 /// Part events with the layer each is placed before: the layer of the next extruding move
 /// (the one printed over the part), as the previews place them.
 fn events(gcode: &Gcode, moves: &Moves) -> Vec<EventView> {
-    let last = moves.layer_z.len().saturating_sub(1);
     part_events(gcode)
         .into_iter()
-        .map(|event| {
-            let next = moves.moves.partition_point(|m| m.line <= event.line);
-            let layer = moves.moves[next..]
-                .iter()
-                .find(|m| m.extruding)
-                .map_or(last, |m| m.layer);
-            EventView { event, layer }
+        .map(|event| EventView {
+            layer: moves.next_extruding_layer(event.line),
+            event,
         })
         .collect()
 }

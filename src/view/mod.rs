@@ -19,6 +19,6 @@ pub mod overlay;
 pub mod page;
 pub mod studio;
 
-pub use job::{JobView, job_view};
-pub use overlay::{CircuitView, MeshView, circuit_view, mesh_views};
+pub use job::{JobView, job_of, job_view};
+pub use overlay::{CircuitView, MeshView, circuit_of, circuit_view, mesh_views};
 pub use page::{Entry, ViewData, page, page_for};

@@ -8,10 +8,12 @@
 use serde::Serialize;
 
 use super::encode::{PositionStream, varints_base64, zigzag};
-use crate::check::ElectricalReport;
+use crate::check::{ElectricalParams, ElectricalReport, Frame, check_electrical};
 use crate::circuit::PlacingMethod;
 use crate::circuit::stage::PlacedCircuit;
+use crate::circuit::stage::{Electronics, ElectronicsError, ElectronicsParams};
 use crate::mesh::Mesh;
+use crate::program::machine::Flavor;
 use crate::region::cavity::Cavity;
 
 /// Triangle meshes, indexed.
@@ -61,7 +63,7 @@ pub struct PartView {
     /// Part name.
     pub name: String,
     /// `auto` (the machine places it), `manual` (a person does) or `none`.
-    pub method: &'static str,
+    pub method: PlacingMethod,
     /// Footprint (pads and body), bed xy, counter-clockwise.
     pub outline: Vec<[f64; 2]>,
     /// Seating plane, mm.
@@ -107,7 +109,7 @@ pub struct CircuitView {
     pub unrouted: Vec<RubberbandView>,
     /// Wires in all.
     pub wires: usize,
-    /// One line per problem of the electrical check (open nets, shorts, events).
+    /// One line per problem of the electrical check, as `conduit check` prints them.
     pub problems: Vec<String>,
 }
 
@@ -123,11 +125,7 @@ pub fn circuit_view(
         .iter()
         .map(|p| PartView {
             name: p.name.clone(),
-            method: match p.method {
-                PlacingMethod::Auto => "auto",
-                PlacingMethod::Manual => "manual",
-                PlacingMethod::None => "none",
-            },
+            method: p.method,
             outline: p.footprint.points_mm(),
             z: p.position.z,
             height: p.body_height,
@@ -169,38 +167,33 @@ pub fn circuit_view(
             to: [w.wire.to.x, w.wire.to.y, w.wire.to.z],
         })
         .collect();
-    let mut problems = Vec::new();
-    if let Some(r) = report {
-        for n in r.open_nets() {
-            problems.push(format!(
-                "net {} is open: {} separate groups",
-                n.net,
-                n.groups.len()
-            ));
-        }
-        for s in &r.shorts {
-            problems.push(format!(
-                "nets {} and {} {} at ({:.2}, {:.2}, {:.2})",
-                s.nets[0],
-                s.nets[1],
-                if s.touching {
-                    "touch".to_owned()
-                } else {
-                    format!("are {:.3} mm apart", s.gap)
-                },
-                s.at[0],
-                s.at[1],
-                s.at[2]
-            ));
-        }
-        for e in &r.events {
-            problems.push(e.message.clone());
-        }
-    }
+    let problems = report
+        .map(ElectricalReport::problem_lines)
+        .unwrap_or_default();
     CircuitView {
         parts,
         unrouted,
         wires: placed.wires.len(),
         problems,
     }
+}
+
+/// The circuit of `e` as `gcode` builds it: placed in `frame` and checked by
+/// [`check_electrical`] with `stage`'s settings, drawn with the wires the traces leave open.
+///
+/// # Errors
+/// The placement does not fit the circuit or the frame.
+pub fn circuit_of(
+    gcode: &conduit_gcode::Gcode,
+    flavor: Flavor,
+    e: &Electronics,
+    frame: &Frame,
+    stage: &ElectronicsParams,
+) -> Result<CircuitView, ElectronicsError> {
+    let report = check_electrical(gcode, flavor, e, frame, stage, &ElectricalParams::of(stage))?;
+    Ok(circuit_view(
+        &report.placed,
+        Some(&report),
+        stage.cavity_offset,
+    ))
 }

@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::circuit::{Placement, PlacingMethod};
+use crate::circuit::{Origin, Placement, PlacingMethod};
 
 /// One part's pose as the placement gives it (its own frame: `origin`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -30,7 +30,7 @@ pub struct StudioView {
     /// Placed parts, in placement order.
     pub parts: Vec<StudioPart>,
     /// The placement's frame: `model` or `bbox_center`.
-    pub origin: &'static str,
+    pub origin: Origin,
     /// Parts a problem is about (outside the solid, overlapping another's cavity).
     pub flagged: Vec<String>,
     /// Problems a print cannot have.
@@ -48,7 +48,7 @@ pub struct StudioPart {
     #[serde(flatten)]
     pub pose: PartPose,
     /// `auto`, `manual` or `none`.
-    pub method: &'static str,
+    pub method: PlacingMethod,
 }
 
 /// The poses of `placement`'s parts.
@@ -64,11 +64,7 @@ pub fn poses(placement: &Placement) -> Vec<StudioPart> {
                 z: p.z,
                 rotation: p.rotation,
             },
-            method: match p.method {
-                PlacingMethod::Auto => "auto",
-                PlacingMethod::Manual => "manual",
-                PlacingMethod::None => "none",
-            },
+            method: p.method,
         })
         .collect()
 }

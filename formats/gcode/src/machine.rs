@@ -179,6 +179,18 @@ pub struct Moves {
     pub layer_z: Vec<f64>,
 }
 
+impl Moves {
+    /// The layer of the first extruding move after line `line` (1-based): the layer printed
+    /// next, e.g. over a part placed at that line. The last layer when nothing extrudes after it.
+    pub fn next_extruding_layer(&self, line: usize) -> usize {
+        let from = self.moves.partition_point(|m| m.line <= line);
+        self.moves[from..]
+            .iter()
+            .find(|m| m.extruding)
+            .map_or(self.layer_z.len().saturating_sub(1), |m| m.layer)
+    }
+}
+
 /// Replays `gcode` as `firmware` would (at 25 mm/s before the first `F`) and returns its moves
 /// with layers numbered.
 ///

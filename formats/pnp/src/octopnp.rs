@@ -25,11 +25,16 @@ pub struct OctoPart {
 impl OctoPart {
     /// The outline in bed coordinates: rotated by the orientation about the destination.
     pub fn outline_on_bed(&self) -> Vec<[f64; 2]> {
-        let (s, c) = self.orientation.to_radians().sin_cos();
-        let [dx, dy, _] = self.destination;
+        let [x, y, _] = self.destination;
+        self.outline_at([x, y], self.orientation)
+    }
+
+    /// The outline with the package origin at `at` (bed x, y, mm), turned by `rotation_deg`.
+    pub fn outline_at(&self, at: [f64; 2], rotation_deg: f64) -> Vec<[f64; 2]> {
+        let (s, c) = rotation_deg.to_radians().sin_cos();
         self.shape
             .iter()
-            .map(|&[x, y]| [dx + x * c - y * s, dy + x * s + y * c])
+            .map(|&[u, v]| [at[0] + u * c - v * s, at[1] + u * s + v * c])
             .collect()
     }
 }

@@ -56,7 +56,7 @@ pub const MAX_DEFAULT_TILES: usize = 36;
 /// File name of the contact sheet.
 pub const CONTACT_SHEET: &str = "contact_sheet.png";
 /// Role of the start and end G-code's extrusions (PrusaSlicer's and conduit's `;TYPE:Custom`).
-const CUSTOM_ROLE: &str = "Custom";
+pub const CUSTOM_ROLE: &str = "Custom";
 /// Role name of extrusions before any role comment.
 pub const UNNAMED_ROLE: &str = "Extrusion";
 /// Colour of part outlines, boxes and names, RGB.

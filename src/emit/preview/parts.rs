@@ -78,14 +78,6 @@ impl PartMark {
 pub fn placed_parts(gcode: &Gcode, moves: &Moves) -> Vec<PartMark> {
     // A description that is not well-formed XML gives no outlines; the events are still drawn.
     let described = read_block(gcode.lines.iter().map(|l| &l.text[..])).unwrap_or_default();
-    let last_layer = moves.layer_z.len().saturating_sub(1);
-    let layer_after = |line: usize| {
-        let from = moves.moves.partition_point(|m| m.line <= line);
-        moves.moves[from..]
-            .iter()
-            .find(|m| m.extruding)
-            .map_or(last_layer, |m| m.layer)
-    };
     let mut marks = Vec::new();
     for event in part_events(gcode) {
         let (method, position, rotation_deg) = if event.machine {
@@ -101,7 +93,7 @@ pub fn placed_parts(gcode: &Gcode, moves: &Moves) -> Vec<PartMark> {
             (PartMethod::Hand, None, 0.0)
         };
         let mut mark = PartMark {
-            layer: layer_after(event.line),
+            layer: moves.next_extruding_layer(event.line),
             line: event.line,
             name: event.part,
             method,
@@ -116,12 +108,7 @@ pub fn placed_parts(gcode: &Gcode, moves: &Moves) -> Vec<PartMark> {
                 .iter()
                 .find(|d| d.name.replace(' ', "_") == mark.name),
         ) {
-            let (s, c) = mark.rotation_deg.to_radians().sin_cos();
-            mark.outline = d
-                .shape
-                .iter()
-                .map(|&[u, v]| [x + u * c - v * s, y + u * s + v * c])
-                .collect();
+            mark.outline = d.outline_at([x, y], mark.rotation_deg);
             mark.height = Some(d.height).filter(|h| *h > 0.0);
         }
         marks.push(mark);

@@ -118,10 +118,7 @@ function loadJob(index, reframe = true) {
   // Parts from the file's OctoPNP block, when no circuit is given.
   const parts = new THREE.Group();
   if (!data.circuit) {
-    for (const p of job.parts) {
-      const shape = p.shape.length ? outlineOnBed(p) : [];
-      parts.add(buildPart({ name: p.name, outline: shape, z: p.destination[2], height: p.height }));
-    }
+    for (const p of job.parts) parts.add(buildPart(p));
   }
   scene.add(parts);
   const b = boundsOf(job);
@@ -143,12 +140,6 @@ function loadJob(index, reframe = true) {
   applyLayers();
   if (reframe) setView('iso');
   else render();
-}
-
-function outlineOnBed(p) {
-  const a = (p.orientation * Math.PI) / 180;
-  const [s, c] = [Math.sin(a), Math.cos(a)];
-  return p.shape.map(([x, y]) => [p.destination[0] + x * c - y * s, p.destination[1] + x * s + y * c]);
 }
 
 // ---- panel ---------------------------------------------------------------------------------
