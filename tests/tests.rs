@@ -38,5 +38,6 @@ mod route_limits;
 mod slice;
 mod studio;
 mod support;
+mod thin_walls;
 mod three_de;
 mod view;

@@ -69,7 +69,9 @@ use crate::program::Role;
 pub use crate::program::machine::{
     DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, PnpSettings, Printer, Tool, ToolKind,
 };
-use crate::region::{InfillPatternKind, MIN_LAYER_HEIGHT, NOZZLE_RANGE, RegionParams};
+use crate::region::{
+    InfillPatternKind, MIN_LAYER_HEIGHT, NOZZLE_RANGE, PerimeterGenerator, RegionParams,
+};
 use crate::toolpaths::{ProgramParams, RoleSpeeds, ToolPathParams};
 
 /// Fastest speed of any move, mm/s: the fastest FFF printers travel at about 1000 mm/s; a
@@ -176,6 +178,18 @@ pub struct SliceSettings {
     /// Print the external loop of each island first (better dimensional accuracy, worse
     /// overhangs). Default false: inner loops first.
     pub external_perimeters_first: bool,
+    /// How the perimeter band is laid out: `"variable"` (default) keeps loops from running over
+    /// themselves and fills what they leave with beads whose number and width follow the wall's
+    /// local thickness, so a 0.3 mm fin or a tapering wall prints at its true thickness;
+    /// `"classic"` is PrusaSlicer's classic generator (fixed-width loops that may overlap
+    /// themselves by 40 % in narrow places, one gap-fill line between loops). PrusaSlicer's
+    /// `perimeter_generator = arachne` maps to `"variable"`.
+    pub perimeter_generator: PerimeterGenerator,
+    /// Print the parts of an island too thin for its external loop (fins, thin walls, the tips
+    /// of sharp corners) as variable-width lines along their middle, down to a quarter of the
+    /// nozzle and at least 0.85 nozzle diameters wide, instead of leaving them out. Default true
+    /// (PrusaSlicer's `thin_walls`; its Arachne generator always does it).
+    pub thin_walls: bool,
     /// Number of skirt loops around the first layer, 0 to 100. Default 0 (no skirt).
     pub skirt_loops: usize,
     /// Clear gap between the first layer's islands and the inner edge of the skirt, mm, from 0
@@ -247,6 +261,8 @@ macro_rules! with_region_keys {
             solid_infill_below_area,
             gap_fill,
             external_perimeters_first,
+            perimeter_generator,
+            thin_walls,
             skirt_loops,
             skirt_distance,
             nozzle_diameter,

@@ -29,8 +29,9 @@
 //!   `top_solid_layers`, `bottom_solid_layers`, `fill_density` (`20%` → 0.2), `fill_pattern`,
 //!   `top_fill_pattern` / `bottom_fill_pattern` (Slic3r: `top_infill_pattern`, …), `fill_angle`,
 //!   `infill_overlap`, `solid_infill_below_area`, `gap_fill_enabled`, `external_perimeters_first`, `support_material`, `skirts`,
-//!   `skirt_distance`, `brim_width`, `bridge_speed`, `gap_fill_speed`, `perimeter_generator` (classic; arachne gives a warning
-//!   that classic perimeters are printed), the speeds (a `%` speed is relative to its
+//!   `skirt_distance`, `brim_width`, `bridge_speed`, `gap_fill_speed`, `perimeter_generator` (`classic`, or `arachne`, also when
+//!   missing, for the variable generator) with `thin_walls` (classic only: Arachne prints thin
+//!   features anyway), the speeds (a `%` speed is relative to its
 //!   PrusaSlicer parent: external perimeter → perimeter, solid infill → infill, top solid →
 //!   solid infill, first layer → perimeter, support → perimeter), `support_material_speed` (→
 //!   `skirt_speed`, as PrusaSlicer prints skirts at support speed);
@@ -55,7 +56,7 @@ use std::collections::BTreeMap;
 use std::collections::BTreeSet;
 
 use super::{Config, ConfigError, Flavor, SolidPattern, Tool};
-use crate::region::InfillPatternKind;
+use crate::region::{InfillPatternKind, PerimeterGenerator};
 
 /// Reads a PrusaSlicer `.ini` (`key = value` lines, `#` comments, `[section]` headers of a
 /// config bundle are skipped). Errors carry the line number.
@@ -272,7 +273,7 @@ pub(crate) fn unescape(s: &str) -> String {
 }
 
 /// Keys read elsewhere that give no warning when present.
-const ACCEPTED: &[&str] = &["printer_technology", "perimeter_generator"];
+const ACCEPTED: &[&str] = &["printer_technology", "perimeter_generator", "thin_walls"];
 
 /// Lists whose length tells the number of extruders.
 const PER_EXTRUDER: &[&str] = &[
@@ -786,16 +787,31 @@ fn infill_overlap(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     Ok(())
 }
 
-/// `perimeter_generator`: conduit prints classic perimeters and warns about any other.
+/// `perimeter_generator` and `thin_walls`: `classic` is conduit's classic generator and prints
+/// thin walls as `thin_walls` says (PrusaSlicer's default 0 when the key is missing); `arachne`
+/// (PrusaSlicer's default, also when the key is missing) is conduit's variable generator, which
+/// like Arachne prints thin features whatever `thin_walls` says. Any other value warns and takes
+/// the variable generator.
 fn perimeter_generator(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
-    if let Some(g) = imp.p.raw(key).map(str::to_owned) {
-        if g.trim() != "classic" {
+    let named = imp.p.raw(key).map(|g| g.trim().to_owned());
+    let thin_walls = imp.p.flag("thin_walls")?;
+    let generator = match named.as_deref() {
+        Some("classic") => PerimeterGenerator::Classic,
+        None | Some("arachne") => PerimeterGenerator::Variable,
+        Some(other) => {
             imp.warnings.push(format!(
-                "perimeter_generator = {}: conduit prints classic perimeters",
-                g.trim()
+                "perimeter_generator = {other}: conduit prints variable-width (arachne-like) \
+                 perimeters"
             ));
+            PerimeterGenerator::Variable
         }
-    }
+    };
+    let slice = &mut imp.cfg.slice;
+    slice.perimeter_generator = generator;
+    slice.thin_walls = match generator {
+        PerimeterGenerator::Classic => thin_walls.unwrap_or(false),
+        PerimeterGenerator::Variable => true,
+    };
     Ok(())
 }
 
@@ -865,7 +881,6 @@ const CHANGES_THE_PRINT: &[(&str, Option<&[&str]>)] = &[
     ("support_material_spacing", None),
     ("support_material_threshold", None),
     ("thick_bridges", Some(&["0"])),
-    ("thin_walls", Some(&["0"])),
     ("top_solid_min_thickness", Some(&["0"])),
     ("wipe_tower", Some(&["0"])),
     ("xy_size_compensation", Some(&["0"])),
@@ -1026,16 +1041,39 @@ mod tests {
     }
 
     #[test]
-    fn arachne_profile_warns_that_classic_is_used() -> Result<(), ConfigError> {
+    fn arachne_profile_takes_the_variable_generator_and_classic_its_thin_walls()
+    -> Result<(), ConfigError> {
         let path = BENCH_INI.replace("prusaslicer.ini", "prusaslicer-arachne.ini");
         let path = std::path::Path::new(&path);
         if !path.exists() {
             println!("skipped: corpus not found");
             return Ok(());
         }
-        let (_, warnings) = super::super::load(path)?;
-        assert_eq!(warnings.len(), 1, "{warnings:?}");
-        assert!(warnings[0].contains("arachne"));
+        let (cfg, warnings) = super::super::load(path)?;
+        assert_eq!(warnings, Vec::<String>::new());
+        assert_eq!(cfg.slice.perimeter_generator, PerimeterGenerator::Variable);
+        assert!(cfg.slice.thin_walls);
+        let (classic, _) = super::super::load(std::path::Path::new(BENCH_INI))?;
+        assert_eq!(
+            classic.slice.perimeter_generator,
+            PerimeterGenerator::Classic
+        );
+        // The bench profile has no `thin_walls`: PrusaSlicer's default is off.
+        assert!(!classic.slice.thin_walls);
+        // Without the key PrusaSlicer takes Arachne; an unknown generator warns.
+        let (missing, _) = from_ini_str("layer_height = 0.2\n")?;
+        assert_eq!(
+            missing.slice.perimeter_generator,
+            PerimeterGenerator::Variable
+        );
+        let (odd, w) = from_ini_str("perimeter_generator = fancy\n")?;
+        assert_eq!(odd.slice.perimeter_generator, PerimeterGenerator::Variable);
+        assert!(
+            w.iter().any(|w| w.contains("perimeter_generator = fancy")),
+            "{w:?}"
+        );
+        let (thin, _) = from_ini_str("perimeter_generator = classic\nthin_walls = 1\n")?;
+        assert!(thin.slice.thin_walls);
         Ok(())
     }
 

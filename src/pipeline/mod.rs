@@ -523,8 +523,11 @@ pub fn slice_scene_watched(
         meshes,
     } = front(scene, cfg, circuit, &mut progress, routing, &mut laps)?;
     let mut extras = extras;
+    // Objects whose planar layers the curved tops cut into.
+    let mut cut_by_tops = vec![false; sliced.len()];
     let curved = (cfg.curved.mode == CurvedMode::Tops).then(|| {
-        let (inserts, report) = curved_tops(&mut sliced, &meshes, cfg);
+        let (inserts, report, cut) = curved_tops(&mut sliced, &meshes, cfg);
+        cut_by_tops = cut;
         for ins in inserts {
             extras
                 .inserts_after
@@ -552,7 +555,18 @@ pub fn slice_scene_watched(
         }
         let heights: Vec<f64> = layers.iter().map(|l| l.z.height()).collect();
         let (zs, islands): (Vec<_>, Vec<_>) = layers.into_iter().map(|l| (l.z, l.islands)).unzip();
-        let regions = make_regions_with_heights(&islands, &heights, &cfg.region_params())?;
+        let mut params = cfg.region_params();
+        if cut_by_tops.get(i).copied().unwrap_or(false) {
+            // Where the curved tops cut the planar layers, the cut leaves slivers along its edge
+            // that are no wall of the model; printed as thin walls they would stand beside the
+            // curved layers' nozzle closer than the planner's collision check allows for (it
+            // keeps the head off the sliced islands, and a thin wall's bead reaches past them).
+            // Those layers keep the classic generator without thin walls, as the planner
+            // assumes.
+            params.perimeter_generator = crate::region::PerimeterGenerator::Classic;
+            params.thin_walls = false;
+        }
+        let regions = make_regions_with_heights(&islands, &heights, &params)?;
         drop(islands);
         objects.push(ObjectLayers {
             tool,
@@ -601,7 +615,8 @@ pub fn slice_scene_watched(
 }
 
 /// Plans the curved tops of every object and removes what the curved layers replace from the
-/// sliced islands; returns the curved layers to insert and the report.
+/// sliced islands; returns the curved layers to insert, the report, and per object whether
+/// anything was removed from it.
 fn curved_tops(
     sliced: &mut [(Vec<crate::slice::SlicedLayer>, SliceReport)],
     meshes: &[Mesh],
@@ -609,6 +624,7 @@ fn curved_tops(
 ) -> (
     Vec<crate::curved::CurvedInsert>,
     crate::curved::CurvedReport,
+    Vec<bool>,
 ) {
     let zs: Vec<Vec<LayerZ>> = sliced
         .iter()
@@ -633,14 +649,16 @@ fn curved_tops(
         )
         .collect();
     let plan = crate::curved::plan_tops(&objects, &cfg.curved_params());
-    for ((layers, _), removals) in sliced.iter_mut().zip(&plan.removals) {
+    let mut cut = vec![false; sliced.len()];
+    for (((layers, _), removals), cut) in sliced.iter_mut().zip(&plan.removals).zip(&mut cut) {
         for (layer, remove) in layers.iter_mut().zip(removals) {
             if !remove.is_empty() {
                 layer.islands = crate::geom::difference(&layer.islands, remove);
+                *cut = true;
             }
         }
     }
-    (plan.inserts, plan.report)
+    (plan.inserts, plan.report, cut)
 }
 
 fn check_fits(meshes: &[Mesh], cfg: &Config) -> Result<(), PipelineError> {

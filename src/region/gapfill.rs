@@ -329,9 +329,12 @@ impl Graph {
 
     /// Removes branches from a free end to a junction that are shorter than the mean thickness
     /// of themselves or of a longer chain at that junction: the chordal (and true) medial axis
-    /// sends such branches into convex corners and bumps, all within about one bead width.
+    /// sends such branches into convex corners and bumps, all within about one bead width. A
+    /// junction left with one chain gets that chain extended instead (see the body).
     fn prune_spurs(&mut self) {
         let adj = self.adjacency();
+        // Per junction, the pruned spurs' free ends and areas (mm²), in a fixed order.
+        let mut pruned: std::collections::BTreeMap<usize, Vec<(usize, f64)>> = Default::default();
         let chains = self.chains();
         let mut at = vec![Vec::new(); self.nodes.len()];
         let stats: Vec<(f64, f64)> = chains
@@ -353,7 +356,47 @@ impl Graph {
             let longer = at[j].iter().map(|&c| stats[c]).filter(|&(l, _)| l > len);
             if len < longer.fold(mean, |m, (_, t)| m.max(t)) {
                 segs.iter().for_each(|&s| self.alive[s] = false);
+                let free = if nodes[0] == j {
+                    nodes[nodes.len() - 1]
+                } else {
+                    nodes[0]
+                };
+                pruned.entry(j).or_default().push((free, len * mean));
             }
+        }
+        // Where every spur at a junction but one chain went, the junction is now that chain's
+        // end: a fork at the end of a strip, whose spurs run to the two corners of a concave end
+        // (where a thin wall meets the rounded end of a loop's bead). The chain goes on to the
+        // middle of the spurs' far ends with their area, so that end is filled instead of
+        // left bare.
+        let adj = self.adjacency();
+        for (j, spurs) in pruned {
+            if adj[j].len() != 1 || spurs.len() < 2 {
+                continue;
+            }
+            let n = spurs.len() as f64;
+            let (x, y) = spurs.iter().fold((0.0, 0.0), |(x, y), &(f, _)| {
+                (x + self.nodes[f].x / n, y + self.nodes[f].y / n)
+            });
+            let area: f64 = spurs.iter().map(|&(_, a)| a).sum();
+            // At the chain's own end thickness, as far as that area reaches, but not more than
+            // half that thickness past the spurs' ends.
+            let (from, target) = (self.nodes[j], Sp::new(x, y));
+            let dist = from.distance_2(target).sqrt();
+            let Some(&last) = adj[j].first() else {
+                continue;
+            };
+            let thickness = self.segs[last].width;
+            if dist < MIN_SEGMENT_MM || thickness <= 0.0 {
+                continue;
+            }
+            let reach = (area / thickness).min(dist + thickness / 2.0);
+            let f = reach / dist;
+            let end = self.node(Sp::new(
+                from.x + (target.x - from.x) * f,
+                from.y + (target.y - from.y) * f,
+            ));
+            self.add(j, end, area);
         }
     }
 
@@ -519,6 +562,31 @@ mod tests {
             .zip(&l.widths)
             .map(|(w, &t)| (unscaled(w[0].x + w[1].x) / 2.0, t))
             .collect()
+    }
+
+    #[test]
+    fn a_strip_ending_in_a_notch_reaches_the_notch_with_the_pruned_area() {
+        // 0.6 mm thick, its right end notched 0.25 mm deep (where a thin wall meets the rounded
+        // end of a loop's bead): the axis forks into the notch's two corners; the forks are too
+        // short to print, and the line goes on to the middle of the corners instead.
+        let g = gap(&[
+            (0.0, 0.0),
+            (10.0, 0.0),
+            (9.75, 0.3),
+            (10.0, 0.6),
+            (0.0, 0.6),
+        ]);
+        let lines = gap_fill(std::slice::from_ref(&g), 0.05, 0.8);
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        let ends = [
+            lines[0].points[0],
+            lines[0].points[lines[0].points.len() - 1],
+        ];
+        let right = ends.iter().map(|p| unscaled(p.x)).fold(f64::MIN, f64::max);
+        assert!(right > 9.65, "the line ends at x = {right}");
+        let (_, area) = measure(&lines);
+        let whole = g.contour.area_mm2();
+        assert!((area - whole).abs() < 0.02 * whole, "{area} of {whole} mm²");
     }
 
     #[test]

@@ -22,6 +22,7 @@
 //!
 //! Spacings follow the flow model documented in [`params`].
 
+pub mod beads;
 pub mod bridge;
 pub mod cavity;
 pub mod gapfill;
@@ -36,8 +37,8 @@ mod test_util;
 
 pub use params::{
     InfillPatternKind, MAX_PERIMETERS, MAX_SKIRT_LOOPS, MAX_SOLID_INFILL_MARGIN, MAX_SOLID_LAYERS,
-    MAX_WIDTH, MAX_WIDTH_NOZZLES, MIN_LAYER_HEIGHT, NOZZLE_RANGE, ParamError, RegionParams,
-    Spacings, spacing,
+    MAX_WIDTH, MAX_WIDTH_NOZZLES, MIN_LAYER_HEIGHT, NOZZLE_RANGE, ParamError, PerimeterGenerator,
+    RegionParams, Spacings, spacing,
 };
 pub use perimeters::{PerimeterLoop, Perimeters, make_perimeters};
 pub use skins::{SkinAreas, SolidRole, detect_skins};
@@ -188,16 +189,7 @@ fn regions(layers: &[Vec<ExPolygon>], heights: &[f64], params: &RegionParams) ->
             let below = index
                 .checked_sub(1)
                 .map_or(&[][..], |i| layers[i].as_slice());
-            let gap_fill = if per.gaps.is_empty() {
-                Vec::new()
-            } else {
-                let sp = lp.spacings(height);
-                gapfill::gap_fill(
-                    &per.gaps,
-                    perimeters::GAP_MIN_FRACTION * lp.perimeter_width,
-                    2.0 * sp.perimeter,
-                )
-            };
+            let gap_fill = thick_lines(&per, &lp, height);
             LayerRegions {
                 index,
                 height,
@@ -217,6 +209,44 @@ fn regions(layers: &[Vec<ExPolygon>], heights: &[f64], params: &RegionParams) ->
             }
         })
         .collect()
+}
+
+/// The variable-width lines of one layer: its gaps' (between `gap_min` and
+/// [`perimeters::max_fill_spacings`] thick)
+/// and its thin walls' (down to the smallest feature, raised to the narrowest bead, up to 2.5
+/// spacings: a wall just too thin for a loop is about 2.1 spacings), then, with the variable
+/// generator, each split into as many beads as its thickness holds ([`beads::beads`]).
+fn thick_lines(per: &Perimeters, params: &RegionParams, height: f64) -> Vec<ThickPolyline> {
+    let sp = params.spacings(height);
+    let mut lines = if per.gaps.is_empty() {
+        Vec::new()
+    } else {
+        gapfill::gap_fill(
+            &per.gaps,
+            perimeters::GAP_MIN_FRACTION * params.perimeter_width,
+            perimeters::max_fill_spacings(params.perimeter_generator) * sp.perimeter,
+        )
+    };
+    if !per.thin_walls.is_empty() {
+        let nozzle = params.nozzle_diameter;
+        let min_bead = spacing(perimeters::MIN_BEAD_NOZZLES * nozzle, height);
+        lines.extend(
+            gapfill::gap_fill(
+                &per.thin_walls,
+                perimeters::MIN_FEATURE_NOZZLES * nozzle,
+                2.5 * sp.perimeter,
+            )
+            .into_iter()
+            .map(|l| beads::at_least(l, min_bead)),
+        );
+    }
+    match params.perimeter_generator {
+        PerimeterGenerator::Classic => lines,
+        PerimeterGenerator::Variable => lines
+            .iter()
+            .flat_map(|l| beads::beads(l, sp.perimeter))
+            .collect(),
+    }
 }
 
 /// Solid infill of one layer, role by role in print order: bottom and internal solid at the

@@ -34,6 +34,22 @@ pub enum InfillPatternKind {
     Triangles,
 }
 
+/// How the perimeter band of an island is laid out (see [`crate::region::perimeters`]).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum PerimeterGenerator {
+    /// Loops never run over themselves, and what they leave is filled with beads whose number
+    /// and width follow the local thickness (PrusaSlicer's and Cura's Arachne in effect): thin
+    /// and tapering walls print at their true thickness. PrusaSlicer's `arachne` maps here.
+    #[default]
+    Variable,
+    /// PrusaSlicer's classic generator: loops of fixed width that may overlap themselves by up to
+    /// 40 % in narrow places, single gap-fill lines between them.
+    Classic,
+}
+
 /// Parameters of perimeter, skin, infill and skirt generation. Lengths in millimetres.
 ///
 /// The config builds it from the `[slice]` keys of the same names, whose documentation gives
@@ -76,6 +92,11 @@ pub struct RegionParams {
     pub gap_fill: bool,
     /// Print the external loop of each island first (better dimensional accuracy, worse overhangs).
     pub external_perimeters_first: bool,
+    /// How the perimeter band is laid out.
+    pub perimeter_generator: PerimeterGenerator,
+    /// Print the parts of an island too thin for its external loop as variable-width lines
+    /// along their middle, instead of leaving them out.
+    pub thin_walls: bool,
     /// Number of skirt loops around the first layer.
     pub skirt_loops: usize,
     /// Clear gap between the first layer's islands and the inner edge of the skirt, mm.
@@ -106,6 +127,8 @@ impl Default for RegionParams {
             solid_infill_below_area: 70.0,
             gap_fill: true,
             external_perimeters_first: false,
+            perimeter_generator: PerimeterGenerator::Variable,
+            thin_walls: true,
             skirt_loops: 0,
             skirt_distance: 6.0,
             nozzle_diameter: 0.4,

@@ -13,9 +13,20 @@
 //! resulting polygon is a loop: contours give counter-clockwise loops, holes give clockwise loops,
 //! so the nozzle always has the part on its left.
 //!
-//! **Thin parts.** Each loop area is *opened* (shrunk by `d_k + r`, grown back by `r`, with
-//! `r = 0.3 · spacing`, PrusaSlicer's `INSET_OVERLAP_TOLERANCE` of 0.4), so a loop that would run
-//! over itself is not made.
+//! **Thin parts.** Each loop area is *opened* (shrunk by `d_k + r`, grown back by `r`), so a loop
+//! that would run over itself is not made. The classic generator takes `r = 0.3 · spacing`
+//! (PrusaSlicer's `INSET_OVERLAP_TOLERANCE` of 0.4: a loop may overlap itself by 40 % of a
+//! spacing, so a 0.7 mm wall gets a loop whose sides overlap and is over-filled by up to 18 %).
+//! The variable generator ([`PerimeterGenerator::Variable`]) takes `r = spacing / 2`: a loop is
+//! made only where its two sides lie at least one spacing apart, and the band it leaves is filled
+//! with beads sized to its thickness (see below and [`super::gapfill::beads`]).
+//!
+//! **Thin walls.** With `thin_walls`, the part of an island outside its external loop's bead (the
+//! loop's centreline area grown by `d_0`) is kept as [`Perimeters::thin_walls`]: a fin or a wall
+//! too thin for a loop, the tip of a sharp corner. The regions stage fills it along its medial
+//! axis at its own thickness, at least [`MIN_BEAD_NOZZLES`] nozzle diameters wide and down to
+//! features of [`MIN_FEATURE_NOZZLES`] (PrusaSlicer's Arachne defaults), so such walls print
+//! instead of vanishing.
 //!
 //! **Gaps.** Where a loop is missing or pinched by that opening, a strip between two loops is
 //! left without material. Between loop `k−1` (centreline area `C_(k−1)`) and loop `k` at distance
@@ -33,13 +44,47 @@
 //! sliver the nozzle cannot fill with whole lines (the gap fill takes it). With zero perimeters
 //! it is the island shrunk by half a solid infill spacing.
 
-use super::params::RegionParams;
+use super::params::{PerimeterGenerator, RegionParams};
 use super::simplify::cleaned;
 use crate::geom::{ExPolygon, Join, Polygon, difference, offset, scaled, unscaled};
 
 /// How far (mm) the opening that removes too-thin loops reaches, as a fraction of the spacing:
 /// `(1 − INSET_OVERLAP_TOLERANCE) / 2` with PrusaSlicer's tolerance of 0.4.
 const OPENING_FRACTION: f64 = 0.3;
+
+/// Widest gap or thin wall filled, in perimeter spacings, by generator: the classic generator's
+/// loops leave gaps of up to two spacings; the variable generator's up to two spacings plus the
+/// narrowest gap (see [`opening_radius`]).
+pub fn max_fill_spacings(generator: PerimeterGenerator) -> f64 {
+    match generator {
+        PerimeterGenerator::Classic => 2.0,
+        PerimeterGenerator::Variable => 2.5,
+    }
+}
+
+/// The radius (mm) of the opening of a loop area whose loops are `spacing` apart. Classic:
+/// `0.3 · spacing`. Variable: half a spacing plus half the narrowest gap, so a loop is made only
+/// where its two sides' beads are at least a spacing apart *and* leave a gap wide enough to fill
+/// between them; a wall just thinner is two beads of half its thickness instead of a loop and an
+/// unfilled hairline (which would leave a 0.91 mm wall 11 % short of plastic).
+fn opening_radius(params: &RegionParams, spacing: f64) -> f64 {
+    match params.perimeter_generator {
+        PerimeterGenerator::Classic => OPENING_FRACTION * spacing,
+        PerimeterGenerator::Variable => (spacing + GAP_MIN_FRACTION * params.perimeter_width) / 2.0,
+    }
+}
+
+/// Largest distance (mm) between a bead's rounded end and the chords that stand for it when the
+/// external loop's reach is measured: far below the smallest thin-wall feature.
+const BEAD_ARC_MM: f64 = 0.005;
+
+/// Narrowest bead printed in a thin wall, in nozzle diameters (PrusaSlicer's Arachne
+/// `min_bead_width` of 85 %): a thinner feature is printed this wide rather than not at all.
+pub const MIN_BEAD_NOZZLES: f64 = 0.85;
+
+/// Thinnest feature printed as a thin wall, in nozzle diameters (Arachne's `min_feature_size` of
+/// 25 %): below it a fin is within the squish of the beads beside it.
+pub const MIN_FEATURE_NOZZLES: f64 = 0.25;
 
 /// Narrowest gap filled, as a fraction of `perimeter_width`: PrusaSlicer's
 /// `0.2 · width · (1 − INSET_OVERLAP_TOLERANCE)`. Narrower strips are within the beads' own
@@ -78,6 +123,9 @@ pub struct Perimeters {
     /// Strips between loops too narrow for another loop, to be gap-filled (empty unless
     /// `gap_fill` is on); see the module docs.
     pub gaps: Vec<ExPolygon>,
+    /// Parts of the islands outside their external loop's bead, too thin for a loop (empty
+    /// unless `thin_walls` is on); see the module docs.
+    pub thin_walls: Vec<ExPolygon>,
 }
 
 /// Returns `polygon` with its vertices running counter-clockwise when `ccw`, clockwise otherwise.
@@ -183,7 +231,7 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
         // The previous loop's centreline area and spacing, for the gaps.
         let mut previous: Option<(Vec<ExPolygon>, f64)> = None;
         for (k, &(depth, width, spacing)) in plan.iter().enumerate() {
-            let radius = OPENING_FRACTION * spacing;
+            let radius = opening_radius(params, spacing);
             let shrunk = shrink_from(island, base.as_ref(), depth + radius);
             let area = if shrunk.is_empty() || radius <= 0.0 {
                 shrunk.clone()
@@ -191,6 +239,17 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
                 offset_cleaned(&shrunk, radius)
             };
             base = Some((scaled(depth + radius), shrunk));
+            if k == 0 && params.thin_walls {
+                out.thin_walls.extend(if area.is_empty() {
+                    island.to_vec()
+                } else {
+                    // What the loop's bead covers is its centreline swept by a disc: a round
+                    // offset. A mitred one would claim up to three times the bead's reach past
+                    // the tip of a tapering loop and leave the wall there empty.
+                    let bead = cleaned(offset(&area, depth + SAFETY_MM, Join::Round(BEAD_ARC_MM)));
+                    difference(island, &bead)
+                });
+            }
             if params.gap_fill
                 && let Some((prev, prev_spacing)) = &previous
             {
@@ -226,7 +285,7 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
             // bead would cover that grown by half a spacing; both growths are taken at once.
             let expected = offset_cleaned(last, -spacing / 2.0);
             if !expected.is_empty() {
-                let r = OPENING_FRACTION * spacing;
+                let r = opening_radius(params, *spacing);
                 let core = offset_cleaned(&expected, -(spacing / 2.0 + r));
                 if core.is_empty() {
                     gaps.extend(expected);
@@ -245,7 +304,7 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
     if !gaps.is_empty() {
         let sp = params.spacings(height);
         let min = GAP_MIN_FRACTION * params.perimeter_width;
-        let max = 2.0 * sp.perimeter;
+        let max = max_fill_spacings(params.perimeter_generator) * sp.perimeter;
         // Drop what is thinner than `min` everywhere and what is wider than `max` (an area a
         // loop or infill covers).
         let kept = shrink_opened(&gaps, 0.0, min / 2.0);
@@ -258,6 +317,12 @@ pub fn make_perimeters(islands: &[ExPolygon], params: &RegionParams, height: f64
         if !out.gaps.is_empty() && !out.infill_area.is_empty() {
             out.infill_area = difference(&out.infill_area, &out.gaps);
         }
+    }
+    if !out.thin_walls.is_empty() {
+        // Slivers thinner than the smallest feature (where the loop's bead meets the contour
+        // within rounding) are dropped; what is left is filled along its middle.
+        let min = MIN_FEATURE_NOZZLES * params.nozzle_diameter;
+        out.thin_walls = shrink_opened(&out.thin_walls, 0.0, min / 2.0);
     }
     out
 }
