@@ -1393,3 +1393,49 @@ fn contours_dropped_from_an_open_mesh_are_a_warning_on_the_terminal() {
         "{err}"
     );
 }
+
+/// The header's estimate (`; estimated printing time = … (S s)`) of a file conduit wrote, in s.
+fn header_seconds(text: &str) -> f64 {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("; estimated printing time = "))
+        .expect("an estimate in the header");
+    let s = line.rsplit('(').next().expect("(S s)");
+    s.trim_end_matches(" s)").parse().expect("seconds")
+}
+
+#[test]
+fn the_header_estimate_is_the_time_check_plans() {
+    // One motion model for both: they differ only by the start G-code's moves (the prime line),
+    // which `check` replays and the writer passes through as text.
+    let dir = temp_dir();
+    let mut cases: Vec<(&str, Vec<PathBuf>, Vec<&str>)> = vec![
+        ("cube", vec![sample("cube_20mm.stl")], vec![]),
+        (
+            "bracket",
+            vec![sample("l_bracket.obj")],
+            vec!["--set", "slice.infill_pattern=grid"],
+        ),
+        ("thin", vec![sample("thin_walls.stl")], vec![]),
+    ];
+    if let Some(corpus) = corpus() {
+        let benchy = corpus.join("bench-models/3DBenchy.stl");
+        if benchy.exists() {
+            cases.push(("benchy", vec![benchy], vec![]));
+        }
+    }
+    for (name, models, extra) in cases {
+        let s = slice(dir.path(), name, &models, &extra);
+        let header = header_seconds(&s.gcode);
+        let (code, v) = check_cli(&dir.path().join(format!("{name}.gcode")), None);
+        assert_eq!(code, Some(0), "{name}: {v}");
+        let planned = v["stats"]["estimated_time_s"]
+            .as_f64()
+            .expect("estimated_time_s");
+        println!("{name}: header {header} s, check {planned:.1} s");
+        assert!(
+            (header - planned).abs() <= 0.01 * planned + 5.0,
+            "{name}: header {header} s, check {planned} s"
+        );
+    }
+}

@@ -6,9 +6,9 @@ use std::f64::consts::PI;
 
 use conduit_gcode::{Gcode, Line, Machine, Move, Position};
 
-use super::time::Planner;
 use super::{Bounds3, CheckParams, CheckReport, Finding, FindingKind, Severity, Stats, ToolUsage};
 use crate::program::machine::ToolKind;
+use crate::program::motion::Planner;
 
 /// Heater state of one tool.
 #[derive(Debug, Clone, Default)]

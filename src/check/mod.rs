@@ -60,7 +60,6 @@
 
 pub mod electrical;
 mod machine;
-mod time;
 
 pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves};
 pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical};
@@ -174,8 +173,8 @@ impl CheckParams {
             temperature_tolerance: 5.0,
             heat_up_time_s: 120.0,
             max_acceleration: p.max_acceleration,
-            jerk: 10.0,
-            max_feedrate: 500.0,
+            jerk: crate::program::motion::JERK_MM_S,
+            max_feedrate: crate::program::motion::MAX_FEEDRATE_MM_S,
             default_feedrate: 25.0,
             max_findings_per_kind: 20,
         }

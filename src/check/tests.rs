@@ -2,8 +2,8 @@
 
 use std::f64::consts::PI;
 
-use super::time::trapezoid_time;
 use super::*;
+use crate::program::motion::trapezoid_time;
 
 const HEAT: &str = "M104 S210\nM109 S210\nG28\nG90\nM82\nG92 E0\n";
 

@@ -12,9 +12,11 @@
 //!   geometry (length, cutting, starting direction, chords).
 //! - [`extrusion`]: the flow model (bead cross-section, E per millimetre, paste tools).
 //! - [`machine`]: the printer, its tools and the part-placement commands.
+//! - [`motion`]: the motion model behind every time estimate (header, cooling, `check`).
 
 pub mod extrusion;
 pub mod machine;
+pub mod motion;
 pub mod segment;
 pub mod toolpath;
 

@@ -14,7 +14,8 @@
 //! # Output
 //!
 //! - A header: `; conduit <version>`, flavour, E mode, layer count, tools used, filament per
-//!   tool (mm, cm³, g) and the estimated time ([`estimate`]). The totals are known only at the
+//!   tool (mm, cm³, g) and the estimated time (every move planned by
+//!   [`crate::program::motion`], the model `conduit check` uses). The totals are known only at the
 //!   end, so the body is built in memory and the header written before it.
 //! - Fan off (`M107`), then, as PrusaSlicer does, the first-layer bed and tool temperatures when
 //!   the start G-code sets none itself; `;TYPE:Custom` and the rendered `printer.start_gcode`;

@@ -8,12 +8,12 @@ pub(super) use switched::header as switched_header;
 use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
 
 use super::GcodeParams;
-use super::estimate::move_time;
 use super::flavor::{Dialect, fan, set_bed, wait_bed};
 use super::sink::{GcodeSink, Motion, MotionKind};
 use super::{EmitError, GcodeStats, Resume, ToolStats};
 use crate::geom::Point3;
 use crate::program::machine::{Flavor, ToolKind};
+use crate::program::motion::{JERK_MM_S, MAX_FEEDRATE_MM_S, Planner};
 use crate::program::{Event, Feed, Layer, LayerItem, Program, Toolpath};
 
 /// Largest distance between an arc of a path's segments and the chords the FFF style writes
@@ -101,7 +101,13 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     type_name: Option<&'static str>,
     width: Option<String>,
     height: Option<String>,
-    time_s: f64,
+    /// Every move written, planned as `conduit check` plans it (its id is the index into
+    /// `planned`).
+    planner: Planner,
+    /// Per move pushed to the planner: the tool that extruded in it, if it extruded.
+    planned: Vec<Option<usize>>,
+    /// Dwells written, s.
+    dwell_s: f64,
     /// Tools the program uses, ascending.
     used: Vec<usize>,
     /// Fan command written last.
@@ -170,7 +176,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             type_name: None,
             width: None,
             height: None,
-            time_s: 0.0,
+            planner: Planner::new(cfg.printer.max_acceleration, JERK_MM_S),
+            planned: Vec::new(),
+            dwell_s: 0.0,
             used: Vec::new(),
             fan: None,
             switch: switched::SwitchState::default(),
@@ -178,12 +186,42 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
     }
 
     fn line(&mut self, line: &str) {
+        self.plan_command(line);
         self.sink.line(line);
     }
 
     fn lines(&mut self, lines: &[String]) {
         for l in lines {
+            self.plan_command(l);
             self.sink.line(l);
+        }
+    }
+
+    /// The motion model's side of a command line written as is (custom G-code, events): the
+    /// firmware empties its queue at a dwell, a heat-up wait, homing and a tool change, and
+    /// `check` plans it so; a dwell's time counts.
+    fn plan_command(&mut self, line: &str) {
+        let code = line.split(';').next().unwrap_or("").trim();
+        let mut words = code.split_whitespace();
+        let Some(command) = words.next() else {
+            return;
+        };
+        let number = |w: &str| w.get(1..).and_then(|v| v.parse::<f64>().ok());
+        match command.to_ascii_uppercase().as_str() {
+            "G4" => {
+                self.planner.flush();
+                let ms: f64 = words
+                    .filter_map(|w| match w.as_bytes().first() {
+                        Some(b'P' | b'p') => number(w),
+                        Some(b'S' | b's') => number(w).map(|s| s * 1000.0),
+                        _ => None,
+                    })
+                    .sum();
+                self.dwell_s += ms.max(0.0) / 1000.0;
+            }
+            "G28" | "M109" | "M190" | "M116" => self.planner.flush(),
+            c if c.starts_with('T') && c[1..].parse::<usize>().is_ok() => self.planner.flush(),
+            _ => {}
         }
     }
 
@@ -200,14 +238,28 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             (_, Some(from)) => (to - from).norm(),
             (_, None) => 0.0,
         };
-        let t = move_time(distance, feed, self.cfg.printer.max_acceleration);
-        self.time_s += t;
-        if kind == MotionKind::Extrude
+        let direction = match (kind, self.pos) {
+            (MotionKind::Retract | MotionKind::Unretract, _) => [0.0; 3],
+            (_, Some(from)) if distance > 0.0 => {
+                let d = (to - from) / distance;
+                [d.x, d.y, d.z]
+            }
+            _ => [0.0; 3],
+        };
+        let extruding = kind == MotionKind::Extrude;
+        self.planner.push(
+            self.planned.len(),
+            distance,
+            feed.min(MAX_FEEDRATE_MM_S),
+            direction,
+            direction,
+        );
+        self.planned.push(self.tool.filter(|_| extruding));
+        if extruding
             && let Some(tool) = self.tool
             && let Some(ts) = self.tools.get_mut(tool)
         {
             ts.filament_mm += e;
-            ts.extrusion_time_s += t;
         }
         let m = Motion {
             kind,
@@ -614,24 +666,32 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
     /// layers; then, as PrusaSlicer's cooling logic with its default thresholds, full speed
     /// (`fan_max_speed`) for layers printed faster than [`SLOWDOWN_BELOW_S`], `fan_min_speed`
     /// for layers slower than [`FAN_BELOW_S`], linear in between. The layer time is the
-    /// extrusion time of its paths ([`move_time`] per segment).
+    /// extrusion time of its paths, each planned by the motion model ([`Planner`]).
     fn fan_speed(&self, layer: &Layer) -> f64 {
         let p = &self.cfg.printer;
         if layer.index < p.disable_fan_first_layers {
             return 0.0;
         }
-        let accel = p.max_acceleration;
-        let time: f64 = layer
-            .paths()
-            .map(|path| {
-                let closing = path.closed.then(|| path.points[0]);
-                path.points
-                    .iter()
-                    .zip(path.points.iter().skip(1).chain(closing.iter()))
-                    .map(|(a, b)| move_time((b - a).norm(), path.speed, accel))
-                    .sum::<f64>()
-            })
-            .sum();
+        // Each path planned as the file runs it, from a stop to a stop (a travel or a
+        // retraction lies between paths).
+        let mut planner = Planner::new(p.max_acceleration, JERK_MM_S);
+        for path in layer.paths() {
+            let closing = path.closed.then(|| path.points[0]);
+            for (a, b) in path
+                .points
+                .iter()
+                .zip(path.points.iter().skip(1).chain(closing.iter()))
+            {
+                let d = b - a;
+                let length = d.norm();
+                if length > 0.0 {
+                    let dir = [d.x / length, d.y / length, d.z / length];
+                    planner.push(0, length, path.speed.min(MAX_FEEDRATE_MM_S), dir, dir);
+                }
+            }
+            planner.flush();
+        }
+        let time = planner.total;
         let (lo, hi) = (p.fan_min_speed, p.fan_max_speed);
         if time <= SLOWDOWN_BELOW_S {
             hi
@@ -864,8 +924,8 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             Event::Switch { on, .. } => self.switch_snippet(*on),
             Event::Dwell { seconds } => {
                 if seconds.is_finite() && *seconds > 0.0 {
+                    // Its time counts as the line is written (see `plan_command`).
                     self.line(&format!("G4 P{}", fmt_f(seconds * 1000.0)));
-                    self.time_s += seconds;
                 }
             }
         }
@@ -924,9 +984,17 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         )?;
         self.line(";TYPE:Custom");
         self.lines(&end);
+        self.planner.flush();
+        for &(id, t) in &self.planner.times {
+            if let Some(Some(tool)) = self.planned.get(id)
+                && let Some(ts) = self.tools.get_mut(*tool)
+            {
+                ts.extrusion_time_s += t;
+            }
+        }
         Ok(GcodeStats {
             layers: program.layers.len(),
-            estimated_time_s: self.time_s,
+            estimated_time_s: self.planner.total + self.dwell_s,
             tools: self.tool_stats(program),
             switched: None,
         })

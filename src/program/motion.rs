@@ -1,14 +1,29 @@
-//! The print-time estimate: moves are planned as firmware plans them — a trapezoidal speed
-//! profile per move at constant acceleration, with the speed carried through each junction
-//! limited by a classic-jerk rule and by what the neighbouring moves can accelerate or brake to.
+//! The machine's motion model, the one print-time estimate: moves are planned as firmware plans
+//! them — a trapezoidal speed profile per move at constant acceleration, with the speed carried
+//! through each junction limited by a classic-jerk rule and by what the neighbouring moves can
+//! accelerate or brake to.
+//!
+//! Place in the pipeline: vocabulary. The G-code writer (`emit`) plans every move it writes with
+//! it for the header's estimate, the tools' extrusion time and the cooling's layer times;
+//! `conduit check` plans every move it replays with it. Both stop the queue where firmware
+//! empties it (a dwell, a heat-up wait, homing, a tool change), so the header and `check` agree
+//! on a file the writer made.
 //!
 //! With `jerk = 0` every move starts and ends at standstill, and a move of length `L` at speed
 //! `v` takes [`trapezoid_time`]: `L/v + v/a` when `L ≥ v²/a`, else `2·√(L/a)`.
 
+/// Largest instantaneous speed change of an axis at a junction, mm/s: Marlin's default
+/// classic jerk (and PrusaSlicer's `machine_max_jerk_x`/`_y` for Marlin), which both the header
+/// and `check` plan with.
+pub const JERK_MM_S: f64 = 10.0;
+
+/// Highest feed rate planned, mm/s: a cap on the machine's speed, far above any print move.
+pub const MAX_FEEDRATE_MM_S: f64 = 500.0;
+
 /// One planned move.
 #[derive(Debug, Clone, Copy)]
 struct Block {
-    /// G-code line of the move, for [`Planner::times`].
+    /// Caller's id of the move (the G-code line in `check`), for [`Planner::times`].
     line: usize,
     length: f64,
     speed: f64,
@@ -18,7 +33,7 @@ struct Block {
 
 /// Queues moves and adds their planned time to [`Planner::total`] at each [`Planner::flush`].
 #[derive(Debug, Clone)]
-pub(super) struct Planner {
+pub struct Planner {
     accel: f64,
     jerk: f64,
     blocks: Vec<Block>,
@@ -26,7 +41,7 @@ pub(super) struct Planner {
     entry: Option<f64>,
     /// Time of the moves committed so far, s.
     pub total: f64,
-    /// Planned time of each committed move: (G-code line, s), in file order.
+    /// Planned time of each committed move: (the id it was pushed with, s), in push order.
     pub times: Vec<(usize, f64)>,
 }
 
@@ -39,7 +54,7 @@ const QUEUE: usize = 64;
 impl Planner {
     /// A planner with acceleration `accel` (mm/s²) and jerk `jerk` (mm/s, the largest
     /// instantaneous speed change of any axis at a junction).
-    pub(super) fn new(accel: f64, jerk: f64) -> Self {
+    pub fn new(accel: f64, jerk: f64) -> Self {
         Self {
             accel,
             jerk: jerk.max(0.0),
@@ -50,9 +65,9 @@ impl Planner {
         }
     }
 
-    /// Queues the move on G-code line `line` of `length` mm at `speed` mm/s, leaving in unit
+    /// Queues the move with id `line` (any number the caller finds it by) of `length` mm at `speed` mm/s, leaving in unit
     /// direction `dir_in` and arriving in `dir_out` (zero vectors for moves of E only).
-    pub(super) fn push(
+    pub fn push(
         &mut self,
         line: usize,
         length: f64,
@@ -76,7 +91,7 @@ impl Planner {
     }
 
     /// Plans the queued moves to a standstill and adds their time.
-    pub(super) fn flush(&mut self) {
+    pub fn flush(&mut self) {
         self.plan(self.blocks.len());
     }
 
@@ -160,7 +175,7 @@ fn block_time(length: f64, speed: f64, entry: f64, exit: f64, a: f64) -> f64 {
 /// otherwise `2·√(L/a)` (a triangle profile). The closed form the planner reduces to without
 /// jerk; used by the tests.
 #[cfg(test)]
-pub(super) fn trapezoid_time(length: f64, v: f64, a: f64) -> f64 {
+pub(crate) fn trapezoid_time(length: f64, v: f64, a: f64) -> f64 {
     if length <= 0.0 || v <= 0.0 {
         return 0.0;
     }
