@@ -1392,6 +1392,32 @@ fn contours_dropped_from_an_open_mesh_are_a_warning_on_the_terminal() {
         err.contains("nothing to print") && err.contains("100 open contour(s) could not be closed"),
         "{err}"
     );
+
+    // A slab 1 mm thick in y without its x = max face: each layer's chain ends 1 mm apart, so it
+    // is closed across that gap and prints, and the terminal says so too.
+    let min_y = cube
+        .iter()
+        .flat_map(|t| t.iter().map(|p| p.y))
+        .fold(f64::MAX, f64::min);
+    let slab: Vec<[conduit::geom::Point3; 3]> = cube
+        .iter()
+        .filter(|t| !t.iter().all(|p| (p.x - max_x).abs() < 1e-9))
+        .map(|t| t.map(|p| conduit::geom::Point3::new(p.x, p.y.min(min_y + 1.0), p.z)))
+        .collect();
+    write_stl(&model, &slab);
+    let out = conduit_env(
+        &slice_args(dir, "slab", std::slice::from_ref(&model), &[]),
+        &[],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning: ")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].contains("100 open contour(s) were closed across a gap of at most 2 mm"),
+        "{}",
+        warnings[0]
+    );
 }
 
 /// The header's estimate (`; estimated printing time = … (S s)`) of a file conduit wrote, in s.
@@ -1437,5 +1463,70 @@ fn the_header_estimate_is_the_time_check_plans() {
             (header - planned).abs() <= 0.01 * planned + 5.0,
             "{name}: header {header} s, check {planned} s"
         );
+    }
+}
+
+/// Per layer (by `;Z:`), the start of every outer-wall loop: the first point of each run of
+/// `External perimeter` moves.
+fn outer_wall_starts(text: &str) -> BTreeMap<i64, Vec<[f64; 2]>> {
+    let r = replay(text);
+    let mut starts: BTreeMap<i64, Vec<[f64; 2]>> = BTreeMap::new();
+    for run in runs(&r.moves) {
+        if run[0].role == "External perimeter" {
+            let layer = run[0].layer_um.expect("a layer marker before the walls");
+            starts
+                .entry(layer)
+                .or_default()
+                .push([run[0].from[0], run[0].from[1]]);
+        }
+    }
+    starts
+}
+
+/// The share of outer-wall starts within 1 mm of an outer-wall start on the layer below.
+fn aligned_share(starts: &BTreeMap<i64, Vec<[f64; 2]>>) -> f64 {
+    let layers: Vec<&Vec<[f64; 2]>> = starts.values().collect();
+    let (mut aligned, mut all) = (0usize, 0usize);
+    for pair in layers.windows(2) {
+        for p in pair[1] {
+            all += 1;
+            if pair[0]
+                .iter()
+                .any(|q| (p[0] - q[0]).hypot(p[1] - q[1]) <= 1.0)
+            {
+                aligned += 1;
+            }
+        }
+    }
+    aligned as f64 / all.max(1) as f64
+}
+
+#[test]
+fn aligned_seams_line_up_on_every_layer() {
+    let dir = temp_dir();
+    // The L bracket's outer wall has one inside corner: every layer's seam is there.
+    let s = slice(dir.path(), "aligned", &[sample("l_bracket.obj")], &[]);
+    let starts = outer_wall_starts(&s.gcode);
+    let first = starts.values().next().expect("walls")[0];
+    assert!(
+        starts.values().all(|l| l.len() == 1 && l[0] == first),
+        "{starts:?}"
+    );
+    assert_eq!(aligned_share(&starts), 1.0);
+    // Nearest scatters them; rear lines them up too.
+    let nearest = ["--set", "slice.seam_position=nearest"];
+    let s = slice(dir.path(), "nearest", &[sample("l_bracket.obj")], &nearest);
+    assert!(aligned_share(&outer_wall_starts(&s.gcode)) < 0.9);
+    if let Some(corpus) = corpus() {
+        let benchy = corpus.join("bench-models/3DBenchy.stl");
+        if benchy.exists() {
+            let s = slice(dir.path(), "benchy", &[benchy], &[]);
+            let share = aligned_share(&outer_wall_starts(&s.gcode));
+            println!(
+                "3DBenchy: {:.1} % of outer-wall starts aligned",
+                share * 100.0
+            );
+            assert!(share >= 0.85, "{share}");
+        }
     }
 }

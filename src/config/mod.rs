@@ -72,7 +72,7 @@ pub use crate::program::machine::{
 use crate::region::{
     InfillPatternKind, MIN_LAYER_HEIGHT, NOZZLE_RANGE, PerimeterGenerator, RegionParams,
 };
-use crate::toolpaths::{ProgramParams, RoleSpeeds, ToolPathParams};
+use crate::toolpaths::{OrderParams, ProgramParams, RoleSpeeds, SeamRule, ToolPathParams};
 
 /// Fastest speed of any move, mm/s: the fastest FFF printers travel at about 1000 mm/s; a
 /// larger number is a typo, and would make every time estimate meaningless.
@@ -178,6 +178,13 @@ pub struct SliceSettings {
     /// Print the external loop of each island first (better dimensional accuracy, worse
     /// overhangs). Default false: inner loops first.
     pub external_perimeters_first: bool,
+    /// Where each perimeter loop starts (PrusaSlicer's `seam_position`): `"aligned"` (default)
+    /// in an inside corner where the loop has one (turning by 50° or more), else in an outside
+    /// corner, else at the rear, so the seams of all layers line up into one line, hidden in a
+    /// corner where the part has one; `"rear"` at the rearmost point (largest Y); `"nearest"` at
+    /// the point nearest to the nozzle (least travel, seams scattered); `"random"` at a point
+    /// that changes from layer to layer.
+    pub seam_position: SeamRule,
     /// How the perimeter band is laid out: `"variable"` (default) keeps loops from running over
     /// themselves and fills what they leave with beads whose number and width follow the wall's
     /// local thickness, so a 0.3 mm fin or a tapering wall prints at its true thickness;
@@ -280,6 +287,7 @@ impl Default for SliceSettings {
                 Self {
                     $($key: region.$key,)+
                     first_layer_height: 0.2,
+                    seam_position: SeamRule::Aligned,
                     top_fill_pattern: SolidPattern::Rectilinear,
                     bottom_fill_pattern: SolidPattern::Rectilinear,
                     support_material: false,
@@ -916,6 +924,10 @@ impl Config {
             .collect();
         ProgramParams {
             tools,
+            order: OrderParams {
+                seam: s.seam_position,
+                ..OrderParams::default()
+            },
             ..ProgramParams::default()
         }
     }

@@ -31,7 +31,7 @@
 //!   `infill_overlap`, `solid_infill_below_area`, `gap_fill_enabled`, `external_perimeters_first`, `support_material`, `skirts`,
 //!   `skirt_distance`, `brim_width`, `bridge_speed`, `gap_fill_speed`, `perimeter_generator` (`classic`, or `arachne`, also when
 //!   missing, for the variable generator) with `thin_walls` (classic only: Arachne prints thin
-//!   features anyway), the speeds (a `%` speed is relative to its
+//!   features anyway), `seam_position`, the speeds (a `%` speed is relative to its
 //!   PrusaSlicer parent: external perimeter → perimeter, solid infill → infill, top solid →
 //!   solid infill, first layer → perimeter, support → perimeter), `support_material_speed` (→
 //!   `skirt_speed`, as PrusaSlicer prints skirts at support speed);
@@ -57,6 +57,7 @@ use std::collections::BTreeSet;
 
 use super::{Config, ConfigError, Flavor, SolidPattern, Tool};
 use crate::region::{InfillPatternKind, PerimeterGenerator};
+use crate::toolpaths::SeamRule;
 
 /// Reads a PrusaSlicer `.ini` (`key = value` lines, `#` comments, `[section]` headers of a
 /// config bundle are skipped). Errors carry the line number.
@@ -427,6 +428,7 @@ const RULES: &[(&str, Rule)] = &[
     ("skirt_distance", Rule::Num(|c| &mut c.slice.skirt_distance)),
     ("brim_width", Rule::Num(|c| &mut c.slice.brim_width)),
     ("perimeter_generator", Rule::Custom(perimeter_generator)),
+    ("seam_position", Rule::Custom(seam_position)),
     // Widths (every role width is read with the generic one).
     ("extrusion_width", Rule::Custom(extrusion_widths)),
     // Speeds; a percentage is of the parent PrusaSlicer uses.
@@ -815,6 +817,25 @@ fn perimeter_generator(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     Ok(())
 }
 
+/// `seam_position`: `aligned`, `nearest`, `rear` and `random` are conduit's rules of the same
+/// names; PrusaSlicer's default (`aligned`) when the key is missing.
+fn seam_position(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let Some(named) = imp.p.raw(key).map(|v| v.trim().to_owned()) else {
+        imp.cfg.slice.seam_position = SeamRule::Aligned;
+        return Ok(());
+    };
+    imp.cfg.slice.seam_position = match named.as_str() {
+        "aligned" => SeamRule::Aligned,
+        "nearest" => SeamRule::Nearest,
+        "rear" => SeamRule::Rear,
+        "random" => SeamRule::Random,
+        _ => {
+            return Err(imp.p.err(key, "expected aligned, nearest, rear or random"));
+        }
+    };
+    Ok(())
+}
+
 /// `extrusion_width` and the role widths of [`WIDTHS`]: a role's 0 (or missing) width falls
 /// back to the generic one, and when that is 0 too to the automatic width; a first-layer width
 /// of 0 takes the perimeter width.
@@ -870,7 +891,6 @@ const CHANGES_THE_PRINT: &[(&str, Option<&[&str]>)] = &[
     ("max_volumetric_speed", Some(&["0"])),
     ("overhangs", Some(&["0"])),
     ("raft_layers", Some(&["0"])),
-    ("seam_position", None),
     ("solid_infill_every_layers", Some(&["0"])),
     ("spiral_vase", Some(&["0"])),
     ("support_material_auto", None),
@@ -1185,7 +1205,7 @@ gcode_comments = 0
                 .split_once(IGNORED_LIST_MARK)
                 .expect("the full list follows the summary");
             // The summary names only what changes the print; the list has every key.
-            assert!(summary.contains("seam_position"), "{file}: {summary}");
+            assert!(summary.contains("infill_anchor"), "{file}: {summary}");
             assert!(!summary.contains("gcode_comments"), "{file}: {summary}");
             assert!(all.contains("gcode_comments"), "{file}: {all}");
             let keys: Vec<&str> = all.split(", ").collect();

@@ -183,18 +183,32 @@ pub struct SliceSummary {
 
 impl SliceSummary {
     /// What the user should hear about on the terminal, one line each: objects whose open
-    /// contours could not be closed and were left out of the print (the mesh has holes).
+    /// contours could not be closed and were left out of the print, or were closed across a gap
+    /// (either way the mesh has holes, and the print differs from a closed mesh's).
     pub fn warnings(&self) -> Vec<String> {
         self.objects
             .iter()
-            .filter(|o| o.slice.open_chains_dropped > 0)
-            .map(|o| {
-                format!(
-                    "object \"{}\": {} open contour(s) could not be closed and were left out \
-                     ({} closed across a gap); the mesh has holes: `conduit info` shows them, \
+            .filter_map(|o| {
+                let (dropped, closed) = (o.slice.open_chains_dropped, o.slice.open_chains_closed);
+                let what = if dropped > 0 {
+                    format!(
+                        "{dropped} open contour(s) could not be closed and were left out \
+                         ({closed} closed across a gap)"
+                    )
+                } else if closed > 0 {
+                    format!(
+                        "{closed} open contour(s) were closed across a gap of at most \
+                         {} mm",
+                        crate::slice::DEFAULT_MAX_GAP_MM
+                    )
+                } else {
+                    return None;
+                };
+                Some(format!(
+                    "object \"{}\": {what}; the mesh has holes: `conduit info` shows them, \
                      `conduit convert --repair` fills them",
-                    o.name, o.slice.open_chains_dropped, o.slice.open_chains_closed
-                )
+                    o.name
+                ))
             })
             .collect()
     }

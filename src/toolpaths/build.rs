@@ -22,7 +22,8 @@
 //!   thin for perimeters) form one more group per object.
 //! - **Seams.** A perimeter or skirt loop starts at the vertex chosen by
 //!   [`OrderParams::seam`]: by default the vertex nearest to where the nozzle is
-//!   ([`SeamRule::Nearest`](super::order::SeamRule::Nearest)).
+//!   ([`SeamRule::Nearest`](super::order::SeamRule::Nearest)); the config's
+//!   `slice.seam_position` picks [`SeamRule::Aligned`](super::order::SeamRule::Aligned).
 //! - **Speeds and widths.** Per tool ([`ToolPathParams`]): perimeters keep the width the
 //!   regions stage gave each loop; infill and skirt take the tool's widths; every path on the
 //!   program's first layer is printed at `first_layer_speed`.

@@ -29,8 +29,19 @@ use crate::program::Toolpath;
 /// differences of sums cannot make the improvement loop cycle.
 const MIN_GAIN_MM: f64 = 1e-9;
 
-/// Where a closed loop printed in a fixed order starts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Where a closed loop printed in a fixed order starts (PrusaSlicer's `seam_position`).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    schemars::JsonSchema,
+)]
+#[serde(rename_all = "lowercase")]
 pub enum SeamRule {
     /// At the vertex nearest to the nozzle (least travel; the seam wanders between layers).
     #[default]
@@ -38,6 +49,85 @@ pub enum SeamRule {
     /// At the rearmost vertex (largest Y), the one nearest to the nozzle among equally rear
     /// ones, so seams line up on the back of the part.
     Rear,
+    /// In a corner where one is (see [`aligned_vertex`]), else at the rear: the same corner or
+    /// the same rear edge on every layer, so seams line up into one seam line, hidden in an
+    /// inside corner where the part has one.
+    Aligned,
+    /// At a vertex picked by a hash of the loop's coordinates: seams scattered over the
+    /// surface, different on every layer and the same from run to run.
+    Random,
+}
+
+/// Smallest turn at a vertex, degrees, for it to count as a corner where [`SeamRule::Aligned`]
+/// puts a seam: the corners of a hexagon (60°) count, the facets of a tessellated curve
+/// (a few degrees each) do not.
+const SEAM_CORNER_DEG: f64 = 50.0;
+
+/// The vertex [`SeamRule::Aligned`] starts a loop at: the rearmost (then leftmost) of the
+/// sharpest turning class present. A concave corner (turning against the loop's direction) hides the seam best;
+/// then a convex corner; without corners, the rear. Each class is taken whole (not the single
+/// sharpest corner) so that a corner's angle drifting a little from layer to layer, as on a
+/// sliced curve, does not move the seam to another corner; the rear breaks ties the same way
+/// on every layer.
+pub fn aligned_vertex(points: &[Point3], from: &Point3) -> usize {
+    let n = points.len();
+    if n < 3 {
+        return nearest_vertex(points, from);
+    }
+    let min_turn = SEAM_CORNER_DEG.to_radians();
+    // Turn at each vertex, positive to the left. Loops run with the material on their left
+    // (around an island counter-clockwise, around a hole clockwise), so a right turn is an
+    // inside corner of the material whichever way the loop runs.
+    let turn = |i: usize| {
+        let (p, q, r) = (&points[(i + n - 1) % n], &points[i], &points[(i + 1) % n]);
+        let (ax, ay, bx, by) = (q.x - p.x, q.y - p.y, r.x - q.x, r.y - q.y);
+        (ax * by - ay * bx).atan2(ax * bx + ay * by)
+    };
+    let concave = |t: f64| t <= -min_turn;
+    let convex = |t: f64| t >= min_turn;
+    let turns: Vec<f64> = (0..n).map(turn).collect();
+    let rearmost = |keep: &dyn Fn(f64) -> bool| -> Option<usize> {
+        let mut best: Option<(usize, f64, f64)> = None;
+        for (i, p) in points.iter().enumerate() {
+            if !keep(turns[i]) {
+                continue;
+            }
+            // Equally rear points (a straight back edge): the leftmost, the same on every
+            // layer, not the nearest to a nozzle that comes from elsewhere each time.
+            let better = match best {
+                None => true,
+                Some((_, y, x)) => p.y > y + 1e-9 || ((p.y - y).abs() <= 1e-9 && p.x < x - 1e-9),
+            };
+            if better {
+                best = Some((i, p.y, p.x));
+            }
+        }
+        best.map(|b| b.0)
+    };
+    rearmost(&concave)
+        .or_else(|| rearmost(&convex))
+        .or_else(|| rearmost(&|_| true))
+        .unwrap_or(0)
+}
+
+/// The vertex [`SeamRule::Random`] starts a loop at: an FNV-1a hash of its coordinates' bits.
+fn random_vertex(points: &[Point3]) -> usize {
+    if points.is_empty() {
+        return 0;
+    }
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for p in points {
+        for v in [p.x, p.y, p.z] {
+            for b in v.to_bits().to_le_bytes() {
+                h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        }
+    }
+    // splitmix64's finaliser: nearby loops (the same ring a layer higher) land far apart.
+    h = (h ^ (h >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    h = (h ^ (h >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    h ^= h >> 31;
+    (h % points.len() as u64) as usize
 }
 
 /// Parameters of travel ordering.
@@ -79,6 +169,8 @@ pub fn nearest_vertex(points: &[Point3], from: &Point3) -> usize {
 pub fn seam_vertex(points: &[Point3], from: &Point3, rule: SeamRule) -> usize {
     match rule {
         SeamRule::Nearest => nearest_vertex(points, from),
+        SeamRule::Aligned => aligned_vertex(points, from),
+        SeamRule::Random => random_vertex(points),
         SeamRule::Rear => {
             let max_y = points.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max);
             let mut best = (0, f64::INFINITY);
@@ -618,5 +710,65 @@ mod tests {
         // Within each group the loops come first, in their given order.
         assert!(paths[0].closed && paths[1].closed && !paths[2].closed && !paths[3].closed);
         assert!((paths[0].points.iter().map(|p| p.x).fold(f64::MAX, f64::min) - 0.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn aligned_seams_go_to_the_inside_corner_else_the_rear() {
+        let from = Point3::new(-50.0, -50.0, 0.2);
+        let p = |x: f64, y: f64| Point3::new(x, y, 0.2);
+        // An L, counter-clockwise: its one inside corner is at (5, 5).
+        let l = [
+            p(0.0, 0.0),
+            p(10.0, 0.0),
+            p(10.0, 5.0),
+            p(5.0, 5.0),
+            p(5.0, 10.0),
+            p(0.0, 10.0),
+        ];
+        assert_eq!(aligned_vertex(&l, &from), 3);
+        // The same L clockwise (a loop around an L-shaped hole, material on its left): the
+        // material's inside corners are the L's outer ones; the rearmost, then leftmost.
+        let mut hole = l.to_vec();
+        hole.reverse();
+        assert_eq!(hole[aligned_vertex(&hole, &from)], p(0.0, 10.0));
+        // A square: no inside corner; of the two rear corners the left one, wherever the
+        // nozzle comes from.
+        let sq = [p(0.0, 0.0), p(10.0, 0.0), p(10.0, 10.0), p(0.0, 10.0)];
+        assert_eq!(aligned_vertex(&sq, &from), 3);
+        assert_eq!(aligned_vertex(&sq, &p(50.0, 50.0)), 3);
+        // A 64-gon has no corner at all: its rearmost vertex, on every layer.
+        let circle: Vec<Point3> = (0..64)
+            .map(|k| {
+                let a = f64::from(k) * std::f64::consts::TAU / 64.0;
+                p(10.0 * a.cos(), 10.0 * a.sin())
+            })
+            .collect();
+        assert_eq!(aligned_vertex(&circle, &from), 16);
+        assert_eq!(
+            seam_vertex(&circle, &Point3::new(10.0, 0.0, 0.2), SeamRule::Aligned),
+            16
+        );
+    }
+
+    #[test]
+    fn random_seams_are_repeatable_and_move_between_layers() {
+        let ring = |z: f64| -> Vec<Point3> {
+            (0..64)
+                .map(|k| {
+                    let a = f64::from(k) * std::f64::consts::TAU / 64.0;
+                    Point3::new(10.0 * a.cos(), 10.0 * a.sin(), z)
+                })
+                .collect()
+        };
+        let from = Point3::new(0.0, 0.0, 0.0);
+        let starts: Vec<usize> = (1..=20)
+            .map(|k| seam_vertex(&ring(f64::from(k) * 0.2), &from, SeamRule::Random))
+            .collect();
+        let again: Vec<usize> = (1..=20)
+            .map(|k| seam_vertex(&ring(f64::from(k) * 0.2), &from, SeamRule::Random))
+            .collect();
+        assert_eq!(starts, again);
+        let distinct: std::collections::BTreeSet<usize> = starts.iter().copied().collect();
+        assert!(distinct.len() >= 10, "{starts:?}");
     }
 }
