@@ -1530,3 +1530,53 @@ fn aligned_seams_line_up_on_every_layer() {
         }
     }
 }
+
+/// Per printed layer, the time `check` plans for its extruding moves, s.
+fn extruding_time_per_layer(text: &str) -> Vec<f64> {
+    let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
+    let report = check(&g, &Config::default().check_params());
+    let m = conduit_gcode::moves(&g, Firmware::Marlin);
+    let layer_of: BTreeMap<usize, usize> = m
+        .moves
+        .iter()
+        .filter(|mv| mv.extruding)
+        .map(|mv| (mv.line, mv.layer))
+        .collect();
+    let mut per_layer = vec![0.0; m.layer_z.len()];
+    for (line, t) in &report.move_times {
+        if let Some(&l) = layer_of.get(line) {
+            per_layer[l] += t;
+        }
+    }
+    per_layer
+}
+
+#[test]
+fn short_layers_are_slowed_to_the_minimum_layer_time() {
+    // A 6 mm cube: each layer prints in about 2 s at full speed.
+    let dir = temp_dir();
+    let tris: Vec<[conduit::geom::Point3; 3]> = stl_triangles(&sample("cube_20mm.stl"))
+        .iter()
+        .map(|t| t.map(|p| conduit::geom::Point3::new(p[0] as f64, p[1] as f64, p[2] as f64)))
+        .map(|t| t.map(|p| conduit::geom::Point3::new(p.x * 0.3, p.y * 0.3, p.z * 0.3)))
+        .collect();
+    let model = dir.path().join("small.stl");
+    write_stl(&model, &tris);
+    let off = ["--set", "printer.slowdown_below_layer_time=0"];
+    let fast = extruding_time_per_layer(
+        &slice(dir.path(), "fast", std::slice::from_ref(&model), &off).gcode,
+    );
+    let slowed = extruding_time_per_layer(&slice(dir.path(), "slow", &[model], &[]).gcode);
+    assert_eq!(fast.len(), slowed.len());
+    println!("layer times, s: full speed {fast:.2?}, slowed {slowed:.2?}");
+    // The first layer (20 mm/s) takes longer than 5 s anyway; the others are quicker.
+    assert!(
+        fast[0] > 5.0 && fast[1..].iter().all(|&t| t < 4.0),
+        "{fast:?}"
+    );
+    // Those take the 5 s (to within the refinement of the factor), none longer: the slowest
+    // moves here (20 mm/s gap fill) stay above min_print_speed when slowed.
+    for (l, t) in slowed.iter().enumerate().skip(1) {
+        assert!((t - 5.0).abs() < 0.05, "layer {l}: {t} s");
+    }
+}

@@ -760,6 +760,18 @@ impl Config {
                 problems.push(format!("{key} must be a finite number, got {v}"));
             }
         }
+        for (key, v) in [
+            (
+                "printer.slowdown_below_layer_time",
+                p.slowdown_below_layer_time,
+            ),
+            ("printer.fan_below_layer_time", p.fan_below_layer_time),
+            ("printer.min_print_speed", p.min_print_speed),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                problems.push(format!("{key} must be a finite number ≥ 0, got {v}"));
+            }
+        }
         for (i, t) in self.tools.iter().enumerate() {
             for (key, v) in [
                 ("temperature", Some(t.temperature)),

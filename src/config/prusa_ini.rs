@@ -16,7 +16,8 @@
 //!   `deretract_speed`, `retract_before_travel`, `retract_lift`, `travel_speed`,
 //!   `machine_max_acceleration_extruding` (or `default_acceleration`),
 //!   `use_relative_e_distances`, `use_firmware_retraction`, `min_fan_speed`, `max_fan_speed`,
-//!   `disable_fan_first_layers`;
+//!   `disable_fan_first_layers`, `slowdown_below_layer_time`, `fan_below_layer_time`,
+//!   `min_print_speed`;
 //! - tools: the comma-separated lists give one value per extruder: `nozzle_diameter`,
 //!   `filament_diameter`, `filament_density` (0, PrusaSlicer's "unknown", keeps the default),
 //!   `filament_type` (the tool's name), `temperature`,
@@ -357,6 +358,18 @@ const RULES: &[(&str, Rule)] = &[
     ("travel_speed", Rule::Num(|c| &mut c.printer.travel_speed)),
     ("min_fan_speed", Rule::Num(|c| &mut c.printer.fan_min_speed)),
     ("max_fan_speed", Rule::Num(|c| &mut c.printer.fan_max_speed)),
+    (
+        "slowdown_below_layer_time",
+        Rule::Num(|c| &mut c.printer.slowdown_below_layer_time),
+    ),
+    (
+        "fan_below_layer_time",
+        Rule::Num(|c| &mut c.printer.fan_below_layer_time),
+    ),
+    (
+        "min_print_speed",
+        Rule::Num(|c| &mut c.printer.min_print_speed),
+    ),
     (
         "machine_max_acceleration_extruding",
         Rule::Custom(acceleration),

@@ -83,6 +83,17 @@ pub struct Printer {
     pub fan_max_speed: f64,
     /// Number of bottom layers printed with the fan off. Default 1.
     pub disable_fan_first_layers: usize,
+    /// Layers whose printing would take less than this (s) are slowed down to take it, so each
+    /// layer cools before the next is laid on it, and get the fan at `fan_max_speed`
+    /// (PrusaSlicer's `slowdown_below_layer_time`); 0 = never slow down. Default 5.
+    pub slowdown_below_layer_time: f64,
+    /// Slowest a slowed-down layer is printed, mm/s (PrusaSlicer's `min_print_speed`); moves
+    /// already slower keep their speed. Default 10.
+    pub min_print_speed: f64,
+    /// Layers taking longer than this (s) get the fan at `fan_min_speed`; between this and
+    /// `slowdown_below_layer_time` the fan runs in proportion (PrusaSlicer's
+    /// `fan_below_layer_time`). Default 60.
+    pub fan_below_layer_time: f64,
     /// Retract with the firmware's `G10`/`G11` instead of E moves. Default false.
     pub use_firmware_retraction: bool,
 }
@@ -180,6 +191,9 @@ impl Default for Printer {
             fan_min_speed: 35.0,
             fan_max_speed: 100.0,
             disable_fan_first_layers: 1,
+            slowdown_below_layer_time: 5.0,
+            min_print_speed: 10.0,
+            fan_below_layer_time: 60.0,
             use_firmware_retraction: false,
         }
     }

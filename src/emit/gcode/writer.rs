@@ -20,13 +20,9 @@ use crate::program::{Event, Feed, Layer, LayerItem, Program, Toolpath};
 /// for it, mm: half the output resolution.
 const ARC_CHORD_TOLERANCE: f64 = 0.0005;
 
-/// Layers printed faster than this (s) get the fan at `fan_max_speed` (PrusaSlicer's default
-/// `slowdown_below_layer_time`).
-const SLOWDOWN_BELOW_S: f64 = 5.0;
-
-/// Layers printed slower than this (s) get the fan at `fan_min_speed` (PrusaSlicer's default
-/// `fan_below_layer_time`).
-const FAN_BELOW_S: f64 = 60.0;
+/// Refinements of a layer's slow-down factor: the planned time is not quite proportional to
+/// the speeds (acceleration), so the factor is corrected by the time it gives, a few times.
+const SLOWDOWN_ROUNDS: usize = 4;
 
 /// Per-tool state and settings prepared once.
 struct ToolState {
@@ -108,6 +104,9 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     planned: Vec<Option<usize>>,
     /// Dwells written, s.
     dwell_s: f64,
+    /// The current layer's slow-down factor on print speeds (1: none), see
+    /// [`Self::slowdown`].
+    speed_factor: f64,
     /// Tools the program uses, ascending.
     used: Vec<usize>,
     /// Fan command written last.
@@ -179,6 +178,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             planner: Planner::new(cfg.printer.max_acceleration, JERK_MM_S),
             planned: Vec::new(),
             dwell_s: 0.0,
+            speed_factor: 1.0,
             used: Vec::new(),
             fan: None,
             switch: switched::SwitchState::default(),
@@ -662,20 +662,13 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         Ok(())
     }
 
-    /// Part-cooling fan for `layer`, percent: off on the first `disable_fan_first_layers`
-    /// layers; then, as PrusaSlicer's cooling logic with its default thresholds, full speed
-    /// (`fan_max_speed`) for layers printed faster than [`SLOWDOWN_BELOW_S`], `fan_min_speed`
-    /// for layers slower than [`FAN_BELOW_S`], linear in between. The layer time is the
-    /// extrusion time of its paths, each planned by the motion model ([`Planner`]).
-    fn fan_speed(&self, layer: &Layer) -> f64 {
-        let p = &self.cfg.printer;
-        if layer.index < p.disable_fan_first_layers {
-            return 0.0;
-        }
-        // Each path planned as the file runs it, from a stop to a stop (a travel or a
-        // retraction lies between paths).
-        let mut planner = Planner::new(p.max_acceleration, JERK_MM_S);
+    /// Extrusion time of `layer` with its print speeds times `factor` (never below
+    /// `printer.min_print_speed` unless already slower), s: each path planned by the motion
+    /// model ([`Planner`]) from a stop to a stop (a travel or a retraction lies between paths).
+    fn layer_time(&self, layer: &Layer, factor: f64) -> f64 {
+        let mut planner = Planner::new(self.cfg.printer.max_acceleration, JERK_MM_S);
         for path in layer.paths() {
+            let speed = self.slowed(path.speed, factor);
             let closing = path.closed.then(|| path.points[0]);
             for (a, b) in path
                 .points
@@ -686,19 +679,61 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                 let length = d.norm();
                 if length > 0.0 {
                     let dir = [d.x / length, d.y / length, d.z / length];
-                    planner.push(0, length, path.speed.min(MAX_FEEDRATE_MM_S), dir, dir);
+                    planner.push(0, length, speed.min(MAX_FEEDRATE_MM_S), dir, dir);
                 }
             }
             planner.flush();
         }
-        let time = planner.total;
+        planner.total
+    }
+
+    /// `speed` times the layer's slow-down `factor`, not below `printer.min_print_speed` (a
+    /// speed already below it is kept).
+    fn slowed(&self, speed: f64, factor: f64) -> f64 {
+        if factor >= 1.0 {
+            speed
+        } else {
+            (speed * factor).max(self.cfg.printer.min_print_speed.min(speed))
+        }
+    }
+
+    /// The factor on `layer`'s print speeds that makes it take `printer.slowdown_below_layer_time`
+    /// (PrusaSlicer's cooling slow-down), 1 when it takes that long anyway; and the layer's
+    /// time at full speed, s.
+    fn slowdown(&self, layer: &Layer) -> (f64, f64) {
+        let target = self.cfg.printer.slowdown_below_layer_time;
+        let time = self.layer_time(layer, 1.0);
+        if !(time > 0.0 && time < target) {
+            return (1.0, time);
+        }
+        let mut factor = time / target;
+        for _ in 0..SLOWDOWN_ROUNDS {
+            let t = self.layer_time(layer, factor);
+            if t <= 0.0 || (t - target).abs() < 1e-3 * target {
+                break;
+            }
+            factor = (factor * t / target).min(1.0);
+        }
+        (factor, time)
+    }
+
+    /// Part-cooling fan for a layer that takes `time` s at full speed, percent: off on the first
+    /// `disable_fan_first_layers` layers; then, as PrusaSlicer's cooling logic, full speed
+    /// (`fan_max_speed`) for layers faster than `slowdown_below_layer_time`, `fan_min_speed` for
+    /// layers slower than `fan_below_layer_time`, linear in between.
+    fn fan_speed(&self, layer: &Layer, time: f64) -> f64 {
+        let p = &self.cfg.printer;
+        if layer.index < p.disable_fan_first_layers {
+            return 0.0;
+        }
         let (lo, hi) = (p.fan_min_speed, p.fan_max_speed);
-        if time <= SLOWDOWN_BELOW_S {
+        let (fast, slow) = (p.slowdown_below_layer_time, p.fan_below_layer_time);
+        if time <= fast {
             hi
-        } else if time >= FAN_BELOW_S {
+        } else if time >= slow || slow <= fast {
             lo
         } else {
-            hi - (hi - lo) * (time - SLOWDOWN_BELOW_S) / (FAN_BELOW_S - SLOWDOWN_BELOW_S)
+            hi - (hi - lo) * (time - fast) / (slow - fast)
         }
     }
 
@@ -735,7 +770,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                 }
             }
         }
-        let fan_line = fan(self.fan_speed(layer));
+        let (factor, time) = self.slowdown(layer);
+        self.speed_factor = factor;
+        let fan_line = fan(self.fan_speed(layer, time));
         if self.fan.as_deref() != Some(fan_line.as_str()) {
             self.line(&fan_line);
             self.fan = Some(fan_line);
@@ -792,7 +829,8 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             self.line(&format!(";HEIGHT:{h}"));
             self.height = Some(h);
         }
-        if let Some(f) = self.feed_word(path.speed) {
+        let speed = self.slowed(path.speed, self.speed_factor);
+        if let Some(f) = self.feed_word(speed) {
             self.line(&format!("G1{f}"));
         }
         let ts = &self.tools[tool];
@@ -833,7 +871,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                 // The same position once written: merge into the next move (absolute E is
                 // cumulative; relative E is carried).
                 pending_de += de;
-                self.motion(MotionKind::Extrude, to, de, path.speed, Some(path.role));
+                self.motion(MotionKind::Extrude, to, de, speed, Some(path.role));
                 self.pos = Some(to);
                 continue;
             }
@@ -854,7 +892,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             }
             pending_de = 0.0;
             self.line(&words);
-            self.motion(MotionKind::Extrude, to, de, path.speed, Some(path.role));
+            self.motion(MotionKind::Extrude, to, de, speed, Some(path.role));
             self.pos = Some(to);
             last_xy = (xs, ys);
         }
