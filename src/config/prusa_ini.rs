@@ -1218,7 +1218,7 @@ gcode_comments = 0
                 .split_once(IGNORED_LIST_MARK)
                 .expect("the full list follows the summary");
             // The summary names only what changes the print; the list has every key.
-            assert!(summary.contains("infill_anchor"), "{file}: {summary}");
+            assert!(summary.contains("extra_perimeters"), "{file}: {summary}");
             assert!(!summary.contains("gcode_comments"), "{file}: {summary}");
             assert!(all.contains("gcode_comments"), "{file}: {all}");
             let keys: Vec<&str> = all.split(", ").collect();
