@@ -27,27 +27,16 @@ const PITCH: f64 = 5.0;
 /// Filament diameter of the default config's tool 0, mm.
 const FILAMENT_MM: f64 = 1.75;
 
-/// The 12 triangles of an axis-aligned box.
+/// The 12 triangles of an axis-aligned box ([`Mesh::cuboid`]).
 fn cuboid(min: [f64; 3], max: [f64; 3]) -> Vec<[Point3; 3]> {
-    let v = |i: usize| {
-        Point3::new(
-            if i & 1 == 0 { min[0] } else { max[0] },
-            if i & 2 == 0 { min[1] } else { max[1] },
-            if i & 4 == 0 { min[2] } else { max[2] },
-        )
-    };
-    // Outward quads, counter-clockwise seen from outside.
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    quads
+    let m = Mesh::cuboid(
+        "box",
+        Point3::new(min[0], min[1], min[2]),
+        Point3::new(max[0], max[1], max[2]),
+    );
+    m.triangles
         .iter()
-        .flat_map(|q| [[v(q[0]), v(q[1]), v(q[2])], [v(q[0]), v(q[2]), v(q[3])]])
+        .map(|t| t.map(|i| m.vertices[i as usize]))
         .collect()
 }
 

@@ -5,6 +5,8 @@ mod switched;
 
 pub(super) use switched::header as switched_header;
 
+use std::collections::VecDeque;
+
 use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
 
 use super::GcodeParams;
@@ -97,11 +99,15 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     type_name: Option<&'static str>,
     width: Option<String>,
     height: Option<String>,
-    /// Every move written, planned as `conduit check` plans it (its id is the index into
-    /// `planned`).
+    /// Every move written, planned as `conduit check` plans it (its id counts the moves).
     planner: Planner,
-    /// Per move pushed to the planner: the tool that extruded in it, if it extruded.
-    planned: Vec<Option<usize>>,
+    /// Per move pushed to the planner and not yet timed: the tool that extruded in it, if it
+    /// extruded; the first is move `planned_from`.
+    planned: VecDeque<Option<usize>>,
+    /// Id of the first move in `planned`.
+    planned_from: usize,
+    /// Id of the next move pushed to the planner.
+    next_move: usize,
     /// Dwells written, s.
     dwell_s: f64,
     /// The current layer's slow-down factor on print speeds (1: none), see
@@ -176,7 +182,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             width: None,
             height: None,
             planner: Planner::new(cfg.printer.max_acceleration, JERK_MM_S),
-            planned: Vec::new(),
+            planned: VecDeque::new(),
+            planned_from: 0,
+            next_move: 0,
             dwell_s: 0.0,
             speed_factor: 1.0,
             used: Vec::new(),
@@ -199,29 +207,48 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
 
     /// The motion model's side of a command line written as is (custom G-code, events): the
     /// firmware empties its queue at a dwell, a heat-up wait, homing and a tool change, and
-    /// `check` plans it so; a dwell's time counts.
+    /// `check` plans it so; a dwell's time counts. Moves (`G0`/`G1`, the bulk of the file) are
+    /// planned where they are written ([`Self::motion`]) and skipped here unparsed; other lines
+    /// are read by the G-code crate's tokenizer, as `check` reads them.
     fn plan_command(&mut self, line: &str) {
-        let code = line.split(';').next().unwrap_or("").trim();
-        let mut words = code.split_whitespace();
-        let Some(command) = words.next() else {
+        let line = line.trim_start();
+        if !matches!(
+            line.as_bytes().first(),
+            Some(b'G' | b'g' | b'M' | b'm' | b'T' | b't')
+        ) || line.starts_with("G1 ")
+            || line.starts_with("G0 ")
+        {
             return;
-        };
-        let number = |w: &str| w.get(1..).and_then(|v| v.parse::<f64>().ok());
-        match command.to_ascii_uppercase().as_str() {
-            "G4" => {
+        }
+        let parsed = conduit_gcode::Line::new(line, conduit_gcode::LineEnding::Lf);
+        match parsed.command() {
+            Some((b'G', 4.0)) => {
                 self.planner.flush();
-                let ms: f64 = words
-                    .filter_map(|w| match w.as_bytes().first() {
-                        Some(b'P' | b'p') => number(w),
-                        Some(b'S' | b's') => number(w).map(|s| s * 1000.0),
-                        _ => None,
-                    })
-                    .sum();
+                let ms = parsed.get(b'P').unwrap_or(0.0) + parsed.get(b'S').unwrap_or(0.0) * 1000.0;
                 self.dwell_s += ms.max(0.0) / 1000.0;
             }
-            "G28" | "M109" | "M190" | "M116" => self.planner.flush(),
-            c if c.starts_with('T') && c[1..].parse::<usize>().is_ok() => self.planner.flush(),
+            Some((b'G', 28.0) | (b'M', 109.0 | 190.0 | 116.0)) => self.planner.flush(),
+            Some((b'T', t)) if t >= 0.0 && t.fract() == 0.0 => self.planner.flush(),
             _ => {}
+        }
+    }
+
+    /// Adds the planned time of the moves the planner has committed to their tools' extrusion
+    /// time, and forgets them: `planned` holds only the moves still queued.
+    fn take_planned_times(&mut self) {
+        for (id, t) in std::mem::take(&mut self.planner.times) {
+            while self.planned_from < id {
+                self.planned.pop_front();
+                self.planned_from += 1;
+            }
+            if self.planned_from == id {
+                self.planned_from += 1;
+                if let Some(Some(tool)) = self.planned.pop_front()
+                    && let Some(ts) = self.tools.get_mut(tool)
+                {
+                    ts.extrusion_time_s += t;
+                }
+            }
         }
     }
 
@@ -248,13 +275,14 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         };
         let extruding = kind == MotionKind::Extrude;
         self.planner.push(
-            self.planned.len(),
+            self.next_move,
             distance,
             feed.min(MAX_FEEDRATE_MM_S),
             direction,
             direction,
         );
-        self.planned.push(self.tool.filter(|_| extruding));
+        self.next_move += 1;
+        self.planned.push_back(self.tool.filter(|_| extruding));
         if extruding
             && let Some(tool) = self.tool
             && let Some(ts) = self.tools.get_mut(tool)
@@ -770,6 +798,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                 }
             }
         }
+        self.take_planned_times();
         let (factor, time) = self.slowdown(layer);
         self.speed_factor = factor;
         let fan_line = fan(self.fan_speed(layer, time));
@@ -1023,13 +1052,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         self.line(";TYPE:Custom");
         self.lines(&end);
         self.planner.flush();
-        for &(id, t) in &self.planner.times {
-            if let Some(Some(tool)) = self.planned.get(id)
-                && let Some(ts) = self.tools.get_mut(*tool)
-            {
-                ts.extrusion_time_s += t;
-            }
-        }
+        self.take_planned_times();
         Ok(GcodeStats {
             layers: program.layers.len(),
             estimated_time_s: self.planner.total + self.dwell_s,
