@@ -379,7 +379,7 @@ fn is_plastic(m: &Move, conductive_tool: usize) -> bool {
     };
     if matches!(
         crate::postprocess::role_of(name),
-        Some(Role::Skirt | Role::Custom)
+        Some(Role::Skirt | Role::Support | Role::SupportInterface | Role::Custom)
     ) {
         return false;
     }

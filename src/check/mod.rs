@@ -30,7 +30,8 @@
 //!
 //! # Findings
 //!
-//! See [`FindingKind`] for every finding with its severity. Temperature rules: a tool extrudes
+//! See [`FindingKind`] for every finding with its severity; [`air`] explains the rule for
+//! extrusion into air. Temperature rules: a tool extrudes
 //! only once its target temperature is reached — after `M109`/`M116`/`TEMPERATURE_WAIT`, or
 //! [`CheckParams::heat_up_time_s`] of estimated print time after an `M104` that raised it.
 //! Extruding with a target set but not yet reached is a warning; extruding with a tool that
@@ -58,6 +59,7 @@
 //! [`emit::preview`](crate::emit::preview), and the checker steps the same machine, with
 //! [`CheckParams::flavor`] as its [`Firmware`].
 
+pub mod air;
 pub mod electrical;
 mod machine;
 
@@ -235,6 +237,9 @@ pub enum FindingKind {
     /// `Yinf`, `X` alone): firmware would skip that axis or reject the line, so the machine does
     /// not go where the file's author meant.
     UnreadableParameter,
+    /// Warning: a layer lays plastic over air, an overhang steeper than 45° with no support
+    /// beneath (one finding per layer, see [`air`]).
+    ExtrusionIntoAir,
 }
 
 impl FindingKind {
@@ -251,6 +256,7 @@ impl FindingKind {
             FindingKind::ExcessiveExtrusion => "excessive_extrusion",
             FindingKind::InvalidArc => "invalid_arc",
             FindingKind::UnreadableParameter => "unreadable_parameter",
+            FindingKind::ExtrusionIntoAir => "extrusion_into_air",
         }
     }
 }
@@ -367,7 +373,45 @@ impl CheckReport {
 
 /// Replays `gcode` on the printer described by `params` and reports problems and statistics.
 pub fn check(gcode: &conduit_gcode::Gcode, params: &CheckParams) -> CheckReport {
-    machine::replay(gcode, params)
+    let mut report = machine::replay(gcode, params);
+    let layers = air::air_layers(&moves(gcode, params.flavor), params);
+    report.add_air(&layers, params.max_findings_per_kind);
+    report
+}
+
+impl CheckReport {
+    /// One [`FindingKind::ExtrusionIntoAir`] warning per layer of `layers`, listed in line
+    /// order among the other findings up to `max_listed`.
+    fn add_air(&mut self, layers: &[air::AirLayer], max_listed: usize) {
+        if layers.is_empty() {
+            return;
+        }
+        let kind = FindingKind::ExtrusionIntoAir;
+        for (i, l) in layers.iter().enumerate() {
+            if i < max_listed {
+                self.findings.push(Finding {
+                    severity: Severity::Warning,
+                    kind,
+                    line: l.line,
+                    message: format!(
+                        "layer at Z {:.3} mm lays {:.1} mm of extrusion over air (an overhang \
+                         steeper than 45° with nothing beneath), first at X {:.3} Y {:.3}{}",
+                        l.z,
+                        l.length,
+                        l.at[0],
+                        l.at[1],
+                        l.role
+                            .as_deref()
+                            .map(|r| format!(" ({r})"))
+                            .unwrap_or_default()
+                    ),
+                });
+            }
+        }
+        *self.counts.entry(kind).or_insert(0) += layers.len();
+        self.warnings += layers.len();
+        self.findings.sort_by_key(|f| f.line);
+    }
 }
 
 /// `1h 2m 3s` / `17m 0s` / `42s`.

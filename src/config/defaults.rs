@@ -70,6 +70,12 @@ const SECTION_DOCS: &[(&str, &str)] = &[
         "Gap compensation (conduit compensate): measured tool-to-surface gaps move the path \
          along the tool axis, pass after pass.",
     ),
+    (
+        "support",
+        "Support material (conduit slice with slice.support_material = true): which overhangs \
+         get columns, the gaps that make them removable, interface layers and patterns. \
+         Lengths mm, angles degrees.",
+    ),
 ];
 
 /// The default configuration ([`Config::default`]) as a TOML document with every key, its

@@ -70,7 +70,8 @@ pub use crate::program::machine::{
     DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, PnpSettings, Printer, Tool, ToolKind,
 };
 use crate::region::{
-    InfillPatternKind, MIN_LAYER_HEIGHT, NOZZLE_RANGE, PerimeterGenerator, RegionParams,
+    BrimParams, BrimType, InfillPatternKind, MIN_LAYER_HEIGHT, NOZZLE_RANGE, PerimeterGenerator,
+    RegionParams, SupportParams, SupportPattern,
 };
 use crate::toolpaths::{OrderParams, ProgramParams, RoleSpeeds, SeamRule, ToolPathParams};
 
@@ -109,6 +110,80 @@ pub struct Config {
     pub robot: RobotSettings,
     /// Gap compensation of robot paths (`[compensate]`).
     pub compensate: CompensateSettings,
+    /// Support material, when `slice.support_material` is on (`[support]`).
+    pub support: SupportSettings,
+}
+
+/// How support material is built (`[support]`), when `slice.support_material` is on: columns
+/// of lines under every overhang steeper than `threshold_angle`, topped by dense interface
+/// layers, `z_gap` below the part and `xy_gap` beside it. Lengths in mm.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+pub struct SupportSettings {
+    /// Overhangs leaning out further than this from the vertical are supported, degrees, 0 to
+    /// 89. Default 45, the angle `conduit check` holds every print to. PrusaSlicer's
+    /// `support_material_threshold` counts from the horizontal: 55 there is 35 here.
+    pub threshold_angle: f64,
+    /// Vertical gap between the support's top and the part (and between a top surface of the
+    /// part and the support standing on it), rounded up to whole layers: what lets the support
+    /// break away. 0 to 5; 0 only for soluble support. Default 0.2.
+    pub z_gap: f64,
+    /// Horizontal gap between the support's beads and the part's walls, 0 to 20. Default 0.3.
+    pub xy_gap: f64,
+    /// Dense layers at the top of each column, 0 to 100. Default 3.
+    pub interface_layers: usize,
+    /// Gap between neighbouring lines of the columns' base, 0 to 50. Default 2.5.
+    pub spacing: f64,
+    /// Gap between neighbouring interface lines, 0 to 50. Default 0.2.
+    pub interface_spacing: f64,
+    /// Base pattern: `"rectilinear"` (default; parallel lines joined into zig-zags, the easiest
+    /// to remove) or `"grid"` (both directions on every layer, stiffer for tall columns).
+    pub pattern: SupportPattern,
+    /// Direction of the base lines, degrees counter-clockwise from +X; the interface runs at
+    /// 90° to it. Default 0.
+    pub angle: f64,
+    /// Only build support that stands on the bed, never on the part. Default false.
+    pub buildplate_only: bool,
+    /// A loop around each piece of the columns' base: it holds the base lines' ends and the
+    /// interface above (stiffer, a little harder to remove). Default true.
+    pub sheath: bool,
+}
+
+impl Default for SupportSettings {
+    fn default() -> Self {
+        let p = SupportParams::default();
+        Self {
+            threshold_angle: p.threshold_angle_deg,
+            z_gap: p.z_gap,
+            xy_gap: p.xy_gap,
+            interface_layers: p.interface_layers,
+            spacing: p.spacing,
+            interface_spacing: p.interface_spacing,
+            pattern: p.pattern,
+            angle: p.angle_deg,
+            buildplate_only: p.buildplate_only,
+            sheath: p.sheath,
+        }
+    }
+}
+
+impl SupportSettings {
+    /// The regions stage's support parameters, built when `enabled`.
+    pub fn params(&self, enabled: bool) -> SupportParams {
+        SupportParams {
+            enabled,
+            threshold_angle_deg: self.threshold_angle,
+            z_gap: self.z_gap,
+            xy_gap: self.xy_gap,
+            interface_layers: self.interface_layers,
+            spacing: self.spacing,
+            interface_spacing: self.interface_spacing,
+            pattern: self.pattern,
+            angle_deg: self.angle,
+            buildplate_only: self.buildplate_only,
+            sheath: self.sheath,
+        }
+    }
 }
 
 /// Pattern of solid (top and bottom) infill.
@@ -214,11 +289,19 @@ pub struct SliceSettings {
     pub top_fill_pattern: SolidPattern,
     /// Pattern of bottom solid infill. Default `"rectilinear"`.
     pub bottom_fill_pattern: SolidPattern,
-    /// Generate support material. Default false.
+    /// Build support material under overhangs (how: `[support]`). Default false.
     pub support_material: bool,
-    /// Width of the brim around the first layer, mm, from 0 (none) to the larger side of
-    /// `printer.bed_size`. Default 0.
+    /// Width of the brim on the first layer, mm, from 0 (none) to the larger side of
+    /// `printer.bed_size`: `round(brim_width / spacing)` loops (at least one) of the first
+    /// layer's perimeter width. Default 0.
     pub brim_width: f64,
+    /// Clear gap between the part and the brim's innermost bead, mm (0: the brim touches the
+    /// part; a small gap makes it easier to remove). Default 0.
+    pub brim_separation: f64,
+    /// Where the brim goes: `"outer"` (default) around each island, `"inner"` inside its holes,
+    /// `"both"`, or `"ears"`: outside, only within `brim_width` of convex corners sharper than
+    /// 125°, where corners lift first.
+    pub brim_type: BrimType,
     /// Speed of inner perimeters, mm/s. Every speed is more than 0 and at most 1000 mm/s.
     /// Default 45.
     pub perimeter_speed: f64,
@@ -238,6 +321,10 @@ pub struct SliceSettings {
     pub first_layer_speed: f64,
     /// Speed of skirt and brim, mm/s. Default 30.
     pub skirt_speed: f64,
+    /// Speed of support material (the columns' base), mm/s. Default 50.
+    pub support_speed: f64,
+    /// Speed of the support's dense interface layers under the part, mm/s. Default 40.
+    pub support_interface_speed: f64,
     /// Speed of conductive traces (paste tools), mm/s. Default 10.
     pub conductive_speed: f64,
     /// Tool of each scene object: object `i` prints with tool `object_tools[i]`; objects past the
@@ -292,6 +379,8 @@ impl Default for SliceSettings {
                     bottom_fill_pattern: SolidPattern::Rectilinear,
                     support_material: false,
                     brim_width: 0.0,
+                    brim_separation: 0.0,
+                    brim_type: BrimType::Outer,
                     perimeter_speed: 45.0,
                     external_perimeter_speed: 25.0,
                     infill_speed: 80.0,
@@ -301,6 +390,8 @@ impl Default for SliceSettings {
                     gap_fill_speed: 20.0,
                     first_layer_speed: 20.0,
                     skirt_speed: 30.0,
+                    support_speed: 50.0,
+                    support_interface_speed: 40.0,
                     conductive_speed: 10.0,
                     object_tools: Vec::new(),
                 }
@@ -325,6 +416,7 @@ impl Default for Config {
             jet: JetSettings::default(),
             robot: RobotSettings::default(),
             compensate: CompensateSettings::default(),
+            support: SupportSettings::default(),
         }
     }
 }
@@ -647,7 +739,6 @@ impl Config {
                 ));
             }
         }
-        warnings.extend(self.unsupported_settings());
         if problems.is_empty() {
             Ok(warnings)
         } else {
@@ -657,7 +748,7 @@ impl Config {
 
     /// The speeds every print move or travel uses, with their keys: each must be positive
     /// and at most [`MAX_SPEED`].
-    fn speed_keys(&self) -> [(&'static str, f64); 12] {
+    fn speed_keys(&self) -> [(&'static str, f64); 14] {
         let s = &self.slice;
         let p = &self.printer;
         [
@@ -670,6 +761,8 @@ impl Config {
             ("slice.gap_fill_speed", s.gap_fill_speed),
             ("slice.first_layer_speed", s.first_layer_speed),
             ("slice.skirt_speed", s.skirt_speed),
+            ("slice.support_speed", s.support_speed),
+            ("slice.support_interface_speed", s.support_interface_speed),
             ("slice.conductive_speed", s.conductive_speed),
             ("printer.travel_speed", p.travel_speed),
             ("printer.retract_speed", p.retract_speed),
@@ -727,12 +820,17 @@ impl Config {
                 s.skirt_distance
             ));
         }
-        if !(s.brim_width.is_finite() && (0.0..=bed).contains(&s.brim_width)) {
-            problems.push(format!(
-                "slice.brim_width must be between 0 and the bed size ({bed} mm), got {}",
-                s.brim_width
-            ));
+        for (key, v) in [
+            ("slice.brim_width", s.brim_width),
+            ("slice.brim_separation", s.brim_separation),
+        ] {
+            if !(v.is_finite() && (0.0..=bed).contains(&v)) {
+                problems.push(format!(
+                    "{key} must be between 0 and the bed size ({bed} mm), got {v}"
+                ));
+            }
         }
+        problems.extend(self.support.params(true).problems());
         for (key, v) in [
             ("printer.bed_temperature", p.bed_temperature),
             (
@@ -804,23 +902,6 @@ impl Config {
         problems
     }
 
-    /// Settings the planar pipeline does not apply yet, when they ask for something other than
-    /// what it does: each is named so a profile's intent is never dropped silently.
-    fn unsupported_settings(&self) -> Vec<String> {
-        let s = &self.slice;
-        let mut out = Vec::new();
-        if s.support_material {
-            out.push("slice.support_material: support structures are not generated yet".to_owned());
-        }
-        if s.brim_width > 0.0 {
-            out.push(format!(
-                "slice.brim_width = {}: brims are not generated yet",
-                s.brim_width
-            ));
-        }
-        out
-    }
-
     /// The tool that prints scene object `object` (see [`SliceSettings::object_tools`]).
     pub fn tool_for_object(&self, object: usize) -> usize {
         self.slice.object_tools.get(object).copied().unwrap_or(0)
@@ -877,7 +958,16 @@ impl Config {
         let s = &self.slice;
         macro_rules! build {
             ($($key:ident),+) => {
-                RegionParams { $($key: s.$key,)+ }
+                RegionParams {
+                    $($key: s.$key,)+
+                    brim: BrimParams {
+                        width: s.brim_width,
+                        separation: s.brim_separation,
+                        kind: s.brim_type,
+                        ..BrimParams::default()
+                    },
+                    support: self.support.params(s.support_material),
+                }
             };
         }
         with_region_keys!(build)
@@ -912,6 +1002,8 @@ impl Config {
             bridge: s.bridge_speed,
             gap_fill: s.gap_fill_speed,
             skirt: s.skirt_speed,
+            support: s.support_speed,
+            support_interface: s.support_interface_speed,
             conductive: s.conductive_speed,
         }
         .clamped(max);

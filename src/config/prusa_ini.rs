@@ -35,7 +35,18 @@
 //!   features anyway), `seam_position`, the speeds (a `%` speed is relative to its
 //!   PrusaSlicer parent: external perimeter → perimeter, solid infill → infill, top solid →
 //!   solid infill, first layer → perimeter, support → perimeter), `support_material_speed` (→
-//!   `skirt_speed`, as PrusaSlicer prints skirts at support speed);
+//!   `support_speed` and `skirt_speed`, as PrusaSlicer prints skirts at support speed),
+//!   `support_material_interface_speed` (`%` of the support speed), `brim_separation`,
+//!   `brim_type` (`no_brim` clears `brim_width`; OrcaSlicer's `brim_ears` → `ears`);
+//! - support (`[support]`): `support_material_threshold` (from the horizontal there, from the
+//!   vertical here: `90 − t`; 0, automatic, keeps 45°), `support_material_contact_distance` →
+//!   `z_gap`, `support_material_xy_spacing` (mm or `%` of the external perimeter width) →
+//!   `xy_gap`, `support_material_interface_layers`, `support_material_spacing`,
+//!   `support_material_interface_spacing`, `support_material_pattern` (`rectilinear`,
+//!   `rectilinear-grid` → `grid`, `honeycomb` → `grid` and others → `rectilinear` with a
+//!   warning),
+//!   `support_material_angle`, `support_material_buildplate_only`,
+//!   `support_material_with_sheath`;
 //! - widths: `extrusion_width` and `first_layer_`, `perimeter_`, `external_perimeter_`,
 //!   `infill_`, `solid_infill_`, `top_infill_extrusion_width`. A value is mm or `%` of the first
 //!   nozzle diameter. 0 (or a missing key) falls back to `extrusion_width`, and when that is 0 too to PrusaSlicer's
@@ -57,7 +68,7 @@ use std::collections::BTreeMap;
 use std::collections::BTreeSet;
 
 use super::{Config, ConfigError, Flavor, SolidPattern, Tool};
-use crate::region::{InfillPatternKind, PerimeterGenerator};
+use crate::region::{BrimType, InfillPatternKind, PerimeterGenerator, SupportPattern};
 use crate::toolpaths::SeamRule;
 
 /// Reads a PrusaSlicer `.ini` (`key = value` lines, `#` comments, `[section]` headers of a
@@ -440,6 +451,11 @@ const RULES: &[(&str, Rule)] = &[
     ),
     ("skirt_distance", Rule::Num(|c| &mut c.slice.skirt_distance)),
     ("brim_width", Rule::Num(|c| &mut c.slice.brim_width)),
+    (
+        "brim_separation",
+        Rule::Num(|c| &mut c.slice.brim_separation),
+    ),
+    ("brim_type", Rule::Custom(brim_type)),
     ("perimeter_generator", Rule::Custom(perimeter_generator)),
     ("seam_position", Rule::Custom(seam_position)),
     // Widths (every role width is read with the generic one).
@@ -480,9 +496,54 @@ const RULES: &[(&str, Rule)] = &[
             |c| &mut c.slice.first_layer_speed,
         ),
     ),
+    ("support_material_speed", Rule::Custom(support_speed)),
     (
-        "support_material_speed",
-        Rule::Percent(|c| c.slice.perimeter_speed, |c| &mut c.slice.skirt_speed),
+        "support_material_interface_speed",
+        Rule::Percent(
+            |c| c.slice.support_speed,
+            |c| &mut c.slice.support_interface_speed,
+        ),
+    ),
+    // Support (after the widths: the xy gap may be a % of the external perimeter width).
+    (
+        "support_material_threshold",
+        Rule::Custom(support_threshold),
+    ),
+    (
+        "support_material_contact_distance",
+        Rule::Num(|c| &mut c.support.z_gap),
+    ),
+    (
+        "support_material_xy_spacing",
+        Rule::Percent(
+            |c| c.slice.external_perimeter_width,
+            |c| &mut c.support.xy_gap,
+        ),
+    ),
+    (
+        "support_material_interface_layers",
+        Rule::Count(|c| &mut c.support.interface_layers),
+    ),
+    (
+        "support_material_spacing",
+        Rule::Num(|c| &mut c.support.spacing),
+    ),
+    (
+        "support_material_interface_spacing",
+        Rule::Num(|c| &mut c.support.interface_spacing),
+    ),
+    ("support_material_pattern", Rule::Custom(support_pattern)),
+    (
+        "support_material_angle",
+        Rule::Num(|c| &mut c.support.angle),
+    ),
+    (
+        "support_material_buildplate_only",
+        Rule::Flag(|c| &mut c.support.buildplate_only),
+    ),
+    (
+        "support_material_with_sheath",
+        Rule::Flag(|c| &mut c.support.sheath),
     ),
 ];
 
@@ -849,6 +910,93 @@ fn seam_position(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     Ok(())
 }
 
+/// `brim_type`: PrusaSlicer's `no_brim` (no brim whatever `brim_width` says), `outer_only`,
+/// `inner_only`, `outer_and_inner`, and OrcaSlicer's `brim_ears` (`auto_brim` is read as
+/// `outer_only`).
+fn brim_type(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let Some(named) = imp.p.raw(key).map(|v| v.trim().to_owned()) else {
+        return Ok(());
+    };
+    let slice = &mut imp.cfg.slice;
+    slice.brim_type = match named.as_str() {
+        "outer_only" | "auto_brim" => BrimType::Outer,
+        "inner_only" => BrimType::Inner,
+        "outer_and_inner" => BrimType::Both,
+        "brim_ears" => BrimType::Ears,
+        "no_brim" => {
+            slice.brim_width = 0.0;
+            BrimType::Outer
+        }
+        _ => {
+            return Err(imp.p.err(
+                key,
+                "expected no_brim, outer_only, inner_only, outer_and_inner or brim_ears",
+            ));
+        }
+    };
+    Ok(())
+}
+
+/// `support_material_speed`: the support's speed, and the skirt's (PrusaSlicer prints skirt
+/// and brim at the support speed); a `%` is of the perimeter speed.
+fn support_speed(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let parent = imp.cfg.slice.perimeter_speed;
+    if let Some(v) = imp.p.abs_or_percent(key, parent)? {
+        imp.cfg.slice.support_speed = v;
+        imp.cfg.slice.skirt_speed = v;
+    }
+    Ok(())
+}
+
+/// `support_material_threshold`: PrusaSlicer counts from the horizontal, conduit from the
+/// vertical; 0 (PrusaSlicer's automatic threshold, about half a bead's overhang a layer) keeps
+/// conduit's 45°.
+fn support_threshold(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    if let Some(raw) = imp.p.raw(key).map(str::trim).filter(|v| v.ends_with('%')) {
+        // SuperSlicer's threshold relative to the extrusion width has no angle.
+        let raw = raw.to_owned();
+        imp.warnings.push(format!(
+            "support_material_threshold = {raw}: a threshold relative to the extrusion width \
+             is read as conduit's {}°",
+            imp.cfg.support.threshold_angle
+        ));
+        return Ok(());
+    }
+    match imp.p.num(key)? {
+        Some(t) if t > 0.0 && t <= 90.0 => imp.cfg.support.threshold_angle = 90.0 - t,
+        Some(t) if t == 0.0 => {}
+        Some(_) => return Err(imp.p.err(key, "expected an angle from 0 to 90 degrees")),
+        None => {}
+    }
+    Ok(())
+}
+
+/// `support_material_pattern`: `rectilinear`, `rectilinear-grid` (conduit's grid); PrusaSlicer's
+/// `honeycomb` becomes the grid and any other pattern (Slic3r's `pillars`) rectilinear, with a
+/// warning.
+fn support_pattern(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let Some(named) = imp.p.raw(key).map(|v| v.trim().to_owned()) else {
+        return Ok(());
+    };
+    imp.cfg.support.pattern = match named.as_str() {
+        "rectilinear" => SupportPattern::Rectilinear,
+        "rectilinear-grid" => SupportPattern::Grid,
+        "honeycomb" => {
+            imp.warnings
+                .push("support_material_pattern = honeycomb: printed as conduit's grid".to_owned());
+            SupportPattern::Grid
+        }
+        other => {
+            // Slic3r's `pillars` and the patterns of other forks.
+            imp.warnings.push(format!(
+                "support_material_pattern = {other}: printed as conduit's rectilinear"
+            ));
+            SupportPattern::Rectilinear
+        }
+    };
+    Ok(())
+}
+
 /// `extrusion_width` and the role widths of [`WIDTHS`]: a role's 0 (or missing) width falls
 /// back to the generic one, and when that is 0 too to the automatic width; a first-layer width
 /// of 0 takes the perimeter width.
@@ -884,8 +1032,6 @@ const CHANGES_THE_PRINT: &[(&str, Option<&[&str]>)] = &[
     ("bottom_solid_min_thickness", Some(&["0"])),
     ("bridge_angle", Some(&["0"])),
     ("bridge_flow_ratio", Some(&["1"])),
-    ("brim_separation", Some(&["0"])),
-    ("brim_type", Some(&["outer_only"])),
     ("complete_objects", Some(&["0"])),
     ("draft_shield", Some(&["disabled", "0"])),
     ("elefant_foot_compensation", Some(&["0"])),
@@ -906,13 +1052,11 @@ const CHANGES_THE_PRINT: &[(&str, Option<&[&str]>)] = &[
     ("raft_layers", Some(&["0"])),
     ("solid_infill_every_layers", Some(&["0"])),
     ("spiral_vase", Some(&["0"])),
-    ("support_material_auto", None),
-    ("support_material_buildplate_only", None),
-    ("support_material_contact_distance", None),
-    ("support_material_interface_layers", None),
-    ("support_material_pattern", None),
-    ("support_material_spacing", None),
-    ("support_material_threshold", None),
+    ("support_material_auto", Some(&["1"])),
+    ("support_material_bottom_contact_distance", Some(&["0"])),
+    ("support_material_bottom_interface_layers", Some(&["-1"])),
+    ("support_material_enforce_layers", Some(&["0"])),
+    ("support_material_style", Some(&["grid"])),
     ("thick_bridges", Some(&["0"])),
     ("top_solid_min_thickness", Some(&["0"])),
     ("wipe_tower", Some(&["0"])),

@@ -94,11 +94,11 @@ impl CircuitPlan {
 }
 
 /// Whether a host extrusion is part of the object: not a skirt, brim, custom start G-code, or a
-/// feature conduit has no role for (support, wipe tower, ironing). Extrusions without any
+/// support, or a feature conduit has no role for (wipe tower, ironing). Extrusions without any
 /// feature name (files without comments) count.
 pub fn is_object_path(path: &ExtrusionPath) -> bool {
     match path.role {
-        Some(Role::Skirt | Role::Custom) => false,
+        Some(Role::Skirt | Role::Support | Role::SupportInterface | Role::Custom) => false,
         Some(_) => true,
         None => path.host_role.is_none(),
     }

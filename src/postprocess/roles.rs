@@ -42,11 +42,17 @@ const NAMES: &[(&str, Role)] = &[
     ("skirt/brim", Role::Skirt),
     ("skirt", Role::Skirt),
     ("brim", Role::Skirt),
+    ("support material", Role::Support),
+    ("support", Role::Support),
+    ("support material interface", Role::SupportInterface),
+    ("support interface", Role::SupportInterface),
+    ("support-interface", Role::SupportInterface),
+    ("support transition", Role::Support),
     ("custom", Role::Custom),
 ];
 
 /// conduit's role for a host feature name, or `None` for features conduit has no role for
-/// (support, wipe and prime towers, ironing) and for names it does not know.
+/// (wipe and prime towers, ironing) and for names it does not know.
 ///
 /// ```
 /// use conduit::postprocess::role_of;
@@ -55,7 +61,9 @@ const NAMES: &[(&str, Role)] = &[
 /// assert_eq!(role_of("Outer wall"), Some(Role::ExternalPerimeter));
 /// assert_eq!(role_of("WALL-INNER"), Some(Role::Perimeter));
 /// assert_eq!(role_of("SKIN"), Some(Role::SolidInfill));
-/// assert_eq!(role_of("Support material"), None);
+/// assert_eq!(role_of("Support material"), Some(Role::Support));
+/// assert_eq!(role_of("SUPPORT-INTERFACE"), Some(Role::SupportInterface));
+/// assert_eq!(role_of("Wipe tower"), None);
 /// ```
 pub fn role_of(host_name: &str) -> Option<Role> {
     let name = host_name.trim();

@@ -28,6 +28,10 @@ pub enum Role {
     SparseInfill,
     /// Skirt (or brim) loops around the first layer.
     Skirt,
+    /// Support material: the sparse base of a support column.
+    Support,
+    /// Support material interface: the dense top layers of a support column, under the part.
+    SupportInterface,
     /// Planar scaffold under curved layers.
     Scaffold,
     /// Buffer layer between the scaffold and curved layers.
@@ -46,7 +50,7 @@ pub enum Role {
 
 impl Role {
     /// Every role, in declaration order.
-    pub const ALL: [Role; 16] = [
+    pub const ALL: [Role; 18] = [
         Role::ExternalPerimeter,
         Role::Perimeter,
         Role::SolidInfill,
@@ -56,6 +60,8 @@ impl Role {
         Role::GapFill,
         Role::SparseInfill,
         Role::Skirt,
+        Role::Support,
+        Role::SupportInterface,
         Role::Scaffold,
         Role::Buffer,
         Role::ConductiveTrace,
@@ -82,6 +88,8 @@ impl Role {
             Role::GapFill => "Gap fill",
             Role::SparseInfill => "Internal infill",
             Role::Skirt => "Skirt/Brim",
+            Role::Support => "Support material",
+            Role::SupportInterface => "Support material interface",
             Role::Scaffold => "Scaffold",
             Role::Buffer => "Buffer",
             Role::ConductiveTrace => "Conductive trace",

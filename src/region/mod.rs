@@ -24,6 +24,7 @@
 
 pub mod beads;
 pub mod bridge;
+pub mod brim;
 pub mod cavity;
 pub mod gapfill;
 pub mod infill;
@@ -32,9 +33,11 @@ pub mod perimeters;
 pub mod simplify;
 pub mod skins;
 pub mod skirt;
+pub mod support;
 #[cfg(test)]
 mod test_util;
 
+pub use brim::{Brim, BrimParams, BrimType, make_brim};
 pub use params::{
     InfillPatternKind, MAX_PERIMETERS, MAX_SKIRT_LOOPS, MAX_SOLID_INFILL_MARGIN, MAX_SOLID_LAYERS,
     MAX_WIDTH, MAX_WIDTH_NOZZLES, MIN_LAYER_HEIGHT, NOZZLE_RANGE, ParamError, PerimeterGenerator,
@@ -43,8 +46,9 @@ pub use params::{
 pub use perimeters::{PerimeterLoop, Perimeters, make_perimeters};
 pub use skins::{SkinAreas, SolidRole, detect_skins};
 pub use skirt::make_skirt;
+pub use support::{SupportLayer, SupportParams, SupportPattern, make_supports};
 
-use crate::geom::{ExPolygon, Polygon, Polyline};
+use crate::geom::{Cap, ExPolygon, Join, Polygon, Polyline, Tolerances, offset, stroke};
 use gapfill::ThickPolyline;
 use infill::lines::{LineFamily, fill_family};
 use infill::{InfillPattern, Rectilinear};
@@ -82,6 +86,10 @@ pub struct LayerRegions {
     pub gap_fill: Vec<ThickPolyline>,
     /// Skirt loops, outermost first; only on layer 0.
     pub skirt: Vec<Polygon>,
+    /// Brim loops and ears; only on layer 0 (printed with the skirt's width and speed).
+    pub brim: Brim,
+    /// Support material on this layer.
+    pub support: SupportLayer,
     /// Extrusion width of the skirt loops, mm.
     pub skirt_width: f64,
     /// Where infill centrelines may go (inside the innermost perimeters), for routing and
@@ -174,17 +182,33 @@ fn regions(layers: &[Vec<ExPolygon>], heights: &[f64], params: &RegionParams) ->
     let infill_areas: Vec<Vec<ExPolygon>> =
         perimeters.iter().map(|p| p.infill_area.clone()).collect();
     let skins = detect_skins(layers, &infill_areas, heights, params);
+    let widths: Vec<f64> = (0..layers.len())
+        .map(|i| params.for_layer(i).perimeter_width)
+        .collect();
+    let supports = make_supports(layers, heights, &widths, &params.support);
     let first = params.for_layer(0);
-    let skirt = match (layers.first(), heights.first()) {
-        (Some(islands), Some(&h)) => make_skirt(islands, &first, h),
-        _ => Vec::new(),
+    let (skirt, brim) = match (layers.first(), heights.first()) {
+        (Some(islands), Some(&h)) => {
+            let brim = make_brim(
+                islands,
+                &params.brim,
+                first.perimeter_width,
+                first.spacings(h).perimeter,
+            );
+            // The skirt goes around everything on the first layer: brim and support too.
+            let mut around = islands.clone();
+            around.extend(printed_area(&brim, &supports[0], first.perimeter_width));
+            (make_skirt(&around, &first, h), brim)
+        }
+        _ => (Vec::new(), Brim::default()),
     };
     perimeters
         .into_par_iter()
         .zip(skins)
+        .zip(supports)
         .zip(heights)
         .enumerate()
-        .map(|(index, ((per, skins), &height))| {
+        .map(|(index, (((per, skins), support), &height))| {
             let lp = params.for_layer(index);
             let below = index
                 .checked_sub(1)
@@ -203,12 +227,36 @@ fn regions(layers: &[Vec<ExPolygon>], heights: &[f64], params: &RegionParams) ->
                 } else {
                     Vec::new()
                 },
+                brim: if index == 0 {
+                    brim.clone()
+                } else {
+                    Brim::default()
+                },
+                support,
                 skirt_width: lp.perimeter_width,
                 infill_area: per.infill_area,
                 skins,
             }
         })
         .collect()
+}
+
+/// The area the brim's beads (`width` wide) and the support cover on the first layer.
+fn printed_area(brim: &Brim, support: &SupportLayer, width: f64) -> Vec<ExPolygon> {
+    if brim.is_empty() && support.area.is_empty() {
+        return Vec::new();
+    }
+    let mut lines: Vec<Polyline> = brim.ears.clone();
+    lines.extend(brim.loops.iter().filter_map(|p| {
+        let first = *p.points.first()?;
+        let mut points = p.points.clone();
+        points.push(first);
+        Some(Polyline { points })
+    }));
+    let join = Join::Round(Tolerances::default().curve_flattening.mm());
+    let mut area = stroke(&lines, width, join, Cap::Round(0.01));
+    area.extend(offset(&support.area, width / 2.0, join));
+    area
 }
 
 /// The variable-width lines of one layer: its gaps' (between `gap_min` and

@@ -16,6 +16,8 @@
 //! island's edge to its external loop's centreline is half the external perimeter *width*, so the
 //! printed outer surface lands on the sliced contour.
 
+use super::brim::BrimParams;
+use super::support::SupportParams;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -101,6 +103,10 @@ pub struct RegionParams {
     pub skirt_loops: usize,
     /// Clear gap between the first layer's islands and the inner edge of the skirt, mm.
     pub skirt_distance: f64,
+    /// Brim on the first layer.
+    pub brim: BrimParams,
+    /// Support material.
+    pub support: SupportParams,
     /// Nozzle diameter, mm.
     pub nozzle_diameter: f64,
     /// Layer height, mm, used in the spacing formula when no per-layer heights are given.
@@ -131,6 +137,8 @@ impl Default for RegionParams {
             thin_walls: true,
             skirt_loops: 0,
             skirt_distance: 6.0,
+            brim: BrimParams::default(),
+            support: SupportParams::default(),
             nozzle_diameter: 0.4,
             layer_height: 0.2,
         }
@@ -263,6 +271,11 @@ pub enum ParamError {
         /// The value given.
         value: f64,
     },
+    /// A support setting is unusable (the message names it and its range).
+    ///
+    /// How to fix: correct the named `[support]` key.
+    #[error("{0}")]
+    Support(String),
 }
 
 /// Distance between the centrelines of two adjacent extrusions of width `width` and height
@@ -375,6 +388,15 @@ impl RegionParams {
                 value: self.infill_angle_deg,
             });
         }
+        for (field, value) in [
+            ("brim_width", self.brim.width),
+            ("brim_separation", self.brim.separation),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                errors.push(ParamError::Negative { field, value });
+            }
+        }
+        errors.extend(self.support.problems().into_iter().map(ParamError::Support));
         errors
     }
 

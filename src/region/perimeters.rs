@@ -471,7 +471,7 @@ mod tests {
         // Without gap fill there is no gap.
         let off = RegionParams {
             gap_fill: false,
-            ..params
+            ..params.clone()
         };
         assert!(make_perimeters(&[per_strip()], &off, 0.2).gaps.is_empty());
         // A wide square has none either: every loop is whole.

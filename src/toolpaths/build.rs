@@ -69,6 +69,10 @@ pub struct RoleSpeeds {
     pub gap_fill: f64,
     /// Skirt and brim. Default 30.
     pub skirt: f64,
+    /// Support material base. Default 50.
+    pub support: f64,
+    /// Support material interface. Default 40.
+    pub support_interface: f64,
     /// Conductive traces and drops. Default 10.
     pub conductive: f64,
 }
@@ -85,6 +89,8 @@ impl Default for RoleSpeeds {
             bridge: 60.0,
             gap_fill: 20.0,
             skirt: 30.0,
+            support: 50.0,
+            support_interface: 40.0,
             conductive: 10.0,
         }
     }
@@ -102,6 +108,8 @@ impl RoleSpeeds {
             Role::TopSolidInfill => self.top_solid_infill,
             Role::SparseInfill | Role::Scaffold | Role::Buffer => self.sparse_infill,
             Role::Skirt => self.skirt,
+            Role::Support => self.support,
+            Role::SupportInterface => self.support_interface,
             Role::ConductiveTrace | Role::ConductiveDrop => self.conductive,
             Role::JetWall | Role::JetFill => self.conductive,
         }
@@ -118,6 +126,8 @@ impl RoleSpeeds {
             bridge: self.bridge.min(max),
             gap_fill: self.gap_fill.min(max),
             skirt: self.skirt.min(max),
+            support: self.support.min(max),
+            support_interface: self.support_interface.min(max),
             conductive: self.conductive.min(max),
         }
     }
@@ -299,18 +309,70 @@ impl PathMaker {
     }
 }
 
-/// The skirt groups and island groups of one object layer.
-fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
+/// The groups of one object layer, in the order they print: skirt loops; brim loops and ears,
+/// and the support (which the part's first layer over it needs in place); the islands.
+struct ObjectGroups {
+    skirt: Vec<Group>,
+    beside: Vec<Group>,
+    islands: Vec<Group>,
+}
+
+/// See [`ObjectGroups`].
+fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> ObjectGroups {
     let r = e.regions;
+    let single = |path: Toolpath| Group {
+        first: vec![path],
+        rest: Vec::new(),
+    };
     let skirt: Vec<Group> = r
         .skirt
         .iter()
         .filter_map(|s| maker.closed(s, Role::Skirt, r.skirt_width))
-        .map(|path| Group {
-            first: vec![path],
-            rest: Vec::new(),
-        })
+        .map(single)
         .collect();
+    let mut beside: Vec<Group> = r
+        .brim
+        .loops
+        .iter()
+        .filter_map(|s| maker.closed(s, Role::Skirt, r.skirt_width))
+        .map(single)
+        .collect();
+    let ears: Vec<Toolpath> = r
+        .brim
+        .ears
+        .iter()
+        .filter_map(|l| maker.open(&l.points, Role::Skirt, r.skirt_width))
+        .collect();
+    if !ears.is_empty() {
+        beside.push(Group {
+            first: Vec::new(),
+            rest: ears,
+        });
+    }
+    // The sheath first, then the lines inside it.
+    let sheath: Vec<Toolpath> = r
+        .support
+        .sheath
+        .iter()
+        .filter_map(|p| maker.closed(p, Role::Support, r.support.width))
+        .collect();
+    let lines: Vec<Toolpath> = [
+        (&r.support.base, Role::Support),
+        (&r.support.interface, Role::SupportInterface),
+    ]
+    .into_iter()
+    .flat_map(|(lines, role)| {
+        lines
+            .iter()
+            .filter_map(move |l| maker.open(&l.points, role, r.support.width))
+    })
+    .collect();
+    if !sheath.is_empty() || !lines.is_empty() {
+        beside.push(Group {
+            first: sheath,
+            rest: lines,
+        });
+    }
     // Islands by index, in index order; their outer loops for infill assignment.
     let mut islands: BTreeMap<usize, Group> = BTreeMap::new();
     let mut outer: Vec<(usize, &Polygon, i128)> = Vec::new();
@@ -369,7 +431,11 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
     if !loose.rest.is_empty() {
         groups.push(loose);
     }
-    (skirt, groups)
+    ObjectGroups {
+        skirt,
+        beside,
+        islands: groups,
+    }
 }
 
 /// The [`Program`] printing `objects` (see the module docs).
@@ -423,6 +489,7 @@ pub fn build_program_with(
         for tool in tools {
             let tp = params.tool(tool);
             let mut skirts = Vec::new();
+            let mut beside = Vec::new();
             let mut islands = Vec::new();
             for e in entries.iter().filter(|e| e.tool == tool) {
                 let maker = PathMaker {
@@ -433,12 +500,15 @@ pub fn build_program_with(
                     params: tp,
                     first_layer: index == 0,
                 };
-                let (s, g) = object_groups(e, &maker);
-                skirts.extend(s);
-                islands.extend(g);
+                let groups = object_groups(e, &maker);
+                skirts.extend(groups.skirt);
+                beside.extend(groups.beside);
+                islands.extend(groups.islands);
                 debug_assert!(e.object < objects.len());
             }
             let (mut paths, end) = order_groups(skirts, &pos, &params.order);
+            let (beside_paths, end) = order_groups(beside, &end, &params.order);
+            paths.extend(beside_paths);
             let (island_paths, end) = order_groups(islands, &end, &params.order);
             paths.extend(island_paths);
             if paths.is_empty() {
