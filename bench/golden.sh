@@ -44,6 +44,8 @@ run slice_bracket slice samples/l_bracket.obj -o out/l_bracket.gcode
 run slice_cube slice samples/cube_20mm.stl -o out/cube.gcode --report out/cube.json
 run slice_hole slice samples/cube_with_hole.stl -o out/hole.gcode --report out/hole.json
 run slice_thin slice samples/thin_walls.stl -o out/thin_walls.gcode
+run slice_overhangs slice samples/overhangs.stl --set slice.support_material=true -o out/overhangs.gcode
+run slice_overhangs_brim slice samples/overhangs.stl --set slice.brim_width=4 --set slice.brim_type=ears -o out/overhangs_brim.gcode
 run slice_bracket_two_tool slice samples/l_bracket.obj -c samples/two_tool_printer.toml \
     -o out/bracket_two_tool.gcode
 run convert_parts convert samples/cube_20mm.stl -o out/cube.3mf

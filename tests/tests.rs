@@ -22,6 +22,7 @@ mod golden;
 mod grammar;
 mod jet;
 mod outputs;
+mod overhangs;
 mod pack_corpus;
 mod place;
 mod postprocess;

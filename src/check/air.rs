@@ -19,11 +19,14 @@
 //! by it. The first layer lies on the bed.
 //!
 //! Points are tested every [`SAMPLE_STEP_MM`] along each extruding move. A stretch of
-//! unheld points is a **bridge**, and fine, when held points come before and after it on the
-//! same path and it runs straight (its direction turns by at most [`BRIDGE_TURN_MAX_DEG`]):
-//! threads spanning from anchor to anchor, sparse infill crossing the lines below, interface
-//! lines across the base. Anything else unheld — a loop hanging over air, a line ending in air —
-//! is extrusion into air once it is at least [`MIN_RUN_MM`] long.
+//! unheld points is cut into straight pieces where its direction turns by more than
+//! [`BRIDGE_TURN_MAX_DEG`]; a piece is a **bridge**, and fine, when the points just past both
+//! its ends are anchors: held points, or for a path the file names a bridge (`;TYPE:` with
+//! "bridge" in it), points within [`GAP_SIDE_MM`] of the layers below or of this layer's
+//! beads printed before (threads spanning from anchor to anchor, sparse infill crossing the
+//! lines below, interface lines across the base, the zig-zag turns of a bridge along its
+//! perimeter). Anything else unheld — a loop hanging over air, a line ending in air — is
+//! extrusion into air once a stretch adds up to [`MIN_RUN_MM`].
 //!
 //! Only filament tools count, and only planar layers: a file that extrudes while moving in Z
 //! (curved layers, conformal paths) is not checked, since its layers are not stacked planes.
@@ -290,12 +293,6 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
                 printed.add(*s, GAP_SIDE_MM);
             }
             for (line, at, length) in runs {
-                if std::env::var_os("AIRDBG").is_some() {
-                    eprintln!(
-                        "AIR z={z:.3} line={line} at={at:?} len={length:.2} role={:?}",
-                        role_of_line.get(&line)
-                    );
-                }
                 let entry = layer.get_or_insert_with(|| AirLayer {
                     z,
                     length: 0.0,

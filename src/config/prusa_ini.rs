@@ -964,9 +964,8 @@ fn support_threshold(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     }
     match imp.p.num(key)? {
         Some(t) if t > 0.0 && t <= 90.0 => imp.cfg.support.threshold_angle = 90.0 - t,
-        Some(t) if t == 0.0 => {}
+        Some(0.0) | None => {}
         Some(_) => return Err(imp.p.err(key, "expected an angle from 0 to 90 degrees")),
-        None => {}
     }
     Ok(())
 }

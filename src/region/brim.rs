@@ -91,11 +91,12 @@ pub fn make_brim(
     spacing: f64,
 ) -> Brim {
     let usable = |v: f64| v.is_finite() && v > 0.0;
+    let separation_ok = params.separation.is_finite() && params.separation >= 0.0;
     if first_layer.is_empty()
         || !usable(params.width)
         || !usable(line_width)
         || !usable(spacing)
-        || !(params.separation.is_finite() && params.separation >= 0.0)
+        || !separation_ok
     {
         return Brim::default();
     }

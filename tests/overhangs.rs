@@ -1,0 +1,181 @@
+//! Supports and brims end to end, on an overhang probe: a 10 mm post whose left side leans out
+//! at 30° from the vertical (needs no support), then at 60° (needs it), with a horizontal arm
+//! 10 mm long on its right at 8 mm. Sliced by the binary without and with support; the G-code
+//! replayed with `conduit_gcode` and checked by `conduit check`.
+
+use std::path::Path;
+
+use conduit::geom::Point3;
+use conduit_gcode::{Firmware, moves, parse};
+use serde_json::Value;
+
+use crate::support::{conduit, root, stderr, temp_dir, write_stl};
+
+/// The probe's profile in the XZ plane, counter-clockwise; it is extruded 20 mm along Y.
+fn profile() -> Vec<[f64; 2]> {
+    let t30 = 4.0 * 30f64.to_radians().tan();
+    let t60 = 6.0 * 60f64.to_radians().tan();
+    vec![
+        [0.0, 0.0],
+        [10.0, 0.0],
+        [10.0, 8.0],
+        [20.0, 8.0],
+        [20.0, 10.0],
+        [-t30 - t60, 10.0],
+        [-t30, 4.0],
+    ]
+}
+
+/// The probe's triangles: the profile's caps (a fan from the arm's inner corner, from which
+/// the whole profile is visible) and its sides, normals outwards.
+fn probe() -> Vec<[Point3; 3]> {
+    let p = profile();
+    let at = |q: [f64; 2], y: f64| Point3::new(q[0], y, q[1]);
+    let mut tris = Vec::new();
+    let hub = 2;
+    for i in 0..p.len() {
+        let (a, b) = ((hub + 1 + i) % p.len(), (hub + 2 + i) % p.len());
+        if a == hub || b == hub {
+            continue;
+        }
+        tris.push([at(p[hub], 0.0), at(p[a], 0.0), at(p[b], 0.0)]);
+        tris.push([at(p[hub], 20.0), at(p[b], 20.0), at(p[a], 20.0)]);
+    }
+    for i in 0..p.len() {
+        let (a, b) = (p[i], p[(i + 1) % p.len()]);
+        tris.push([at(a, 0.0), at(b, 20.0), at(b, 0.0)]);
+        tris.push([at(a, 0.0), at(a, 20.0), at(b, 20.0)]);
+    }
+    tris
+}
+
+/// Slices `stl` with `extra` arguments; the G-code and the shift from model to bed X.
+fn slice(dir: &Path, stl: &Path, extra: &[&str]) -> (String, f64) {
+    let (gcode, report) = (dir.join("out.gcode"), dir.join("out.json"));
+    let mut args = vec![
+        "slice".to_owned(),
+        stl.display().to_string(),
+        "-o".into(),
+        gcode.display().to_string(),
+        "--report".into(),
+        report.display().to_string(),
+    ];
+    args.extend(extra.iter().map(|s| (*s).to_owned()));
+    let o = conduit(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let min_x = r["objects"][0]["bbox"]["min"][0].as_f64().expect("bbox");
+    let model_min = profile().iter().map(|q| q[0]).fold(f64::MAX, f64::min);
+    (
+        std::fs::read_to_string(&gcode).expect("G-code"),
+        min_x - model_min,
+    )
+}
+
+/// `conduit check --json` of `gcode`: the number of extrusion_into_air findings.
+fn air_findings(dir: &Path, gcode: &str) -> usize {
+    let path = dir.join("check.gcode");
+    std::fs::write(&path, gcode).expect("write");
+    let o = conduit(["check", path.to_str().expect("utf-8"), "--json"]);
+    let r: Value = serde_json::from_slice(&o.stdout).expect("check JSON");
+    r["counts"]["extrusion_into_air"].as_u64().unwrap_or(0) as usize
+}
+
+/// Extruding moves of one role: (x, z) of both ends, model X.
+fn role_moves(gcode: &str, shift: f64, role: &str) -> Vec<([f64; 2], [f64; 2])> {
+    let parsed = parse(gcode.as_bytes()).expect("G-code parses");
+    moves(&parsed, Firmware::Marlin)
+        .moves
+        .into_iter()
+        .filter(|m| m.extruding && m.role.as_deref() == Some(role))
+        .filter_map(|m| {
+            let (a, b) = ((m.from[0]?, m.from[2]?), (m.to[0]?, m.to[2]?));
+            Some(([a.0 - shift, a.1], [b.0 - shift, b.1]))
+        })
+        .collect()
+}
+
+#[test]
+fn the_overhang_probe_prints_with_removable_support_and_nothing_over_air() {
+    let dir = temp_dir();
+    let stl = dir.path().join("probe.stl");
+    write_stl(&stl, &probe());
+    let sample = root().join("samples/overhangs.stl");
+    assert!(
+        std::fs::read(&sample).expect("samples/overhangs.stl")
+            == std::fs::read(&stl).expect("probe"),
+        "samples/overhangs.stl is not the probe this test generates"
+    );
+    // Without support the arm and the 60° side hang in air, layer after layer.
+    let (bare, _) = slice(dir.path(), &stl, &[]);
+    let found = air_findings(dir.path(), &bare);
+    assert!(found >= 20, "{found} layers over air");
+    assert!(role_moves(&bare, 0.0, "Support material").is_empty());
+
+    let (gcode, shift) = slice(dir.path(), &stl, &["--set", "slice.support_material=true"]);
+    assert_eq!(air_findings(dir.path(), &gcode), 0);
+    let support: Vec<([f64; 2], [f64; 2])> = ["Support material", "Support material interface"]
+        .iter()
+        .flat_map(|r| role_moves(&gcode, shift, r))
+        .collect();
+    let ends = || support.iter().flat_map(|(a, b)| [*a, *b]);
+    // Under the arm, from the bed up to one empty layer below it (the arm's first layer is
+    // 8.0–8.2 mm; support ends with the layer 7.6–7.8, leaving 7.8–8.0 empty)...
+    let arm: Vec<[f64; 2]> = ends().filter(|p| p[0] > 10.5).collect();
+    assert!(arm.iter().all(|p| p[0] <= 20.0 + 1e-3));
+    let top = arm.iter().map(|p| p[1]).fold(f64::MIN, f64::max);
+    let bottom = arm.iter().map(|p| p[1]).fold(f64::MAX, f64::min);
+    assert!(
+        (top - 7.8).abs() < 1e-6 && (bottom - 0.2).abs() < 1e-6,
+        "{bottom}–{top}"
+    );
+    // ... and at least xy_gap + half a bead from the post's wall.
+    assert!(
+        ends()
+            .filter(|p| p[0] > 10.0 && p[1] < 7.9)
+            .all(|p| p[0] >= 10.0 + 0.3 + 0.225 - 1e-3)
+    );
+    // Under the 60° side (left of x = −2.31), up to one empty layer below its top layer.
+    let t30 = 4.0 * 30f64.to_radians().tan();
+    assert!(ends().any(|p| p[0] < -t30 - 1.0 && p[1] < 4.0));
+    assert!(ends().all(|p| p[1] <= 9.6 + 1e-6));
+    // The arm's lowest layer lies over the interface, one layer up.
+    let arm_plastic = role_moves(&gcode, shift, "External perimeter")
+        .into_iter()
+        .flat_map(|(a, b)| [a, b])
+        .filter(|p| p[0] > 12.0)
+        .map(|p| p[1])
+        .fold(f64::MAX, f64::min);
+    assert!((arm_plastic - 8.2).abs() < 1e-6, "{arm_plastic}");
+    let interface = role_moves(&gcode, shift, "Support material interface");
+    assert!(
+        interface
+            .iter()
+            .any(|(a, _)| a[0] > 10.5 && (a[1] - 7.8).abs() < 1e-6)
+    );
+}
+
+#[test]
+fn a_brim_surrounds_the_first_layer_only() {
+    let dir = temp_dir();
+    let stl = dir.path().join("probe.stl");
+    write_stl(&stl, &probe());
+    let (gcode, shift) = slice(dir.path(), &stl, &["--set", "slice.brim_width=4"]);
+    let brim = role_moves(&gcode, shift, "Skirt/Brim");
+    assert!(!brim.is_empty());
+    // On the first layer, outside the post's 10 mm footprint, within the brim's width.
+    let xs: Vec<f64> = brim.iter().flat_map(|(a, b)| [a[0], b[0]]).collect();
+    assert!(brim.iter().all(|(a, b)| a[1] == 0.2 && b[1] == 0.2));
+    let (lo, hi) = xs
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(l, h), &x| (l.min(x), h.max(x)));
+    // round(4 / 0.407) = 10 loops: the outermost centreline is 0.225 + 9 · 0.407 out.
+    // The first layer is cut at z = 0.1, where the 30° side is 0.058 mm out.
+    let reach = 0.225 + 9.0 * conduit::region::spacing(0.45, 0.2);
+    let left = -0.1 * 30f64.to_radians().tan();
+    assert!(
+        (lo - left + reach).abs() < 0.01 && (hi - 10.0 - reach).abs() < 0.01,
+        "{lo} {hi}"
+    );
+}
