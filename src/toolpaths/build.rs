@@ -38,7 +38,7 @@ use crate::geom::{Point2, Point3, Polygon, scaled, segment_distance2, unscaled};
 use crate::program::extrusion::BeadShape;
 use crate::program::{Event, Layer, LayerExtras, LayerInsert, LayerItem, Program, Role, Toolpath};
 use crate::region::gapfill::split_by_width;
-use crate::region::{LayerRegions, SolidRole};
+use crate::region::{LayerRegions, PerimeterLoop, SolidRole};
 use crate::slice::LayerZ;
 
 /// The layers of one object (or one material of an object), printed with one tool.
@@ -299,6 +299,56 @@ impl PathMaker {
     }
 }
 
+/// The loops of one island cut into units that print together: the loops around one hole
+/// (a hole's loop at depth `d` lies inside its loop at depth `d + 1`) and the loops around the
+/// island's outside (at depth `d + 1` inside the one at depth `d`). Each unit keeps the regions
+/// stage's order (inner to outer, or outer to inner), so a hole's loops are laid one after the
+/// other instead of every hole being visited once per depth. Returns indices into `loops`, the
+/// units in order of their first loop.
+fn loop_units(loops: &[(&PerimeterLoop, Toolpath)]) -> Vec<Vec<usize>> {
+    let n = loops.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for a in 0..n {
+        let la = loops[a].0;
+        let Some(&probe) = la.polygon.points.first() else {
+            continue;
+        };
+        // The loop one depth away that encloses `a`: deeper for a hole, shallower outside.
+        let encloses = |b: &&PerimeterLoop| {
+            b.is_hole == la.is_hole
+                && if la.is_hole {
+                    b.depth == la.depth + 1
+                } else {
+                    b.depth + 1 == la.depth
+                }
+        };
+        let owner = (0..n)
+            .filter(|&b| encloses(&loops[b].0) && loops[b].0.polygon.contains(probe))
+            .min_by_key(|&b| (loops[b].0.polygon.signed_area2().abs(), b));
+        if let Some(b) = owner {
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+            if ra != rb {
+                parent[ra.max(rb)] = ra.min(rb);
+            }
+        }
+    }
+    let mut units: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for i in 0..n {
+        let r = root(&mut parent, i);
+        units.entry(r).or_default().push(i);
+    }
+    let mut out: Vec<Vec<usize>> = units.into_values().collect();
+    out.sort_by_key(|u| u.first().copied());
+    out
+}
+
 /// The skirt groups and island groups of one object layer.
 fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
     let r = e.regions;
@@ -308,12 +358,13 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
         .filter_map(|s| maker.closed(s, Role::Skirt, r.skirt_width))
         .map(|path| Group {
             first: vec![path],
-            rest: Vec::new(),
+            ..Default::default()
         })
         .collect();
     // Islands by index, in index order; their outer loops for infill assignment.
     let mut islands: BTreeMap<usize, Group> = BTreeMap::new();
     let mut outer: Vec<(usize, &Polygon, i128)> = Vec::new();
+    let mut island_loops: BTreeMap<usize, Vec<(&PerimeterLoop, Toolpath)>> = BTreeMap::new();
     for lp in &r.perimeters {
         let role = if lp.external {
             Role::ExternalPerimeter
@@ -321,10 +372,21 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> (Vec<Group>, Vec<Group>) {
             Role::Perimeter
         };
         if let Some(path) = maker.closed(&lp.polygon, role, lp.width) {
-            islands.entry(lp.island).or_default().first.push(path);
+            island_loops.entry(lp.island).or_default().push((lp, path));
         }
         if lp.external && !lp.is_hole {
             outer.push((lp.island, &lp.polygon, lp.polygon.signed_area2().abs()));
+        }
+    }
+    for (island, loops) in island_loops {
+        let units = loop_units(&loops);
+        let mut paths: Vec<Option<Toolpath>> = loops.into_iter().map(|(_, p)| Some(p)).collect();
+        let group = islands.entry(island).or_default();
+        for unit in units {
+            group.units.push(unit.len());
+            group
+                .first
+                .extend(unit.into_iter().filter_map(|i| paths[i].take()));
         }
     }
     let mut loose = Group::default();

@@ -19,10 +19,16 @@
 //! boundary). Connectors run along the boundary, so they are printed where the infill meets
 //! the innermost perimeter; they add about one boundary length per family to the extruded length.
 
-use crate::geom::{ExPolygon, Point2, Polygon, Polyline, clip_polylines, scaled, segment_distance};
+use crate::geom::{
+    ExPolygon, Point2, Polygon, Polyline, clip_polylines, scaled, segment_distance, segment_param,
+};
 
 /// Longest connector, in line spacings (a boundary meeting the lines at 20° needs ~2.9).
 pub const CONNECT_LIMIT: f64 = 3.0;
+
+/// Farthest a clipped line's end may lie from the boundary edge it is placed on (nm): clipping
+/// rounds intersections to the nanometre.
+const LOCATE_TOLERANCE_NM: f64 = 1000.0;
 
 /// Rounding slack (nm) when deciding whether a connector leaves the area: clipped end points are
 /// rounded to the nanometre, so a connector along an edge can stray a few units either side.
@@ -103,15 +109,17 @@ pub fn fill_family(area: &[ExPolygon], family: LineFamily, connect: bool) -> Vec
             }
         })
         .collect();
-    let ordered = order_nearest(pieces);
-    if connect {
-        join_adjacent(ordered, area, CONNECT_LIMIT * s)
+    let pieces = if connect {
+        let lattice = |p: Point2| dot(p, n) / s - family.phase;
+        let boundary = Boundary::new(area, lattice, k_lo as i64, k_hi as i64);
+        connect_along_boundary(pieces, &boundary, CONNECT_LIMIT * s)
     } else {
-        ordered
-            .into_iter()
-            .map(|p| Polyline { points: p.points })
-            .collect()
-    }
+        pieces
+    };
+    order_nearest(pieces)
+        .into_iter()
+        .map(|p| Polyline { points: p.points })
+        .collect()
 }
 
 /// Greedy nearest-neighbour chaining of `pieces`, reversing pieces as needed.
@@ -151,26 +159,233 @@ fn order_nearest(pieces: Vec<Piece>) -> Vec<Piece> {
     out
 }
 
-/// Joins consecutive pieces on adjacent lines whose connector is short and inside `area`.
-fn join_adjacent(pieces: Vec<Piece>, area: &[ExPolygon], max_len_nm: f64) -> Vec<Polyline> {
-    let mut out: Vec<Polyline> = Vec::new();
-    let mut last_line: Option<i64> = None;
-    for piece in pieces {
-        if let (Some(prev), Some(line)) = (out.last_mut(), last_line) {
-            let a = prev.points[prev.points.len() - 1];
-            let b = piece.points[0];
-            let adjacent = (piece.line - line).abs() == 1;
-            let short = (a.distance_squared(b) as f64).sqrt() <= max_len_nm;
-            if adjacent && short && segment_inside(a, b, area) {
-                prev.points.extend(piece.points);
-                last_line = Some(piece.line);
-                continue;
+/// A piece end placed on the boundary: the ring, the edge it lies on and its arc length from
+/// the ring's first vertex (nm).
+#[derive(Debug, Clone, Copy)]
+struct OnRing {
+    ring: usize,
+    edge: usize,
+    along: f64,
+}
+
+/// The boundary rings of an area with their arc lengths, and its edges bucketed by the lattice
+/// lines they cross, so a piece end is placed by looking only at the edges that reach its line.
+struct Boundary<'a> {
+    rings: Vec<&'a [Point2]>,
+    /// Per ring, the arc length at each vertex; one more entry than vertices (the perimeter).
+    arc: Vec<Vec<f64>>,
+    /// Per lattice line `k_lo + i`, the (ring, edge) pairs that reach it.
+    buckets: Vec<Vec<(usize, usize)>>,
+    k_lo: i64,
+}
+
+impl<'a> Boundary<'a> {
+    fn new(area: &'a [ExPolygon], lattice: impl Fn(Point2) -> f64, k_lo: i64, k_hi: i64) -> Self {
+        let rings: Vec<&[Point2]> = rings(area)
+            .map(|r| r.points.as_slice())
+            .filter(|r| r.len() >= 2)
+            .collect();
+        let lines = usize::try_from(k_hi - k_lo + 1).unwrap_or(0);
+        let mut buckets = vec![Vec::new(); lines];
+        let mut arc = Vec::with_capacity(rings.len());
+        // Slack in spacings so an end rounded onto the far side of a vertex still finds its edge.
+        const SLACK: f64 = 1e-3;
+        for (r, pts) in rings.iter().enumerate() {
+            let mut acc = vec![0.0; pts.len() + 1];
+            for i in 0..pts.len() {
+                let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+                acc[i + 1] = acc[i] + (a.distance_squared(b) as f64).sqrt();
+                let (la, lb) = (lattice(a), lattice(b));
+                let lo = (la.min(lb) - SLACK).ceil().max(k_lo as f64) as i64;
+                let hi = (la.max(lb) + SLACK).floor().min(k_hi as f64) as i64;
+                for k in lo..=hi {
+                    if let Some(bucket) = usize::try_from(k - k_lo)
+                        .ok()
+                        .and_then(|i| buckets.get_mut(i))
+                    {
+                        bucket.push((r, i));
+                    }
+                }
+            }
+            arc.push(acc);
+        }
+        Self {
+            rings,
+            arc,
+            buckets,
+            k_lo,
+        }
+    }
+
+    /// Where `p`, an end of a piece on lattice line `line`, lies on the boundary: the nearest
+    /// edge reaching that line, if within [`LOCATE_TOLERANCE_NM`].
+    fn locate(&self, p: Point2, line: i64) -> Option<OnRing> {
+        let bucket = self.buckets.get(usize::try_from(line - self.k_lo).ok()?)?;
+        let mut best: Option<(f64, OnRing)> = None;
+        for &(ring, edge) in bucket {
+            let pts = self.rings[ring];
+            let (a, b) = (pts[edge], pts[(edge + 1) % pts.len()]);
+            let d = segment_distance(p, a, b);
+            if d <= LOCATE_TOLERANCE_NM && best.is_none_or(|(bd, _)| d < bd) {
+                let len = self.arc[ring][edge + 1] - self.arc[ring][edge];
+                let along = self.arc[ring][edge] + segment_param(p, a, b) * len;
+                best = Some((d, OnRing { ring, edge, along }));
             }
         }
-        last_line = Some(piece.line);
-        out.push(Polyline {
-            points: piece.points,
-        });
+        best.map(|(_, at)| at)
+    }
+
+    /// Length of the ring's perimeter, nm.
+    fn perimeter(&self, ring: usize) -> f64 {
+        self.arc[ring].last().copied().unwrap_or(0.0)
+    }
+
+    /// The ring's vertices passed when walking forward along it from `from` to `to`.
+    fn vertices_between(&self, from: OnRing, to: OnRing) -> Vec<Point2> {
+        let pts = self.rings[from.ring];
+        let n = pts.len();
+        if from.edge == to.edge && to.along >= from.along {
+            return Vec::new();
+        }
+        let mut out = Vec::new();
+        let mut v = (from.edge + 1) % n;
+        loop {
+            out.push(pts[v]);
+            if v == to.edge || out.len() > n {
+                break;
+            }
+            v = (v + 1) % n;
+        }
+        out
+    }
+}
+
+/// Joins `pieces` into zig-zags by links that follow the area's boundary (PrusaSlicer's
+/// rectilinear infill connects its lines the same way, along the contour between consecutive
+/// intersections, in `FillRectilinear.cpp`). A link joins two piece ends that are neighbours
+/// along a ring (no other line meets the ring between them), on the same or adjacent lattice
+/// lines, at most `max_len_nm` apart along the ring; each ring arc between two consecutive ends
+/// can carry only the link between those two ends, so no connector is printed twice.
+///
+/// Chains are walked: each starts at the free piece on the lowest lattice line (an extremity of
+/// the sweep), and at every piece end continues to the ring neighbour on the next line in the
+/// direction of travel, else on the same line (around the top of a hole), else on the line
+/// back (turning the sweep round, down the other side of a hole); the shorter link on ties.
+fn connect_along_boundary(
+    pieces: Vec<Piece>,
+    boundary: &Boundary<'_>,
+    max_len_nm: f64,
+) -> Vec<Piece> {
+    let n = pieces.len();
+    // Piece ends on each ring, in order along it; and where each piece end sits in that order.
+    let mut on_ring: Vec<Vec<(f64, usize, usize, OnRing)>> =
+        vec![Vec::new(); boundary.rings.len()];
+    for (i, piece) in pieces.iter().enumerate() {
+        let ends = [piece.points[0], piece.points[piece.points.len() - 1]];
+        for (end, p) in ends.into_iter().enumerate() {
+            if let Some(at) = boundary.locate(p, piece.line) {
+                on_ring[at.ring].push((at.along, i, end, at));
+            }
+        }
+    }
+    let lines: Vec<i64> = pieces.iter().map(|p| p.line).collect();
+    let mut slot: Vec<[Option<(usize, usize)>; 2]> = vec![[None, None]; n];
+    for (ring, ends) in on_ring.iter_mut().enumerate() {
+        ends.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+        for (k, e) in ends.iter().enumerate() {
+            slot[e.1][e.2] = Some((ring, k));
+        }
+    }
+    // The links leaving piece `i` at end `e`: (to piece, to end, points between, length, Δline).
+    let candidates = |i: usize, e: usize, used: &[bool]| {
+        let mut out: Vec<(usize, usize, Vec<Point2>, f64, i64)> = Vec::new();
+        let Some((ring, k)) = slot[i][e] else {
+            return out;
+        };
+        let ends = &on_ring[ring];
+        let m = ends.len();
+        let perimeter = boundary.perimeter(ring).max(1.0);
+        if m < 2 {
+            return out;
+        }
+        let here = ends[k];
+        for (other, forward) in [(ends[(k + 1) % m], true), (ends[(k + m - 1) % m], false)] {
+            let (j, f) = (other.1, other.2);
+            let dline = lines[j] - lines[i];
+            if j == i || used[j] || dline.abs() > 1 {
+                continue;
+            }
+            let (length, via) = if forward {
+                (
+                    (other.0 - here.0).rem_euclid(perimeter),
+                    boundary.vertices_between(here.3, other.3),
+                )
+            } else {
+                let mut v = boundary.vertices_between(other.3, here.3);
+                v.reverse();
+                ((here.0 - other.0).rem_euclid(perimeter), v)
+            };
+            if length <= max_len_nm {
+                out.push((j, f, via, length, dline));
+            }
+        }
+        out
+    };
+    let mut used = vec![false; n];
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by_key(|&i| (lines[i], i));
+    let mut slots: Vec<Option<Piece>> = pieces.into_iter().map(Some).collect();
+    let mut out = Vec::new();
+    for &start in &order {
+        if used[start] {
+            continue;
+        }
+        used[start] = true;
+        // Leave the first piece by the end that continues up the lattice, if either does.
+        let rises = |e: usize, used: &[bool]| {
+            candidates(start, e, used)
+                .iter()
+                .filter(|c| c.4 == 1)
+                .map(|c| c.3)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut exit = if rises(0, &used) < rises(1, &used) { 0 } else { 1 };
+        let mut dir = 1;
+        let Some(mut chain) = slots[start].take() else {
+            continue;
+        };
+        if exit == 0 {
+            chain.points.reverse();
+        }
+        let mut piece = start;
+        loop {
+            let cands = candidates(piece, exit, &used);
+            let rank = |d: i64| if d == dir { 0 } else if d == 0 { 1 } else { 2 };
+            let Some(best) = cands
+                .into_iter()
+                .min_by(|a, b| rank(a.4).cmp(&rank(b.4)).then(a.3.total_cmp(&b.3)))
+            else {
+                break;
+            };
+            let (j, entry, via, _, dline) = best;
+            let Some(mut next) = slots[j].take() else {
+                break;
+            };
+            used[j] = true;
+            if dline != 0 {
+                dir = dline;
+            }
+            if entry == 1 {
+                next.points.reverse();
+            }
+            for q in via.into_iter().chain(next.points) {
+                if chain.points.last() != Some(&q) {
+                    chain.points.push(q);
+                }
+            }
+            (piece, exit) = (j, 1 - entry);
+        }
+        out.push(chain);
     }
     out
 }
