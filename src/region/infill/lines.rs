@@ -26,6 +26,14 @@ use crate::geom::{
 /// Longest connector, in line spacings (a boundary meeting the lines at 20° needs ~2.9).
 pub const CONNECT_LIMIT: f64 = 3.0;
 
+/// Longest anchor at a chain's free end, in line spacings: 2.8 mm for 20 % sparse infill of
+/// 0.45 mm lines, about PrusaSlicer's default `infill_anchor` (600 % of the width, 2.7 mm).
+pub const ANCHOR_LIMIT: f64 = 1.25;
+
+/// Smallest turn of the boundary, degrees, that counts as a corner an anchor may run to (the
+/// same threshold as an aligned seam's corner).
+pub const ANCHOR_CORNER_DEG: f64 = 50.0;
+
 /// Farthest a clipped line's end may lie from the boundary edge it is placed on (nm): clipping
 /// rounds intersections to the nanometre.
 const LOCATE_TOLERANCE_NM: f64 = 1000.0;
@@ -112,7 +120,7 @@ pub fn fill_family(area: &[ExPolygon], family: LineFamily, connect: bool) -> Vec
     let pieces = if connect {
         let lattice = |p: Point2| dot(p, n) / s - family.phase;
         let boundary = Boundary::new(area, lattice, k_lo as i64, k_hi as i64);
-        connect_along_boundary(pieces, &boundary, CONNECT_LIMIT * s)
+        connect_along_boundary(pieces, &boundary, s)
     } else {
         pieces
     };
@@ -240,6 +248,48 @@ impl<'a> Boundary<'a> {
         self.arc[ring].last().copied().unwrap_or(0.0)
     }
 
+    /// The first corner (a turn of at least [`ANCHOR_CORNER_DEG`]) met walking along the ring
+    /// from `from`, forward or backward, within `reach` nm: its distance and the vertices up to
+    /// and including it.
+    fn corner_within(&self, from: OnRing, reach: f64, forward: bool) -> Option<(f64, Vec<Point2>)> {
+        let (pts, arc) = (self.rings[from.ring], &self.arc[from.ring]);
+        let n = pts.len();
+        if n < 3 || reach <= 0.0 {
+            return None;
+        }
+        let min_turn = ANCHOR_CORNER_DEG.to_radians();
+        let turn = |v: usize| {
+            let (p, q, r) = (pts[(v + n - 1) % n], pts[v], pts[(v + 1) % n]);
+            let (ax, ay) = ((q.x - p.x) as f64, (q.y - p.y) as f64);
+            let (bx, by) = ((r.x - q.x) as f64, (r.y - q.y) as f64);
+            (ax * by - ay * bx).atan2(ax * bx + ay * by).abs()
+        };
+        let (mut v, mut dist) = if forward {
+            ((from.edge + 1) % n, arc[from.edge + 1] - from.along)
+        } else {
+            (from.edge, from.along - arc[from.edge])
+        };
+        let mut out = Vec::new();
+        for _ in 0..n {
+            if dist > reach {
+                return None;
+            }
+            out.push(pts[v]);
+            if turn(v) >= min_turn {
+                return Some((dist, out));
+            }
+            if forward {
+                dist += arc[v + 1] - arc[v];
+                v = (v + 1) % n;
+            } else {
+                let u = (v + n - 1) % n;
+                dist += arc[u + 1] - arc[u];
+                v = u;
+            }
+        }
+        None
+    }
+
     /// The ring's vertices passed when walking forward along it from `from` to `to`.
     fn vertices_between(&self, from: OnRing, to: OnRing) -> Vec<Point2> {
         let pts = self.rings[from.ring];
@@ -274,8 +324,9 @@ impl<'a> Boundary<'a> {
 fn connect_along_boundary(
     pieces: Vec<Piece>,
     boundary: &Boundary<'_>,
-    max_len_nm: f64,
+    spacing_nm: f64,
 ) -> Vec<Piece> {
+    let max_len_nm = CONNECT_LIMIT * spacing_nm;
     let n = pieces.len();
     // Piece ends on each ring, in order along it; and where each piece end sits in that order.
     let mut on_ring: Vec<Vec<(f64, usize, usize, OnRing)>> =
@@ -331,6 +382,38 @@ fn connect_along_boundary(
         }
         out
     };
+    // The anchor of a chain's free end (after PrusaSlicer's `infill_anchor`): the end carried
+    // along the boundary into the nearest corner within reach, so a chain can begin or finish
+    // where aligned seams put the end of the perimeters. It stops at that corner, at most
+    // [`ANCHOR_LIMIT`] spacings away and half a spacing short of the next line end; two
+    // anchors on one arc each stop at the first corner they meet, so they never overlap.
+    let anchor = |i: usize, e: usize| -> Vec<Point2> {
+        let Some((ring, k)) = slot[i][e] else {
+            return Vec::new();
+        };
+        let ends = &on_ring[ring];
+        let m = ends.len();
+        let perimeter = boundary.perimeter(ring).max(1.0);
+        let here = ends[k];
+        let arc = |forward: bool| {
+            if m < 2 {
+                perimeter
+            } else if forward {
+                (ends[(k + 1) % m].0 - here.0).rem_euclid(perimeter)
+            } else {
+                (here.0 - ends[(k + m - 1) % m].0).rem_euclid(perimeter)
+            }
+        };
+        [true, false]
+            .into_iter()
+            .filter_map(|forward| {
+                let reach = (ANCHOR_LIMIT * spacing_nm).min(arc(forward) - spacing_nm / 2.0);
+                boundary.corner_within(here.3, reach, forward)
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, points)| points)
+            .unwrap_or_default()
+    };
     let mut used = vec![false; n];
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by_key(|&i| (lines[i], i));
@@ -350,12 +433,18 @@ fn connect_along_boundary(
                 .fold(f64::INFINITY, f64::min)
         };
         let mut exit = if rises(0, &used) < rises(1, &used) { 0 } else { 1 };
+        let mut head = anchor(start, 1 - exit);
+        head.reverse();
         let mut dir = 1;
         let Some(mut chain) = slots[start].take() else {
             continue;
         };
         if exit == 0 {
             chain.points.reverse();
+        }
+        if !head.is_empty() {
+            head.extend(chain.points);
+            chain.points = head;
         }
         let mut piece = start;
         loop {
@@ -385,6 +474,7 @@ fn connect_along_boundary(
             }
             (piece, exit) = (j, 1 - entry);
         }
+        chain.points.extend(anchor(piece, exit));
         out.push(chain);
     }
     out
