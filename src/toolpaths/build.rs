@@ -857,6 +857,47 @@ mod tests {
     }
 
     #[test]
+    fn loops_print_hole_by_hole() {
+        // A 30 mm square with three 4 mm square holes in a row, two loops around each.
+        let mut island = square(0.0, 0.0, 30.0);
+        for x in [4.0, 13.0, 22.0] {
+            let mut hole = square(x, 13.0, 4.0).contour;
+            hole.points.reverse();
+            island.holes.push(hole);
+        }
+        let obj = object(0, vec![island], 6, &RegionParams::default());
+        let program = build_program(&[obj], &ProgramParams::default());
+        let loops: Vec<&Toolpath> = program.layers[3].paths().filter(|p| p.closed).collect();
+        assert_eq!(loops.len(), 8);
+        // Which hole (0, 1, 2) a loop goes round, or 3 for the outside.
+        let hole_of = |p: &Toolpath| {
+            let (x0, x1) = p
+                .points
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.x), b.max(q.x)));
+            if x1 - x0 > 20.0 {
+                3
+            } else {
+                ((x0 - 2.0) / 9.0).floor() as usize
+            }
+        };
+        let seq: Vec<usize> = loops.iter().map(|p| hole_of(p)).collect();
+        // Each hole's two loops are consecutive, inner (depth 1) then outer (depth 0).
+        for pair in seq.chunks(2) {
+            assert_eq!(pair[0], pair[1], "{seq:?}");
+        }
+        for pair in loops.chunks(2) {
+            assert_eq!(
+                (pair[0].role, pair[1].role),
+                (Role::Perimeter, Role::ExternalPerimeter)
+            );
+        }
+        let mut holes = seq.clone();
+        holes.dedup();
+        assert_eq!(holes.len(), 4, "{seq:?}");
+    }
+
+    #[test]
     fn simplify_drops_collinear_and_tiny_deviations_only() {
         let mm = Point2::from_mm;
         let line = [

@@ -579,8 +579,77 @@ mod tests {
         assert!(loose[1].points[0].x > loose[1].points[1].x);
         let joined = fill_family(&area, family, true);
         assert_eq!(joined.len(), 1);
-        assert_eq!(joined[0].points.len(), 20);
-        assert!((polyline_length(&joined[0]) - (100.0 + 9.0)).abs() < 1e-5);
+        // Ten lines, nine connectors of one spacing, and an anchor of 0.5 mm at each end into
+        // the corner the first and the last line end beside.
+        assert_eq!(joined[0].points.len(), 22);
+        assert!((polyline_length(&joined[0]) - (100.0 + 9.0 + 1.0)).abs() < 1e-5);
+        let ends = [joined[0].points[0], joined[0].points[21]];
+        let corners = [Point2::from_mm(0.0, 0.0), Point2::from_mm(0.0, 10.0)];
+        assert!(ends.iter().all(|e| corners.contains(e)), "{ends:?}");
+    }
+
+    /// Every segment of `lines` lies inside `area` (up to rounding) and, when it is not along a
+    /// lattice line (a connector or an anchor), on the area's boundary.
+    fn assert_on_area_or_boundary(lines: &[Polyline], area: &[ExPolygon], family: LineFamily) {
+        let (sin, cos) = family.angle_rad.sin_cos();
+        for l in lines {
+            for w in l.points.windows(2) {
+                assert!(segment_inside(w[0], w[1], area), "{w:?} leaves the area");
+                let (dx, dy) = ((w[1].x - w[0].x) as f64, (w[1].y - w[0].y) as f64);
+                let along_lattice = (dx * sin - dy * cos).abs() <= 2.0;
+                if !along_lattice {
+                    let on_ring = rings(area).any(|r| {
+                        (0..r.points.len()).any(|i| {
+                            let (a, b) = (r.points[i], r.points[(i + 1) % r.points.len()]);
+                            segment_distance(w[0], a, b) <= LOCATE_TOLERANCE_NM
+                                && segment_distance(w[1], a, b) <= LOCATE_TOLERANCE_NM
+                        })
+                    });
+                    assert!(on_ring, "connector {w:?} is not on the boundary");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn lines_around_holes_join_along_the_hole_into_few_chains() {
+        // A 40 mm square with four 6 mm square holes: the lines through the holes are cut into
+        // three pieces each. Following the boundary, around the holes too, joins them into
+        // chains of four pieces or more on average, in every direction.
+        let mut area = square_island(0.0, 0.0, 40.0);
+        for (x, y) in [(8.0, 8.0), (26.0, 8.0), (8.0, 26.0), (26.0, 26.0)] {
+            let mut hole = crate::region::test_util::rect(x, y, x + 6.0, y + 6.0);
+            hole.points.reverse();
+            area.holes.push(hole);
+        }
+        let area = [area];
+        for angle in [0.0f64, 45.0, 90.0, 30.0] {
+            let family = LineFamily {
+                angle_rad: angle.to_radians(),
+                spacing_mm: 2.0,
+                phase: 0.5,
+            };
+            let loose = fill_family(&area, family, false);
+            let joined = fill_family(&area, family, true);
+            assert!(
+                joined.len() * 4 <= loose.len(),
+                "{angle}°: {} chains of {} pieces",
+                joined.len(),
+                loose.len()
+            );
+            assert_on_area_or_boundary(&joined, &area, family);
+            // Every piece printed once: the joined length is the loose length plus connectors
+            // no longer than the limit each.
+            let (a, b) = (
+                loose.iter().map(polyline_length).sum::<f64>(),
+                joined.iter().map(polyline_length).sum::<f64>(),
+            );
+            let links = loose.len() - joined.len() + 2 * joined.len();
+            assert!(
+                b >= a && b <= a + links as f64 * CONNECT_LIMIT * 2.0,
+                "{angle}°: {a} → {b}"
+            );
+        }
     }
 
     #[test]
@@ -605,6 +674,7 @@ mod tests {
             phase: 0.5,
         };
         let area = [u];
+        assert_on_area_or_boundary(&fill_family(&area, family, true), &area, family);
         for l in fill_family(&area, family, true) {
             for w in l.points.windows(2) {
                 assert!(segment_inside(w[0], w[1], &area), "{:?} leaves the U", w);
