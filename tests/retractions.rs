@@ -42,7 +42,12 @@ fn plate_triangles() -> Vec<[Point3; 3]> {
             let (x0, y0) = (i as f64 * CELL, j as f64 * CELL);
             let (x1, y1) = (x0 + CELL, y0 + CELL);
             quad(p(x0, y0, h), p(x1, y0, h), p(x1, y1, h), p(x0, y1, h));
-            quad(p(x0, y0, 0.0), p(x0, y1, 0.0), p(x1, y1, 0.0), p(x1, y0, 0.0));
+            quad(
+                p(x0, y0, 0.0),
+                p(x0, y1, 0.0),
+                p(x1, y1, 0.0),
+                p(x1, y0, 0.0),
+            );
             if !solid(i - 1, j) {
                 quad(p(x0, y0, 0.0), p(x0, y0, h), p(x0, y1, h), p(x0, y1, 0.0));
             }
@@ -174,7 +179,10 @@ fn a_plate_with_holes_prints_hole_by_hole_with_joined_infill_and_few_retractions
             _ => last_inner = None,
         }
     }
-    assert_eq!(pairs, 17, "16 holes and the outside, each inner loop then its outer loop");
+    assert_eq!(
+        pairs, 17,
+        "16 holes and the outside, each inner loop then its outer loop"
+    );
 
     // Infill, connectors along the boundary included, stays in the infill area: deeper in the
     // material than the inner loop's centreline by more than a fifth of a millimetre, so no
@@ -184,7 +192,10 @@ fn a_plate_with_holes_prints_hole_by_hole_with_joined_infill_and_few_retractions
         .filter(|m| m.extruding && role(m) == "Perimeter")
         .flat_map(|m| [depth(xyz(m.from)), depth(xyz(m.to))])
         .fold(f64::INFINITY, f64::min);
-    assert!((0.5..0.8).contains(&inner_loop), "inner loop at {inner_loop}");
+    assert!(
+        (0.5..0.8).contains(&inner_loop),
+        "inner loop at {inner_loop}"
+    );
     for m in all
         .iter()
         .filter(|m| m.extruding && role(m).contains("infill"))

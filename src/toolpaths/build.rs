@@ -15,9 +15,10 @@
 //!   previous path's; the program's first tool is implied ([`Program::first_tool`]), not an
 //!   event.
 //! - **Order within a tool.** The skirt first (outermost loop first, as the regions stage
-//!   gives it), then the islands nearest-first; each island prints its perimeter loops in the
-//!   regions stage's order (inner to outer by default) and then its solid and sparse infill in
-//!   travel order ([`super::order`]). Infill lines belong to the island whose outer loop
+//!   gives it), then the islands nearest-first; each island prints its perimeter loops hole by
+//!   hole — the loops around one hole (or around the outside) together, in the regions stage's
+//!   order (inner to outer by default), the holes nearest-first — and then its solid and sparse
+//!   infill in travel order ([`super::order`]). Infill lines belong to the island whose outer loop
 //!   contains their first point (the smallest such loop); lines outside every loop (islands too
 //!   thin for perimeters) form one more group per object.
 //! - **Seams.** A perimeter or skirt loop starts at the vertex chosen by

@@ -9,15 +9,22 @@
 //! **Clipping.** The lines are clipped together, as one serpentine path whose hops between
 //! lines lie outside the area, with [`clip_polylines`].
 //!
-//! **Order.** Pieces are chained greedily: after each piece, the nearest free end of any other
-//! piece comes next (ties go to the lower index, so output is deterministic). On a convex area
-//! this is exactly the boustrophedon order.
+//! **Connection.** Pieces are joined into zig-zags by links that run *along the area's
+//! boundary* between two piece ends that are neighbours on a ring (no other line meets the ring
+//! between them), lie on the same or adjacent lattice lines and are at most [`CONNECT_LIMIT`]
+//! spacings apart along the ring — PrusaSlicer's rectilinear infill connects its lines the same
+//! way (`FillRectilinear.cpp`: links along the contour between consecutive intersections). A
+//! chain starts at the free piece on the lowest line and at each end takes the link onward in
+//! its direction of travel, else along the same line (over the top of a hole), else back (down
+//! the other side of the hole), so one chain sweeps round a hole instead of stopping at it.
+//! Links lie on the boundary, where the infill meets the innermost perimeter, never across the
+//! area or over a perimeter; they add about half a boundary length per family to the extruded
+//! length. A chain's free ends are then *anchored* (after PrusaSlicer's `infill_anchor`): carried
+//! along the boundary into a corner within [`ANCHOR_LIMIT`] spacings, where aligned seams end the
+//! perimeters, so the nozzle goes on to the infill without a long travel.
 //!
-//! **Connection.** Two consecutive pieces on adjacent lines are joined by a straight connector
-//! when it is at most [`CONNECT_LIMIT`] spacings long and stays inside the area (no boundary edge
-//! is crossed by more than [`INSIDE_TOLERANCE_NM`], and its quarter points are inside or on the
-//! boundary). Connectors run along the boundary, so they are printed where the infill meets
-//! the innermost perimeter; they add about one boundary length per family to the extruded length.
+//! **Order.** Chains are then ordered greedily: after each, the nearest free end of any other
+//! comes next (ties go to the lower index, so output is deterministic).
 
 use crate::geom::{
     ExPolygon, Point2, Polygon, Polyline, clip_polylines, scaled, segment_distance, segment_param,
@@ -329,8 +336,7 @@ fn connect_along_boundary(
     let max_len_nm = CONNECT_LIMIT * spacing_nm;
     let n = pieces.len();
     // Piece ends on each ring, in order along it; and where each piece end sits in that order.
-    let mut on_ring: Vec<Vec<(f64, usize, usize, OnRing)>> =
-        vec![Vec::new(); boundary.rings.len()];
+    let mut on_ring: Vec<Vec<(f64, usize, usize, OnRing)>> = vec![Vec::new(); boundary.rings.len()];
     for (i, piece) in pieces.iter().enumerate() {
         let ends = [piece.points[0], piece.points[piece.points.len() - 1]];
         for (end, p) in ends.into_iter().enumerate() {
@@ -432,7 +438,11 @@ fn connect_along_boundary(
                 .map(|c| c.3)
                 .fold(f64::INFINITY, f64::min)
         };
-        let mut exit = if rises(0, &used) < rises(1, &used) { 0 } else { 1 };
+        let mut exit = if rises(0, &used) < rises(1, &used) {
+            0
+        } else {
+            1
+        };
         let mut head = anchor(start, 1 - exit);
         head.reverse();
         let mut dir = 1;
@@ -449,7 +459,15 @@ fn connect_along_boundary(
         let mut piece = start;
         loop {
             let cands = candidates(piece, exit, &used);
-            let rank = |d: i64| if d == dir { 0 } else if d == 0 { 1 } else { 2 };
+            let rank = |d: i64| {
+                if d == dir {
+                    0
+                } else if d == 0 {
+                    1
+                } else {
+                    2
+                }
+            };
             let Some(best) = cands
                 .into_iter()
                 .min_by(|a, b| rank(a.4).cmp(&rank(b.4)).then(a.3.total_cmp(&b.3)))
