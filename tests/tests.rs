@@ -32,6 +32,7 @@ mod preview;
 mod regressions_conform;
 mod regressions_route;
 mod regressions_slice;
+mod retractions;
 mod robot;
 mod roundtrip;
 mod route_help;

@@ -28,7 +28,7 @@
 //! perimeter). Anything else unheld — a loop hanging over air, a line ending in air — is
 //! extrusion into air once a stretch adds up to [`MIN_RUN_MM`].
 //!
-//! Only filament tools count, and only planar layers: a file that extrudes while moving in Z
+//! Only filament beads are checked (paste beads hold what lies on them), and only planar layers: a file that extrudes while moving in Z
 //! (curved layers, conformal paths) is not checked, since its layers are not stacked planes.
 
 use std::collections::HashMap;
@@ -171,12 +171,14 @@ fn cell(v: f64) -> i64 {
     (v / CELL_MM).floor() as i64
 }
 
-/// A planar extruding move of a filament tool: its layer, Z and the segments of its path.
-fn planar_segments(m: &Move, params: &CheckParams) -> Option<(usize, f64, Vec<Segment>)> {
-    if !m.extruding || !m.has_xy || params.tool(m.tool).kind != ToolKind::Filament {
+/// A planar extruding move: its layer, whether a filament tool lays it, and the segments of
+/// its path.
+fn planar_segments(m: &Move, params: &CheckParams) -> Option<(usize, bool, Vec<Segment>)> {
+    if !m.extruding || !m.has_xy {
         return None;
     }
-    let z = m.to[2]?;
+    let filament = params.tool(m.tool).kind == ToolKind::Filament;
+    m.to[2]?;
     let mut pts = Vec::with_capacity(m.path.len());
     for q in &m.path {
         pts.push([q[0]?, q[1]?]);
@@ -185,7 +187,16 @@ fn planar_segments(m: &Move, params: &CheckParams) -> Option<(usize, f64, Vec<Se
         .windows(2)
         .map(|w| Segment { a: w[0], b: w[1] })
         .collect();
-    Some((m.layer, z, segments))
+    Some((m.layer, filament, segments))
+}
+
+/// One run of consecutive extruding moves of one kind of tool.
+#[derive(Clone, Default)]
+struct Path {
+    /// Laid by a filament tool (checked); paste beads only hold what lies on them.
+    filament: bool,
+    /// (G-code line, segment) in print order.
+    segments: Vec<(usize, Segment)>,
 }
 
 /// Whether any extruding move changes Z (a non-planar file).
@@ -204,7 +215,7 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
     }
     // Per layer: its paths (runs of consecutive extruding moves), each a list of (line, segment).
     let n = moves.layer_z.len();
-    let mut paths: Vec<Vec<Vec<(usize, Segment)>>> = vec![Vec::new(); n];
+    let mut paths: Vec<Vec<Path>> = vec![Vec::new(); n];
     let role_of_line: HashMap<usize, Option<String>> = moves
         .moves
         .iter()
@@ -214,13 +225,18 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
     let mut open = false;
     for m in &moves.moves {
         match planar_segments(m, params) {
-            Some((layer, _, segments)) if layer < n => {
-                if !open {
-                    paths[layer].push(Vec::new());
+            Some((layer, filament, segments)) if layer < n => {
+                let same = open && paths[layer].last().is_some_and(|p| p.filament == filament);
+                if !same {
+                    paths[layer].push(Path {
+                        filament,
+                        segments: Vec::new(),
+                    });
                     open = true;
                 }
                 if let Some(path) = paths[layer].last_mut() {
-                    path.extend(segments.into_iter().map(|s| (m.line, s)));
+                    path.segments
+                        .extend(segments.into_iter().map(|s| (m.line, s)));
                 }
             }
             _ => {
@@ -248,7 +264,11 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
             .collect();
         for &k in &below {
             if indexes[k].is_none() {
-                let segments = paths[k].iter().flatten().map(|(_, s)| *s).collect();
+                let segments = paths[k]
+                    .iter()
+                    .flat_map(|p| &p.segments)
+                    .map(|(_, s)| *s)
+                    .collect();
                 indexes[k] = Some(LayerIndex::new(
                     moves.layer_z[k],
                     segments,
@@ -273,6 +293,13 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
         // The beads of this layer printed so far: anchors for the bridges that follow.
         let mut printed = LayerIndex::new(z, Vec::new(), GAP_SIDE_MM);
         for path in &paths[l] {
+            if !path.filament {
+                for (_, s) in &path.segments {
+                    printed.add(*s, GAP_SIDE_MM);
+                }
+                continue;
+            }
+            let path = &path.segments;
             let bridge_role = path.first().is_some_and(|(line, _)| {
                 role_of_line
                     .get(line)

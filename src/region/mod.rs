@@ -412,9 +412,9 @@ mod tests {
             "{}",
             len * sp / area
         );
-        // Sparse infill at 20 %.
+        // Sparse infill at 20 %, plus its connectors and anchors along the boundary.
         let sparse = total_length(&regions[5].sparse_infill) * sp / area;
-        assert!((sparse - 0.2).abs() < 0.04, "{sparse}");
+        assert!((0.2..0.25).contains(&sparse), "{sparse}");
     }
 
     #[test]

@@ -519,14 +519,16 @@ mod tests {
         }
         let s = run(&floating, &only);
         assert!((0..=13).all(|j| !s[j].is_empty()));
-        // The first layer is dense: lines at the interface spacing.
+        // The first layer is dense: lines at the interface spacing (the y of the long
+        // horizontal segments; links and anchors along the edge are short or vertical).
         let pitch = |l: &SupportLayer| -> f64 {
-            let ys: Vec<i64> = l
+            let mut ys: Vec<i64> = l
                 .base
                 .iter()
-                .flat_map(|p| p.points.iter().map(|q: &Point2| q.y))
+                .flat_map(|p| p.points.windows(2))
+                .filter(|w: &&[Point2]| w[0].y == w[1].y && (w[1].x - w[0].x).abs() > 1_000_000)
+                .map(|w| w[0].y)
                 .collect();
-            let mut ys = ys;
             ys.sort_unstable();
             ys.dedup();
             ys.windows(2)

@@ -15,9 +15,10 @@
 //!   previous path's; the program's first tool is implied ([`Program::first_tool`]), not an
 //!   event.
 //! - **Order within a tool.** The skirt first (outermost loop first, as the regions stage
-//!   gives it), then the islands nearest-first; each island prints its perimeter loops in the
-//!   regions stage's order (inner to outer by default) and then its solid and sparse infill in
-//!   travel order ([`super::order`]). Infill lines belong to the island whose outer loop
+//!   gives it), then the islands nearest-first; each island prints its perimeter loops hole by
+//!   hole — the loops around one hole (or around the outside) together, in the regions stage's
+//!   order (inner to outer by default), the holes nearest-first — and then its solid and sparse
+//!   infill in travel order ([`super::order`]). Infill lines belong to the island whose outer loop
 //!   contains their first point (the smallest such loop); lines outside every loop (islands too
 //!   thin for perimeters) form one more group per object.
 //! - **Seams.** A perimeter or skirt loop starts at the vertex chosen by
@@ -38,7 +39,7 @@ use crate::geom::{Point2, Point3, Polygon, scaled, segment_distance2, unscaled};
 use crate::program::extrusion::BeadShape;
 use crate::program::{Event, Layer, LayerExtras, LayerInsert, LayerItem, Program, Role, Toolpath};
 use crate::region::gapfill::split_by_width;
-use crate::region::{LayerRegions, SolidRole};
+use crate::region::{LayerRegions, PerimeterLoop, SolidRole};
 use crate::slice::LayerZ;
 
 /// The layers of one object (or one material of an object), printed with one tool.
@@ -309,6 +310,56 @@ impl PathMaker {
     }
 }
 
+/// The loops of one island cut into units that print together: the loops around one hole
+/// (a hole's loop at depth `d` lies inside its loop at depth `d + 1`) and the loops around the
+/// island's outside (at depth `d + 1` inside the one at depth `d`). Each unit keeps the regions
+/// stage's order (inner to outer, or outer to inner), so a hole's loops are laid one after the
+/// other instead of every hole being visited once per depth. Returns indices into `loops`, the
+/// units in order of their first loop.
+fn loop_units(loops: &[(&PerimeterLoop, Toolpath)]) -> Vec<Vec<usize>> {
+    let n = loops.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for a in 0..n {
+        let la = loops[a].0;
+        let Some(&probe) = la.polygon.points.first() else {
+            continue;
+        };
+        // The loop one depth away that encloses `a`: deeper for a hole, shallower outside.
+        let encloses = |b: &&PerimeterLoop| {
+            b.is_hole == la.is_hole
+                && if la.is_hole {
+                    b.depth == la.depth + 1
+                } else {
+                    b.depth + 1 == la.depth
+                }
+        };
+        let owner = (0..n)
+            .filter(|&b| encloses(&loops[b].0) && loops[b].0.polygon.contains(probe))
+            .min_by_key(|&b| (loops[b].0.polygon.signed_area2().abs(), b));
+        if let Some(b) = owner {
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+            if ra != rb {
+                parent[ra.max(rb)] = ra.min(rb);
+            }
+        }
+    }
+    let mut units: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for i in 0..n {
+        let r = root(&mut parent, i);
+        units.entry(r).or_default().push(i);
+    }
+    let mut out: Vec<Vec<usize>> = units.into_values().collect();
+    out.sort_by_key(|u| u.first().copied());
+    out
+}
+
 /// The groups of one object layer, in the order they print: skirt loops; brim loops and ears,
 /// and the support (which the part's first layer over it needs in place); the islands.
 struct ObjectGroups {
@@ -322,7 +373,7 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> ObjectGroups {
     let r = e.regions;
     let single = |path: Toolpath| Group {
         first: vec![path],
-        rest: Vec::new(),
+        ..Default::default()
     };
     let skirt: Vec<Group> = r
         .skirt
@@ -345,8 +396,8 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> ObjectGroups {
         .collect();
     if !ears.is_empty() {
         beside.push(Group {
-            first: Vec::new(),
             rest: ears,
+            ..Default::default()
         });
     }
     // The sheath first, then the lines inside it.
@@ -371,11 +422,13 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> ObjectGroups {
         beside.push(Group {
             first: sheath,
             rest: lines,
+            ..Default::default()
         });
     }
     // Islands by index, in index order; their outer loops for infill assignment.
     let mut islands: BTreeMap<usize, Group> = BTreeMap::new();
     let mut outer: Vec<(usize, &Polygon, i128)> = Vec::new();
+    let mut island_loops: BTreeMap<usize, Vec<(&PerimeterLoop, Toolpath)>> = BTreeMap::new();
     for lp in &r.perimeters {
         let role = if lp.external {
             Role::ExternalPerimeter
@@ -383,10 +436,21 @@ fn object_groups(e: &Entry<'_>, maker: &PathMaker) -> ObjectGroups {
             Role::Perimeter
         };
         if let Some(path) = maker.closed(&lp.polygon, role, lp.width) {
-            islands.entry(lp.island).or_default().first.push(path);
+            island_loops.entry(lp.island).or_default().push((lp, path));
         }
         if lp.external && !lp.is_hole {
             outer.push((lp.island, &lp.polygon, lp.polygon.signed_area2().abs()));
+        }
+    }
+    for (island, loops) in island_loops {
+        let units = loop_units(&loops);
+        let mut paths: Vec<Option<Toolpath>> = loops.into_iter().map(|(_, p)| Some(p)).collect();
+        let group = islands.entry(island).or_default();
+        for unit in units {
+            group.units.push(unit.len());
+            group
+                .first
+                .extend(unit.into_iter().filter_map(|i| paths[i].take()));
         }
     }
     let mut loose = Group::default();
@@ -862,6 +926,47 @@ mod tests {
                 .paths()
                 .any(|p| p.points[0].x > 15.0 && p.height == 0.3)
         );
+    }
+
+    #[test]
+    fn loops_print_hole_by_hole() {
+        // A 30 mm square with three 4 mm square holes in a row, two loops around each.
+        let mut island = square(0.0, 0.0, 30.0);
+        for x in [4.0, 13.0, 22.0] {
+            let mut hole = square(x, 13.0, 4.0).contour;
+            hole.points.reverse();
+            island.holes.push(hole);
+        }
+        let obj = object(0, vec![island], 6, &RegionParams::default());
+        let program = build_program(&[obj], &ProgramParams::default());
+        let loops: Vec<&Toolpath> = program.layers[3].paths().filter(|p| p.closed).collect();
+        assert_eq!(loops.len(), 8);
+        // Which hole (0, 1, 2) a loop goes round, or 3 for the outside.
+        let hole_of = |p: &Toolpath| {
+            let (x0, x1) = p
+                .points
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.x), b.max(q.x)));
+            if x1 - x0 > 20.0 {
+                3
+            } else {
+                ((x0 - 2.0) / 9.0).floor() as usize
+            }
+        };
+        let seq: Vec<usize> = loops.iter().map(|p| hole_of(p)).collect();
+        // Each hole's two loops are consecutive, inner (depth 1) then outer (depth 0).
+        for pair in seq.chunks(2) {
+            assert_eq!(pair[0], pair[1], "{seq:?}");
+        }
+        for pair in loops.chunks(2) {
+            assert_eq!(
+                (pair[0].role, pair[1].role),
+                (Role::Perimeter, Role::ExternalPerimeter)
+            );
+        }
+        let mut holes = seq.clone();
+        holes.dedup();
+        assert_eq!(holes.len(), 4, "{seq:?}");
     }
 
     #[test]

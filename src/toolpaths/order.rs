@@ -16,8 +16,9 @@
 //!
 //! [`order_groups`] keeps paths that belong together (an island's perimeters and its infill)
 //! together: groups are visited nearest-first, each group's `first` paths print in their given
-//! order (a closed loop starts at the vertex chosen by the [`SeamRule`]), then its `rest` in the
-//! order of the two steps above.
+//! order (a closed loop starts at the vertex chosen by the [`SeamRule`]) unit by unit, the
+//! units nearest-first (an island's loops around one hole, then those around the next), then
+//! its `rest` in the order of the two steps above.
 //!
 //! Travel is measured as the straight 3D distance from the end of one path to the start of the
 //! next.
@@ -458,25 +459,65 @@ pub struct Group {
     /// Printed first, in this order (e.g. an island's perimeters, inner to outer); closed loops
     /// start where the [`SeamRule`] says, open paths at their nearer end.
     pub first: Vec<Toolpath>,
+    /// Lengths of the consecutive runs of `first` that each print as one unit, in their given
+    /// order, the units themselves nearest-first (e.g. the loops around each hole of an
+    /// island, so the nozzle finishes one hole before moving to the next). Empty, or not adding
+    /// up to `first`'s length: `first` is one unit.
+    pub units: Vec<usize>,
     /// Printed after `first`, ordered by [`order_paths`] (e.g. the island's infill).
     pub rest: Vec<Toolpath>,
 }
 
+/// Where a closed or open path is entered from `from` when its start is fixed by the seam rule
+/// (loops) or free to be either end (open paths).
+fn fixed_entry(p: &Toolpath, from: &Point3, seam: SeamRule) -> f64 {
+    if p.closed {
+        let v = seam_vertex(&p.points, from, seam);
+        p.points.get(v).map_or(f64::INFINITY, |q| dist(q, from))
+    } else {
+        best_entry(p, from).0
+    }
+}
+
 impl Group {
+    /// `first` cut into its units (see [`Group::units`]).
+    fn split_units(first: Vec<Toolpath>, units: &[usize]) -> Vec<Vec<Toolpath>> {
+        if units.is_empty() || units.iter().sum::<usize>() != first.len() {
+            return vec![first];
+        }
+        let mut it = first.into_iter();
+        units
+            .iter()
+            .map(|&n| it.by_ref().take(n).collect())
+            .collect()
+    }
+
     /// Travel from `from` to the nearest place this group can be entered.
     fn entry_distance(&self, from: &Point3, seam: SeamRule) -> f64 {
-        match self.first.first() {
-            Some(p) if p.closed => {
-                let v = seam_vertex(&p.points, from, seam);
-                p.points.get(v).map_or(f64::INFINITY, |q| dist(q, from))
-            }
-            Some(p) => best_entry(p, from).0,
-            None => self
+        if self.first.is_empty() {
+            return self
                 .rest
                 .iter()
                 .map(|p| best_entry(p, from).0)
-                .fold(f64::INFINITY, f64::min),
+                .fold(f64::INFINITY, f64::min);
         }
+        let mut starts = vec![0];
+        if !self.units.is_empty() && self.units.iter().sum::<usize>() == self.first.len() {
+            starts = self
+                .units
+                .iter()
+                .scan(0, |at, &n| {
+                    let s = *at;
+                    *at += n;
+                    Some(s)
+                })
+                .collect();
+        }
+        starts
+            .into_iter()
+            .filter_map(|i| self.first.get(i))
+            .map(|p| fixed_entry(p, from, seam))
+            .fold(f64::INFINITY, f64::min)
     }
 }
 
@@ -503,17 +544,36 @@ pub fn order_groups(
         let Some(group) = best.and_then(|(i, _)| left[i].take()) else {
             break;
         };
-        for mut p in group.first {
-            if p.closed {
-                let v = seam_vertex(&p.points, &pos, params.seam);
-                p.rotate_start(v);
-            } else if best_entry(&p, &pos).1 {
-                p.reverse();
+        let mut units: Vec<Option<Vec<Toolpath>>> = Group::split_units(group.first, &group.units)
+            .into_iter()
+            .map(Some)
+            .collect();
+        loop {
+            // The unit whose first path is entered nearest (ties to the earlier unit).
+            let mut next: Option<(usize, f64)> = None;
+            for (i, u) in units.iter().enumerate() {
+                if let Some(p) = u.as_ref().and_then(|u| u.first()) {
+                    let d = fixed_entry(p, &pos, params.seam);
+                    if next.is_none_or(|b| d < b.1) {
+                        next = Some((i, d));
+                    }
+                }
             }
-            if let Some(e) = p.end() {
-                pos = *e;
+            let Some(unit) = next.and_then(|(i, _)| units[i].take()) else {
+                break;
+            };
+            for mut p in unit {
+                if p.closed {
+                    let v = seam_vertex(&p.points, &pos, params.seam);
+                    p.rotate_start(v);
+                } else if best_entry(&p, &pos).1 {
+                    p.reverse();
+                }
+                if let Some(e) = p.end() {
+                    pos = *e;
+                }
+                out.push(p);
             }
-            out.push(p);
         }
         for p in order_paths(group.rest, &pos, params) {
             if let Some(e) = p.end() {
@@ -679,7 +739,7 @@ mod tests {
         assert_eq!(ordered[0].points[0], Point3::new(10.0, 0.0, 0.2));
         let groups = vec![Group {
             first: vec![square_loop(0.0, 0.0, 10.0)],
-            rest: vec![],
+            ..Default::default()
         }];
         let rear = OrderParams {
             seam: SeamRule::Rear,
@@ -694,6 +754,7 @@ mod tests {
     fn groups_stay_together_and_visit_nearest_first() {
         let island = |x: f64| Group {
             first: vec![square_loop(x, 0.0, 10.0), square_loop(x + 1.0, 1.0, 8.0)],
+            units: vec![],
             rest: vec![
                 line(x + 2.0, 5.0, x + 8.0, 5.0),
                 line(x + 2.0, 3.0, x + 8.0, 3.0),

@@ -2,8 +2,8 @@
 //!
 //! Every pattern here is made of straight lines on a lattice anchored at the origin
 //! ([`lines`]): generated in scaled integer coordinates, clipped to the area with
-//! [`crate::geom::clip_polylines`], ordered nearest-first (boustrophedon on convex areas) and
-//! joined into zig-zags along the boundary where that stays inside the area.
+//! [`crate::geom::clip_polylines`], joined into zig-zags by links along the area's boundary
+//! (around holes too) and ordered nearest-first.
 //!
 //! The area handed to a pattern is where line *centrelines* may go (see
 //! [`super::perimeters`]): lines run right up to its boundary. `spacing_mm` is the distance
