@@ -100,7 +100,15 @@ struct LayerIndex {
     z: f64,
     segments: Vec<Segment>,
     cells: HashMap<(i64, i64), Vec<u32>>,
+    /// Segments spanning more than [`MAX_CELLS_PER_SEGMENT`] cells (a stray move far off the
+    /// bed), tested by every query instead.
+    long: Vec<u32>,
 }
+
+/// The most grid cells one segment is entered in.
+const MAX_CELLS_PER_SEGMENT: i64 = 4096;
+/// The most samples taken along one move.
+const MAX_SAMPLES_PER_SEGMENT: f64 = 10_000.0;
 
 impl LayerIndex {
     /// `segments` indexed for queries up to `reach` from them.
@@ -109,6 +117,7 @@ impl LayerIndex {
             z,
             segments: Vec::with_capacity(segments.len()),
             cells: HashMap::new(),
+            long: Vec::new(),
         };
         for s in segments {
             index.add(s, reach);
@@ -122,11 +131,26 @@ impl LayerIndex {
         self.segments.push(s);
         let (x0, x1) = (s.a[0].min(s.b[0]) - reach, s.a[0].max(s.b[0]) + reach);
         let (y0, y1) = (s.a[1].min(s.b[1]) - reach, s.a[1].max(s.b[1]) + reach);
+        let span = (cell(x1) - cell(x0) + 1).saturating_mul(cell(y1) - cell(y0) + 1);
+        if span > MAX_CELLS_PER_SEGMENT {
+            self.long.push(i);
+            return;
+        }
         for cx in cell(x0)..=cell(x1) {
             for cy in cell(y0)..=cell(y1) {
                 self.cells.entry((cx, cy)).or_default().push(i);
             }
         }
+    }
+
+    /// The segments a query at `p` must test.
+    fn candidates(&self, p: [f64; 2]) -> impl Iterator<Item = &Segment> {
+        self.cells
+            .get(&(cell(p[0]), cell(p[1])))
+            .into_iter()
+            .flatten()
+            .chain(&self.long)
+            .map(|&i| &self.segments[i as usize])
     }
 
     /// Whether a centreline passes within `reach` of `p`.
@@ -143,13 +167,9 @@ impl LayerIndex {
     /// passes within `reach` of `p`, or centrelines pass within [`GAP_SIDE_MM`] on both sides of
     /// it (it lies along a narrow gap between beads).
     fn holds(&self, p: [f64; 2], dir: f64, reach: f64) -> bool {
-        let Some(ids) = self.cells.get(&(cell(p[0]), cell(p[1]))) else {
-            return false;
-        };
         let n = [-dir.sin(), dir.cos()];
         let (mut left, mut right) = (false, false);
-        for &i in ids {
-            let s = &self.segments[i as usize];
+        for s in self.candidates(p) {
             let (d, q) = s.nearest(p);
             if d <= reach {
                 return true;
@@ -168,6 +188,7 @@ impl LayerIndex {
 }
 
 fn cell(v: f64) -> i64 {
+    // Saturating: a coordinate past ±9·10¹⁸ mm lands in the last cell.
     (v / CELL_MM).floor() as i64
 }
 
@@ -354,7 +375,9 @@ fn unheld_runs(
             continue;
         }
         let dir = dy.atan2(dx);
-        let steps = (len / SAMPLE_STEP_MM).ceil().max(1.0) as usize;
+        let steps = (len / SAMPLE_STEP_MM)
+            .ceil()
+            .clamp(1.0, MAX_SAMPLES_PER_SEGMENT) as usize;
         let first = usize::from(!samples.is_empty());
         for i in first..=steps {
             let t = i as f64 / steps as f64;
@@ -509,6 +532,19 @@ mod tests {
             [15.0, 2.5],
         ]]);
         assert_eq!(air(&bent).len(), 1);
+    }
+
+    #[test]
+    fn a_stray_move_far_off_the_bed_is_reported_without_filling_memory() {
+        let posts = vec![square(0.0, 0.0, 5.0)];
+        let layers = vec![
+            posts.clone(),
+            posts.clone(),
+            vec![vec![[2.5, 0.0], [900_000.0, -900_000.0]]],
+        ];
+        let found = air(&layers);
+        assert_eq!(found.len(), 1);
+        assert!(found[0].length > 1.2e6, "{}", found[0].length);
     }
 
     #[test]
