@@ -9,7 +9,7 @@ use conduit::geom::Point3;
 use conduit_gcode::{Firmware, moves, parse};
 use serde_json::Value;
 
-use crate::support::{conduit, root, stderr, temp_dir, write_stl};
+use crate::support::{conduit, root, slice_with_report, temp_dir, write_stl};
 
 /// The probe's profile in the XZ plane, counter-clockwise; it is extruded 20 mm along Y.
 fn profile() -> Vec<[f64; 2]> {
@@ -51,26 +51,9 @@ fn probe() -> Vec<[Point3; 3]> {
 
 /// Slices `stl` with `extra` arguments; the G-code and the shift from model to bed X.
 fn slice(dir: &Path, stl: &Path, extra: &[&str]) -> (String, f64) {
-    let (gcode, report) = (dir.join("out.gcode"), dir.join("out.json"));
-    let mut args = vec![
-        "slice".to_owned(),
-        stl.display().to_string(),
-        "-o".into(),
-        gcode.display().to_string(),
-        "--report".into(),
-        report.display().to_string(),
-    ];
-    args.extend(extra.iter().map(|s| (*s).to_owned()));
-    let o = conduit(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let r: Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
-    let min_x = r["objects"][0]["bbox"]["min"][0].as_f64().expect("bbox");
+    let (text, min) = slice_with_report(dir, stl, extra);
     let model_min = profile().iter().map(|q| q[0]).fold(f64::MAX, f64::min);
-    (
-        std::fs::read_to_string(&gcode).expect("G-code"),
-        min_x - model_min,
-    )
+    (text, min[0] - model_min)
 }
 
 /// `conduit check --json` of `gcode`: the number of extrusion_into_air findings.

@@ -9,7 +9,7 @@ use std::path::Path;
 use conduit::geom::Point3;
 use conduit_gcode::{Firmware, Move, moves};
 
-use crate::support::{conduit, stderr, temp_dir, write_stl, xyz};
+use crate::support::{slice_with_report, temp_dir, write_stl, xyz};
 
 /// Side of one cell of the plate's grid, mm.
 const CELL: f64 = 4.0;
@@ -69,19 +69,10 @@ fn plate_triangles() -> Vec<[Point3; 3]> {
 fn slice_plate(dir: &Path, extra: &[&str]) -> Vec<Move> {
     let model = dir.join("plate.stl");
     write_stl(&model, &plate_triangles());
-    let out = dir.join("plate.gcode");
-    let mut args = vec![
-        "slice".to_owned(),
-        model.display().to_string(),
-        "-q".to_owned(),
-        "-o".to_owned(),
-        out.display().to_string(),
-    ];
-    args.extend(extra.iter().map(|s| (*s).to_owned()));
-    let o = conduit(&args);
-    assert!(o.status.success(), "slicing failed: {}", stderr(&o));
-    let text = std::fs::read(&out).expect("G-code written");
-    let g = conduit_gcode::parse(&text).expect("G-code parses");
+    let mut args = vec!["-q"];
+    args.extend_from_slice(extra);
+    let (text, _) = slice_with_report(dir, &model, &args);
+    let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
     moves(&g, Firmware::Marlin).moves
 }
 

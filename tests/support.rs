@@ -102,6 +102,31 @@ pub fn stl_triangles(path: &Path) -> Vec<[[f32; 3]; 3]> {
     conduit_stl::read(&bytes).expect("STL parses").triangles
 }
 
+/// `conduit slice MODEL -o DIR/out.gcode --report DIR/out.json EXTRA…`, which must succeed:
+/// the G-code's text and where the first object's bounding box starts on the bed (X, Y, Z).
+pub fn slice_with_report(dir: &Path, model: &Path, extra: &[&str]) -> (String, [f64; 3]) {
+    let (gcode, report) = (dir.join("out.gcode"), dir.join("out.json"));
+    let mut args = vec![
+        "slice".to_owned(),
+        model.display().to_string(),
+        "-o".into(),
+        gcode.display().to_string(),
+        "--report".into(),
+        report.display().to_string(),
+    ];
+    args.extend(extra.iter().map(|s| (*s).to_owned()));
+    let o = conduit(&args);
+    assert!(o.status.success(), "slicing failed: {}", stderr(&o));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let min = &r["objects"][0]["bbox"]["min"];
+    let at = |i: usize| min[i].as_f64().expect("bbox");
+    (
+        std::fs::read_to_string(&gcode).expect("G-code"),
+        [at(0), at(1), at(2)],
+    )
+}
+
 /// Writes `tris` as a binary STL with their facet normals.
 pub fn write_stl(path: &Path, tris: &[[conduit::geom::Point3; 3]]) {
     let mut b = vec![0u8; 80];

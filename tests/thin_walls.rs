@@ -15,7 +15,7 @@ use conduit::slice::{SliceParams, slice_mesh};
 use conduit_gcode::{Firmware, moves};
 use serde_json::Value;
 
-use crate::support::{conduit, corpus, root, stderr, temp_dir, write_stl};
+use crate::support::{conduit, corpus, root, slice_with_report, stderr, temp_dir, write_stl};
 
 /// Wall thicknesses of the probe, mm.
 const WALLS: [f64; 10] = [0.25, 0.3, 0.45, 0.6, 0.7, 0.8, 0.9, 1.0, 1.2, 1.5];
@@ -63,26 +63,8 @@ fn prism(outline: &[[f64; 2]], h: f64) -> Vec<[Point3; 3]> {
 /// Slices `stl` with `extra` arguments; the G-code text and where the model's origin landed on
 /// the bed (the report's bounding box minus `model_min`).
 fn slice(dir: &Path, stl: &Path, model_min: [f64; 2], extra: &[&str]) -> (String, [f64; 2]) {
-    let (gcode, report) = (dir.join("out.gcode"), dir.join("out.json"));
-    let mut args = vec![
-        "slice".to_owned(),
-        stl.display().to_string(),
-        "-o".into(),
-        gcode.display().to_string(),
-        "--report".into(),
-        report.display().to_string(),
-    ];
-    args.extend(extra.iter().map(|s| (*s).to_owned()));
-    let o = conduit(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let r: Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
-    let min = &r["objects"][0]["bbox"]["min"];
-    let at = |i: usize| min[i].as_f64().expect("bbox") - model_min[i];
-    (
-        std::fs::read_to_string(&gcode).expect("G-code"),
-        [at(0), at(1)],
-    )
+    let (text, min) = slice_with_report(dir, stl, extra);
+    (text, [min[0] - model_min[0], min[1] - model_min[1]])
 }
 
 /// The fraction of the segment `a`–`b` inside the box `[x0, y0, x1, y1]` (Liang–Barsky).
