@@ -71,7 +71,7 @@ pub use crate::program::machine::{
 };
 use crate::region::{
     BrimParams, BrimType, InfillPatternKind, MIN_LAYER_HEIGHT, NOZZLE_RANGE, PerimeterGenerator,
-    RegionParams, SupportParams, SupportPattern,
+    RegionParams, SupportParams,
 };
 use crate::toolpaths::{OrderParams, ProgramParams, RoleSpeeds, SeamRule, ToolPathParams};
 
@@ -111,79 +111,7 @@ pub struct Config {
     /// Gap compensation of robot paths (`[compensate]`).
     pub compensate: CompensateSettings,
     /// Support material, when `slice.support_material` is on (`[support]`).
-    pub support: SupportSettings,
-}
-
-/// How support material is built (`[support]`), when `slice.support_material` is on: columns
-/// of lines under every overhang steeper than `threshold_angle`, topped by dense interface
-/// layers, `z_gap` below the part and `xy_gap` beside it. Lengths in mm.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(default, deny_unknown_fields)]
-pub struct SupportSettings {
-    /// Overhangs leaning out further than this from the vertical are supported, degrees, 0 to
-    /// 89. Default 45, the angle `conduit check` holds every print to. PrusaSlicer's
-    /// `support_material_threshold` counts from the horizontal: 55 there is 35 here.
-    pub threshold_angle: f64,
-    /// Vertical gap between the support's top and the part (and between a top surface of the
-    /// part and the support standing on it), rounded up to whole layers: what lets the support
-    /// break away. 0 to 5; 0 only for soluble support. Default 0.2.
-    pub z_gap: f64,
-    /// Horizontal gap between the support's beads and the part's walls, 0 to 20. Default 0.3.
-    pub xy_gap: f64,
-    /// Dense layers at the top of each column, 0 to 100. Default 3.
-    pub interface_layers: usize,
-    /// Gap between neighbouring lines of the columns' base, 0 to 50. Default 2.5.
-    pub spacing: f64,
-    /// Gap between neighbouring interface lines, 0 to 50. Default 0.2.
-    pub interface_spacing: f64,
-    /// Base pattern: `"rectilinear"` (default; parallel lines joined into zig-zags, the easiest
-    /// to remove) or `"grid"` (both directions on every layer, stiffer for tall columns).
-    pub pattern: SupportPattern,
-    /// Direction of the base lines, degrees counter-clockwise from +X; the interface runs at
-    /// 90° to it. Default 0.
-    pub angle: f64,
-    /// Only build support that stands on the bed, never on the part. Default false.
-    pub buildplate_only: bool,
-    /// A loop around each piece of the columns' base: it holds the base lines' ends and the
-    /// interface above (stiffer, a little harder to remove). Default true.
-    pub sheath: bool,
-}
-
-impl Default for SupportSettings {
-    fn default() -> Self {
-        let p = SupportParams::default();
-        Self {
-            threshold_angle: p.threshold_angle_deg,
-            z_gap: p.z_gap,
-            xy_gap: p.xy_gap,
-            interface_layers: p.interface_layers,
-            spacing: p.spacing,
-            interface_spacing: p.interface_spacing,
-            pattern: p.pattern,
-            angle: p.angle_deg,
-            buildplate_only: p.buildplate_only,
-            sheath: p.sheath,
-        }
-    }
-}
-
-impl SupportSettings {
-    /// The regions stage's support parameters, built when `enabled`.
-    pub fn params(&self, enabled: bool) -> SupportParams {
-        SupportParams {
-            enabled,
-            threshold_angle_deg: self.threshold_angle,
-            z_gap: self.z_gap,
-            xy_gap: self.xy_gap,
-            interface_layers: self.interface_layers,
-            spacing: self.spacing,
-            interface_spacing: self.interface_spacing,
-            pattern: self.pattern,
-            angle_deg: self.angle,
-            buildplate_only: self.buildplate_only,
-            sheath: self.sheath,
-        }
-    }
+    pub support: SupportParams,
 }
 
 /// Pattern of solid (top and bottom) infill.
@@ -416,7 +344,7 @@ impl Default for Config {
             jet: JetSettings::default(),
             robot: RobotSettings::default(),
             compensate: CompensateSettings::default(),
-            support: SupportSettings::default(),
+            support: SupportParams::default(),
         }
     }
 }
@@ -830,7 +758,7 @@ impl Config {
                 ));
             }
         }
-        problems.extend(self.support.params(true).problems());
+        problems.extend(self.support.problems());
         for (key, v) in [
             ("printer.bed_temperature", p.bed_temperature),
             (
@@ -966,7 +894,10 @@ impl Config {
                         kind: s.brim_type,
                         ..BrimParams::default()
                     },
-                    support: self.support.params(s.support_material),
+                    support: SupportParams {
+                        enabled: s.support_material,
+                        ..self.support.clone()
+                    },
                 }
             };
         }

@@ -71,33 +71,42 @@ pub enum SupportPattern {
     Grid,
 }
 
-/// What support to build. Lengths in millimetres.
-#[derive(Debug, Clone, PartialEq)]
+/// How support material is built (`[support]` in the config, whose keys these are), when
+/// `slice.support_material` is on: columns of lines under every overhang steeper than
+/// `threshold_angle`, topped by dense interface layers, `z_gap` below the part and `xy_gap`
+/// beside it. Lengths in mm.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
 pub struct SupportParams {
-    /// Build support at all.
+    /// Build support at all: `slice.support_material`, not a key of `[support]`.
+    #[serde(skip)]
     pub enabled: bool,
-    /// Overhangs leaning out further than this from the vertical, degrees, are supported.
-    pub threshold_angle_deg: f64,
-    /// Vertical gap between the support's top and the part above it (and between a part's top
-    /// surface and the support standing on it), rounded up to whole layers; 0 for soluble
-    /// support.
+    /// Overhangs leaning out further than this from the vertical are supported, degrees, 0 to
+    /// 89. Default 45, the angle `conduit check` holds every print to. PrusaSlicer's
+    /// `support_material_threshold` counts from the horizontal: 55 there is 35 here.
+    pub threshold_angle: f64,
+    /// Vertical gap between the support's top and the part (and between a top surface of the
+    /// part and the support standing on it), rounded up to whole layers: what lets the support
+    /// break away. 0 to 5; 0 only for soluble support. Default 0.2.
     pub z_gap: f64,
-    /// Horizontal gap between the support's beads and the part's walls.
+    /// Horizontal gap between the support's beads and the part's walls, 0 to 20. Default 0.3.
     pub xy_gap: f64,
-    /// Dense layers at the top of each column.
+    /// Dense layers at the top of each column, 0 to 100. Default 3.
     pub interface_layers: usize,
-    /// Gap between neighbouring base lines (PrusaSlicer's `support_material_spacing`).
+    /// Gap between neighbouring lines of the columns' base, 0 to 50. Default 2.5.
     pub spacing: f64,
-    /// Gap between neighbouring interface lines (`support_material_interface_spacing`).
+    /// Gap between neighbouring interface lines, 0 to 50. Default 0.2.
     pub interface_spacing: f64,
-    /// How the base is filled.
+    /// Base pattern: `"rectilinear"` (default; parallel lines joined into zig-zags, the easiest
+    /// to remove) or `"grid"` (both directions on every layer, stiffer for tall columns).
     pub pattern: SupportPattern,
-    /// Direction of the base lines, degrees counter-clockwise from +X.
-    pub angle_deg: f64,
-    /// Only support what stands on the bed, never on the part.
+    /// Direction of the base lines, degrees counter-clockwise from +X; the interface runs at
+    /// 90° to it. Default 0.
+    pub angle: f64,
+    /// Only build support that stands on the bed, never on the part. Default false.
     pub buildplate_only: bool,
-    /// A loop around each piece of the base (PrusaSlicer's `support_material_with_sheath`):
-    /// it holds the base lines' ends and the zig-zag turns, and the interface above.
+    /// A loop around each piece of the columns' base: it holds the base lines' ends and the
+    /// interface above (stiffer, a little harder to remove). Default true.
     pub sheath: bool,
 }
 
@@ -106,14 +115,14 @@ impl Default for SupportParams {
     fn default() -> Self {
         Self {
             enabled: false,
-            threshold_angle_deg: 45.0,
+            threshold_angle: 45.0,
             z_gap: 0.2,
             xy_gap: 0.3,
             interface_layers: 3,
             spacing: 2.5,
             interface_spacing: 0.2,
             pattern: SupportPattern::Rectilinear,
-            angle_deg: 0.0,
+            angle: 0.0,
             buildplate_only: false,
             sheath: true,
         }
@@ -129,7 +138,7 @@ impl SupportParams {
                 out.push(what);
             }
         };
-        let t = self.threshold_angle_deg;
+        let t = self.threshold_angle;
         need(
             t.is_finite() && (0.0..=MAX_THRESHOLD_DEG).contains(&t),
             format!("support.threshold_angle must be between 0 and {MAX_THRESHOLD_DEG}°, got {t}"),
@@ -146,8 +155,8 @@ impl SupportParams {
             );
         }
         need(
-            self.angle_deg.is_finite(),
-            format!("support.angle must be finite, got {}", self.angle_deg),
+            self.angle.is_finite(),
+            format!("support.angle must be finite, got {}", self.angle),
         );
         need(
             self.interface_layers <= 100,
@@ -209,7 +218,7 @@ pub fn make_supports(
             Some(*z)
         })
         .collect();
-    let tan = params.threshold_angle_deg.to_radians().tan();
+    let tan = params.threshold_angle.to_radians().tan();
     let round = Join::Round(Tolerances::default().curve_flattening.mm());
     // 1. Overhangs, each layer against the one below; the contact is the whole step out over
     // the layer below where an overhang is, so the bands of a slope join into one wedge.
@@ -335,9 +344,9 @@ pub fn make_supports(
                 spacing_mm,
                 phase: 0.5,
             };
-            let mut families = vec![family(params.angle_deg, base_gap)];
+            let mut families = vec![family(params.angle, base_gap)];
             if params.pattern == SupportPattern::Grid && j > 0 {
-                families.push(family(params.angle_deg + 90.0, base_gap));
+                families.push(family(params.angle + 90.0, base_gap));
             }
             // The sheath runs along the base's edge; the lines stop half a spacing inside it.
             let (sheath, lines_area) = if params.sheath && !base_area.is_empty() {
@@ -352,7 +361,7 @@ pub fn make_supports(
                 (Vec::new(), base_area.clone())
             };
             let base = fill_pieces(&lines_area, &families);
-            let interface = fill_pieces(&interface_area, &[family(params.angle_deg + 90.0, dense)]);
+            let interface = fill_pieces(&interface_area, &[family(params.angle + 90.0, dense)]);
             SupportLayer {
                 area,
                 sheath,
@@ -552,7 +561,7 @@ mod tests {
                 .all(SupportLayer::is_empty)
         );
         let bad = on(SupportParams {
-            threshold_angle_deg: 95.0,
+            threshold_angle: 95.0,
             z_gap: -1.0,
             ..Default::default()
         });
