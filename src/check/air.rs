@@ -32,6 +32,7 @@
 //! (curved layers, conformal paths) is not checked, since its layers are not stacked planes.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use conduit_gcode::{Move, Moves};
 
@@ -218,6 +219,16 @@ struct Path {
     filament: bool,
     /// (G-code line, segment) in print order.
     segments: Vec<(usize, Segment)>,
+    /// The feature role of each move, by G-code line, in line order.
+    roles: Vec<(usize, Option<Arc<str>>)>,
+}
+
+impl Path {
+    /// The feature role of the move at `line`.
+    fn role_at(&self, line: usize) -> Option<&str> {
+        let i = self.roles.binary_search_by_key(&line, |(l, _)| *l).ok()?;
+        self.roles[i].1.as_deref()
+    }
 }
 
 /// Whether any extruding move changes Z (a non-planar file).
@@ -237,12 +248,6 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
     // Per layer: its paths (runs of consecutive extruding moves), each a list of (line, segment).
     let n = moves.layer_z.len();
     let mut paths: Vec<Vec<Path>> = vec![Vec::new(); n];
-    let role_of_line: HashMap<usize, Option<String>> = moves
-        .moves
-        .iter()
-        .filter(|m| m.extruding)
-        .map(|m| (m.line, m.role.as_deref().map(str::to_owned)))
-        .collect();
     let mut open = false;
     for m in &moves.moves {
         match planar_segments(m, params) {
@@ -251,13 +256,14 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
                 if !same {
                     paths[layer].push(Path {
                         filament,
-                        segments: Vec::new(),
+                        ..Path::default()
                     });
                     open = true;
                 }
                 if let Some(path) = paths[layer].last_mut() {
                     path.segments
                         .extend(segments.into_iter().map(|s| (m.line, s)));
+                    path.roles.push((m.line, m.role.clone()));
                 }
             }
             _ => {
@@ -320,11 +326,8 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
                 }
                 continue;
             }
-            let path = &path.segments;
-            let bridge_role = path.first().is_some_and(|(line, _)| {
-                role_of_line
-                    .get(line)
-                    .and_then(Option::as_deref)
+            let bridge_role = path.segments.first().is_some_and(|(line, _)| {
+                path.role_at(*line)
                     .is_some_and(|r| r.to_ascii_lowercase().contains("bridge"))
             });
             let anchored = |p: [f64; 2]| {
@@ -336,8 +339,8 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
                                 .is_some_and(|ix| ix.near(p, GAP_SIDE_MM))
                         }))
             };
-            let runs = unheld_runs(path, &held, &anchored);
-            for (_, s) in path {
+            let runs = unheld_runs(&path.segments, &held, &anchored);
+            for (_, s) in &path.segments {
                 printed.add(*s, GAP_SIDE_MM);
             }
             for (line, at, length) in runs {
@@ -346,7 +349,7 @@ pub fn air_layers(moves: &Moves, params: &CheckParams) -> Vec<AirLayer> {
                     length: 0.0,
                     line,
                     at,
-                    role: role_of_line.get(&line).cloned().flatten(),
+                    role: path.role_at(line).map(str::to_owned),
                 });
                 entry.length += length;
             }
