@@ -80,6 +80,21 @@ impl Brim {
     pub fn is_empty(&self) -> bool {
         self.loops.is_empty() && self.ears.is_empty()
     }
+
+    /// Every bead's centreline as a polyline: the ears, then the loops closed on themselves.
+    pub fn lines(&self) -> Vec<Polyline> {
+        let mut lines = self.ears.clone();
+        lines.extend(self.loops.iter().filter_map(closed_polyline));
+        lines
+    }
+}
+
+/// `p` as a polyline that ends where it starts; `None` for a polygon without points.
+fn closed_polyline(p: &Polygon) -> Option<Polyline> {
+    let first = *p.points.first()?;
+    let mut points = p.points.clone();
+    points.push(first);
+    Some(Polyline { points })
 }
 
 /// The brim around `first_layer` (see the module docs) for beads `line_width` wide laid
@@ -122,15 +137,7 @@ pub fn make_brim(
             .collect();
         if params.kind == BrimType::Ears {
             let discs = ear_discs(first_layer, params, join);
-            let closed: Vec<Polyline> = outer
-                .iter()
-                .filter_map(|p| {
-                    let first = *p.points.first()?;
-                    let mut points = p.points.clone();
-                    points.push(first);
-                    Some(Polyline { points })
-                })
-                .collect();
+            let closed: Vec<Polyline> = outer.iter().filter_map(closed_polyline).collect();
             if !discs.is_empty() {
                 brim.ears = clip_polylines(&closed, &discs);
             }

@@ -246,15 +246,8 @@ fn printed_area(brim: &Brim, support: &SupportLayer, width: f64) -> Vec<ExPolygo
     if brim.is_empty() && support.area.is_empty() {
         return Vec::new();
     }
-    let mut lines: Vec<Polyline> = brim.ears.clone();
-    lines.extend(brim.loops.iter().filter_map(|p| {
-        let first = *p.points.first()?;
-        let mut points = p.points.clone();
-        points.push(first);
-        Some(Polyline { points })
-    }));
     let join = Join::Round(Tolerances::default().curve_flattening.mm());
-    let mut area = stroke(&lines, width, join, Cap::Round(0.01));
+    let mut area = stroke(&brim.lines(), width, join, Cap::Round(0.01));
     area.extend(offset(&support.area, width / 2.0, join));
     area
 }
