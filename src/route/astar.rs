@@ -303,6 +303,12 @@ impl Search {
         search
     }
 
+    /// Gives up on routes costing more than `cap` too (a search confined to a window whose
+    /// routes are only answers below what leaving it would cost).
+    pub(crate) fn cap_cost(&mut self, cap: f64) {
+        self.cost_limit = self.cost_limit.min(cap);
+    }
+
     /// Where the search stands.
     pub fn state(&self) -> SearchState {
         self.state
