@@ -192,7 +192,13 @@ fn check_design(
     for (k, p) in placed.iter().enumerate() {
         let l = p.length();
         length += l;
-        points += (l / step).ceil().max(1.0) + 1.0;
+        // As `design::discretise` cuts it: every segment in ⌈l/step⌉ parts.
+        let parts: f64 = p
+            .points
+            .windows(2)
+            .map(|w| ((w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / step).ceil())
+            .sum();
+        points += parts.max(1.0) + 1.0;
         if points > MAX_DESIGN_POINTS as f64 {
             // The rest is summed for the message only.
             let rest: f64 = placed[k + 1..].iter().map(design::PlanarPath::length).sum();
@@ -294,6 +300,9 @@ pub struct Planned {
     pub paths: Vec<Vec<Point3>>,
     /// The report (registration and replay are filled in by the caller).
     pub report: ConformReport,
+    /// The vertices of the design on the surface seen from above ([`correct::corners`]): where
+    /// the printed path must pass, for the report's accuracy.
+    pub corners: Vec<[f64; 2]>,
 }
 
 /// Tip paths of `t` (zero-standoff paths with their local geometry) under `mode`.
@@ -456,7 +465,11 @@ pub fn plan(
         deposit: deposit::deposit(surface, &paths, &params.nozzle, &params.thresholds),
         comparison,
     });
-    Ok(Planned { paths, report })
+    Ok(Planned {
+        paths,
+        report,
+        corners: correct::corners(&on.projected.paths),
+    })
 }
 
 /// The planned paths as a one-layer Program for `cfg`'s writer: conductive traces of tool
