@@ -260,16 +260,19 @@ fn printed_path(track: &Track, placed: &[Placed]) -> Vec<Point3> {
     out.into_iter().map(|p| p.tip).collect()
 }
 
-/// The vertices of the zero-standoff paths `t` seen from above where they turn (path ends
-/// left out), xy in mm: where the printed path must pass.
-pub fn corners(t: &[Vec<Point3>]) -> Vec<[f64; 2]> {
+/// The vertices of the zero-standoff paths `t` seen from above where they turn, xy in mm:
+/// where the printed path must pass. Path ends are left out, and so are the vertices within
+/// `skip` mm (along the path) of its start, where a shift along the path starts the first tip.
+pub fn corners(t: &[Vec<Point3>], skip: f64) -> Vec<[f64; 2]> {
     t.iter()
         .flat_map(|p| {
             let track = Track::new(p);
             track
                 .vertex_index
                 .iter()
-                .filter_map(|&k| track.points.get(k).copied())
+                .zip(&track.vertex_s)
+                .filter(|&(_, &s)| s > skip)
+                .filter_map(|(&k, _)| track.points.get(k).copied())
                 .collect::<Vec<_>>()
         })
         .collect()
@@ -315,8 +318,14 @@ impl Track {
         let mut next = acc;
         for i in (0..n).rev() {
             if i > 0 && i + 1 < n {
-                let a = [points[i][0] - points[i - 1][0], points[i][1] - points[i - 1][1]];
-                let b = [points[i + 1][0] - points[i][0], points[i + 1][1] - points[i][1]];
+                let a = [
+                    points[i][0] - points[i - 1][0],
+                    points[i][1] - points[i - 1][1],
+                ];
+                let b = [
+                    points[i + 1][0] - points[i][0],
+                    points[i + 1][1] - points[i][1],
+                ];
                 let turn = (a[0] * b[1] - a[1] * b[0])
                     .atan2(a[0] * b[0] + a[1] * b[1])
                     .abs();
@@ -371,7 +380,10 @@ impl Track {
     /// The point at arc length `sigma` (within the path), z = 0.
     fn at(&self, sigma: f64) -> Vector3 {
         let n = self.points.len();
-        let k = self.s.partition_point(|&x| x <= sigma).clamp(1, n.max(2) - 1);
+        let k = self
+            .s
+            .partition_point(|&x| x <= sigma)
+            .clamp(1, n.max(2) - 1);
         let (Some(p), Some(q)) = (self.points.get(k - 1), self.points.get(k)) else {
             return self
                 .points
@@ -813,7 +825,11 @@ mod tests {
         );
         // Seen from above, the printed path is the design less the first shift (d_o/2).
         let len = |p: &[Point3]| p.windows(2).map(|w| (w[1] - w[0]).xy().norm()).sum::<f64>();
-        assert!((len(&t) - len(&printed) - 0.25).abs() < 1e-9, "{}", len(&printed));
+        assert!(
+            (len(&t) - len(&printed) - 0.25).abs() < 1e-9,
+            "{}",
+            len(&printed)
+        );
         assert!((printed[0].x - 0.25).abs() < 1e-12, "{}", printed[0]);
     }
 

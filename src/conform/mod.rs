@@ -13,10 +13,13 @@
 //! 6. [`correct`]: standoff, tip-disk contact escape, shift along the travel (the tip placed
 //!    on the deposit model, or the published method's curvature-scaled downhill formula); then
 //!    a clearance pass with the whole nozzle ([`nozzle`]: its bore and its tool solid, checked
-//!    against the surface by [`crate::surface::contact`]) lifts what still touches.
+//!    against the surface by [`crate::surface::contact`], exactly per triangle) lifts what
+//!    still touches. Every shift runs along the path, never past a corner nor backwards.
 //! 7. [`deposit`]: expected deposit thickness and its errors, for every corrections mode.
 //! 8. [`report`]: the JSON report; [`replay`] re-checks the written G-code for contacts (the
-//!    replay walk of [`crate::surface::replay`] with the surface as obstacle).
+//!    replay walk of [`crate::surface::replay`] with the surface as obstacle, `G28` homing to
+//!    the printer's home) and measures its accuracy: the tip above the surface, the printed
+//!    length against the design's on the surface, the corners' deviation.
 //!
 //! Robot and five-axis work builds on the same stages: [`orient`] sets a tool axis per point
 //! (surface normal, vertical or fixed) for the robot emitters in [`crate::emit::robot`];
@@ -293,6 +296,13 @@ impl ConformParams {
     }
 }
 
+/// How far along a path its first tip may start ahead of the design (the largest shift of the
+/// corrections: d_o/2 + d, the published method's most), mm: the corners of the accuracy report
+/// are counted from there.
+pub fn corner_skip(params: &ConformParams) -> f64 {
+    params.nozzle.tip_radius() + params.nozzle.inner
+}
+
 /// The planned paths of a run.
 #[derive(Debug, Clone)]
 pub struct Planned {
@@ -468,7 +478,7 @@ pub fn plan(
     Ok(Planned {
         paths,
         report,
-        corners: correct::corners(&on.projected.paths),
+        corners: correct::corners(&on.projected.paths, corner_skip(params)),
     })
 }
 

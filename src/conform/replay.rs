@@ -155,7 +155,9 @@ pub struct Accuracy {
     pub surface_length: f64,
     /// `printed_length / surface_length`.
     pub length_ratio: f64,
-    /// Corners of the design (vertices where it turns, path ends left out) over the surface.
+    /// Corners of the design on the surface (vertices where it turns; path ends, and the
+    /// stretch of d_o/2 + d at each path's start where the first tip may start ahead, left
+    /// out).
     pub corners: usize,
     /// Largest distance, seen from above, from a corner to the dispensing moves, mm.
     pub corner_deviation_max: f64,

@@ -153,7 +153,7 @@ pub fn max_over_cone(p: [[f64; 2]; 3], vals: [f64; 3], r0: f64, r1: f64, k: f64)
     let mut best = f64::NEG_INFINITY;
     let within = |q: [f64; 2]| {
         let d = dot(q, q).sqrt();
-        (d >= r0 && d <= r1).then_some(d)
+        (r0..=r1).contains(&d).then_some(d)
     };
     for (i, q) in p.iter().enumerate() {
         if let Some(d) = within(*q) {
@@ -195,7 +195,10 @@ pub fn max_over_cone(p: [[f64; 2]; 3], vals: [f64; 3], r0: f64, r1: f64, k: f64)
         // Level: the inner circle is as high as the annulus gets, anywhere on it; a point of
         // it in the triangle, if any, is a corner or a crossing already — or the whole
         // triangle holds the circle, and its centre then lies inside too.
-        if let Some(v) = f.inside([r0, 0.0]).filter(|_| f.inside([0.0, 0.0]).is_some()) {
+        if let Some(v) = f
+            .inside([r0, 0.0])
+            .filter(|_| f.inside([0.0, 0.0]).is_some())
+        {
             best = best.max(v - k * r0);
         }
     }
@@ -364,13 +367,21 @@ mod tests {
         let mut met = 0;
         for _ in 0..300 {
             let p = [0; 3].map(|_| [rng.range(-0.6, 0.6), rng.range(-0.6, 0.6)]);
-            let (a, b, c) = (rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            let (a, b, c) = (
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            );
             let vals = p.map(|q| a * q[0] + b * q[1] + c);
             let exact = max_over_disc(p, vals, r);
             let dense = disc
                 .iter()
                 .copied()
-                .chain(triangle_points(p).into_iter().filter(|q| dot(*q, *q) <= r * r))
+                .chain(
+                    triangle_points(p)
+                        .into_iter()
+                        .filter(|q| dot(*q, *q) <= r * r),
+                )
                 .filter_map(|q| value_at(p, vals, q))
                 .fold(None, |b: Option<f64>, v| Some(b.map_or(v, |b| b.max(v))));
             match (exact, dense) {
@@ -394,8 +405,12 @@ mod tests {
         let mut rng = Rng(7);
         for _ in 0..4 {
             let n = 30;
-            let h: Vec<f64> = (0..(n + 1) * (n + 1)).map(|_| rng.range(0.0, 0.1)).collect();
-            let p = |i: usize, j: usize| Point3::new(0.2 * i as f64, 0.2 * j as f64, h[j * (n + 1) + i]);
+            let h: Vec<f64> = (0..(n + 1) * (n + 1))
+                .map(|_| rng.range(0.0, 0.1))
+                .collect();
+            let p = |i: usize, j: usize| {
+                Point3::new(0.2 * i as f64, 0.2 * j as f64, h[j * (n + 1) + i])
+            };
             let mut tris = Vec::new();
             for j in 0..n {
                 for i in 0..n {
@@ -445,7 +460,11 @@ mod tests {
         // sampled densely (the triangle to catch slivers).
         for _ in 0..200 {
             let p = [0; 3].map(|_| [rng.range(-2.0, 2.0), rng.range(-2.0, 2.0)]);
-            let (a, b, c) = (rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            let (a, b, c) = (
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            );
             let vals = p.map(|q| a * q[0] + b * q[1] + c);
             let k = rng.range(0.0, 3.0);
             let exact = max_over_cone(p, vals, r0, r1, k);

@@ -291,7 +291,10 @@ mod tests {
         let n = 320;
         let mut t = Vec::new();
         for i in 0..n {
-            let (a0, a1) = (-8.0 + 16.0 * i as f64 / n as f64, -8.0 + 16.0 * (i + 1) as f64 / n as f64);
+            let (a0, a1) = (
+                -8.0 + 16.0 * i as f64 / n as f64,
+                -8.0 + 16.0 * (i + 1) as f64 / n as f64,
+            );
             t.push([at(a0, -8.0), at(a1, -8.0), at(a1, 8.0)]);
             t.push([at(a0, -8.0), at(a1, 8.0), at(a0, 8.0)]);
         }

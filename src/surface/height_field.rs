@@ -207,7 +207,11 @@ impl HeightField {
         let mut out = Vec::new();
         for cy in cy0..=cy1 {
             for cx in cx0..=cx1 {
-                out.extend(self.cells[cy * self.dims[0] + cx].iter().map(|&i| i as usize));
+                out.extend(
+                    self.cells[cy * self.dims[0] + cx]
+                        .iter()
+                        .map(|&i| i as usize),
+                );
             }
         }
         out.sort_unstable();

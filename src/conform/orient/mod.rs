@@ -331,7 +331,7 @@ pub fn plan(
         axes,
         report,
         orientation,
-        corners: super::correct::corners(&projected.paths),
+        corners: super::correct::corners(&projected.paths, super::corner_skip(params)),
     })
 }
 
