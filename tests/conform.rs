@@ -342,8 +342,8 @@ fn run_method(name: String, s: &Surface, design: &Design) -> Run {
         Ok(x) => x,
         Err(e) => panic!("{name}: {e}"),
     };
-    let (_, replay) = match write_and_replay(&planned.paths, &cfg, s, &p) {
-        Ok(x) => x,
+    let replay = match write_and_replay(&planned.paths, &cfg, s, &p) {
+        Ok(x) => x.contacts,
         Err(e) => panic!("{name}: {e}"),
     };
     let r = &planned.report;
@@ -893,4 +893,335 @@ fn the_readme_example_prints_the_monopole_on_the_sample_film() {
     ]);
     assert!(p.status.success(), "{}", stderr(&p));
     assert!(views.join("side_xz.svg").is_file() && views.join("layer_0001.svg").is_file());
+}
+
+/// Issue 25's fold: creases along a direction 11.25° off the y axis (half a step of the old 16
+/// rim samples), flanks of 30°, 47° and 60° in turn, 1 mm high: every crease (V and Λ) far
+/// sharper than the 0.5 mm tip disc.
+fn issue_25_fold() -> Surface {
+    let (sin, cos) = 11.25f64.to_radians().sin_cos();
+    let flanks = [30f64, 47.0, 60.0].map(|a| a.to_radians().tan());
+    let profile = move |a: f64| {
+        // Rise and fall of 1 mm on each flank, the flanks' slopes in turn.
+        let mut x = a.rem_euclid(3.0 * (2.0 / flanks[0] + 2.0 / flanks[1] + 2.0 / flanks[2]));
+        for s in flanks {
+            let half = 1.0 / s;
+            if x < 2.0 * half {
+                return if x < half {
+                    s * x
+                } else {
+                    s * (2.0 * half - x)
+                };
+            }
+            x -= 2.0 * half;
+        }
+        0.0
+    };
+    // The creases fall on the grid's lines: the mesh is cut along them exactly.
+    let mut across: Vec<f64> = vec![];
+    let mut a = -30.0;
+    let period: f64 = flanks.iter().map(|s| 2.0 / s).sum();
+    let start = (a / period).floor() * period;
+    a = start;
+    while a <= 30.0 {
+        for s in flanks {
+            let half = 1.0 / s;
+            for k in 0..8 {
+                across.push(a + 2.0 * half * k as f64 / 8.0);
+            }
+            a += 2.0 * half;
+        }
+    }
+    let along: Vec<f64> = (0..=60).map(|k| -30.0 + k as f64).collect();
+    let at = |u: f64, v: f64| {
+        // u across the creases, v along them.
+        Point3::new(
+            100.0 + u * cos - v * sin,
+            100.0 + u * sin + v * cos,
+            1.0 + profile(u - start),
+        )
+    };
+    let mut t = Vec::new();
+    for w in across.windows(2) {
+        for v in along.windows(2) {
+            t.push([at(w[0], v[0]), at(w[1], v[0]), at(w[1], v[1])]);
+            t.push([at(w[0], v[0]), at(w[1], v[1]), at(w[0], v[1])]);
+        }
+    }
+    surface(t)
+}
+
+/// The highest the surface reaches over the disc of radius `r` about (x, y) by dense sampling:
+/// `rings` rings of `angles` points and the centre, then four rounds of a 21 × 21 grid ten
+/// times finer around the best sample so far (inside the disc): a ridge under the disc is
+/// found to a fraction of a micrometre, as a rim contact is by the rings.
+fn dense_disc_max(s: &Surface, x: f64, y: f64, r: f64, rings: usize, angles: usize) -> f64 {
+    let mut best = (s.height(x, y).unwrap_or(f64::MIN), [x, y]);
+    let mut take = |q: [f64; 2], best: &mut (f64, [f64; 2])| {
+        if (q[0] - x).hypot(q[1] - y) <= r
+            && let Some(h) = s.height(q[0], q[1])
+            && h > best.0
+        {
+            *best = (h, q);
+        }
+    };
+    for i in 1..=rings {
+        let rr = r * i as f64 / rings as f64;
+        for k in 0..angles {
+            let t = std::f64::consts::TAU * k as f64 / angles as f64;
+            take([x + rr * t.cos(), y + rr * t.sin()], &mut best);
+        }
+    }
+    let mut step = r / rings as f64;
+    for _ in 0..4 {
+        step /= 10.0;
+        let c = best.1;
+        for i in -10..=10 {
+            for j in -10..=10 {
+                take([c[0] + step * i as f64, c[1] + step * j as f64], &mut best);
+            }
+        }
+    }
+    best.0
+}
+
+/// The tip disc's clearance as the check sampled it before the exact query: the centre and 4
+/// rings of 16 points (0.1 mm apart on the rim of a 0.5 mm disc).
+fn sampled_clearance(s: &Surface, q: &Point3, r: f64) -> f64 {
+    let mut best = s.height(q.x, q.y).unwrap_or(f64::MIN);
+    for ring in 1..=4 {
+        let rr = r * ring as f64 / 4.0;
+        for k in 0..16 {
+            let t = std::f64::consts::TAU * k as f64 / 16.0;
+            if let Some(h) = s.height(q.x + rr * t.cos(), q.y + rr * t.sin()) {
+                best = best.max(h);
+            }
+        }
+    }
+    q.z - best
+}
+
+/// The dispensing moves of a written conform G-code, as the replay reads them.
+fn printed_moves(written: &conduit::pipeline::conform::Written) -> Vec<[Point3; 2]> {
+    let m = &written.machine;
+    let machine = conduit::check::Machine::new(m.flavor, 25.0).with_home(m.home);
+    conduit::check::moves_on(&written.parsed, machine)
+        .moves
+        .iter()
+        .filter(|mv| m.body.contains(&mv.line) && mv.feed <= m.print_feed + 1e-9)
+        .filter_map(|mv| {
+            let p = |q: &[Option<f64>; 3]| Some(Point3::new(q[0]?, q[1]?, q[2]?));
+            Some([p(&mv.from)?, p(&mv.to)?])
+        })
+        .collect()
+}
+
+#[test]
+fn issue_25_the_fold_is_printed_without_contact_by_the_exact_query_and_dense_sampling_agrees() {
+    let s = issue_25_fold();
+    let p = params(Corrections::default(), Mapping::Projection);
+    let cfg = Config::default();
+    // Lines across the creases and along them, and a zigzag.
+    let d = design(vec![
+        vec![[-15.0, 0.0], [15.0, 0.0]],
+        vec![[-15.0, 3.0], [15.0, 9.0]],
+        vec![[0.0, -15.0], [0.0, 15.0]],
+        vec![
+            [-10.0, -10.0],
+            [-5.0, -5.0],
+            [0.0, -10.0],
+            [5.0, -5.0],
+            [10.0, -10.0],
+        ],
+    ]);
+    let planned = match plan(&s, &d, &at(100.0, 100.0), &p, |_| {}) {
+        Ok(x) => x,
+        Err(e) => panic!("{e}"),
+    };
+    let written = match write_and_replay(&planned.paths, &cfg, &s, &p) {
+        Ok(x) => x,
+        Err(e) => panic!("{e}"),
+    };
+    let replay = &written.contacts;
+    assert_eq!(
+        (replay.printing, replay.travel, replay.custom),
+        (0, 0, 0),
+        "{replay:?}"
+    );
+    // Every dispensing sample's tip clearance by the exact query; the 40 tightest checked
+    // against 100 rings × 400 angles (40 001 points) of the disc.
+    let nozzle = &p.nozzle;
+    let r = nozzle.tip_radius();
+    let mut samples: Vec<(f64, Point3)> = printed_moves(&written)
+        .iter()
+        .flat_map(|m| {
+            let n = (((m[1] - m[0]).norm() / (p.nozzle.inner / 4.0)).ceil() as usize).max(1);
+            (0..=n).map(move |k| m[0] + (m[1] - m[0]) * (k as f64 / n as f64))
+        })
+        .filter_map(|q| nozzle.solid.tip_clearance(&s, &q).map(|c| (c, q)))
+        .collect();
+    assert!(samples.len() > 1000, "{}", samples.len());
+    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (lowest, _) = samples[0];
+    assert!(lowest > 0.0, "the tip disc reaches the surface: {lowest}");
+    let mut worst_gap = 0.0f64;
+    for (c, q) in samples.iter().take(40) {
+        let dense = q.z - dense_disc_max(&s, q.x, q.y, r, 100, 400);
+        // Sampling never finds the surface higher than the exact answer, and finds it as high
+        // to a tenth of a micrometre.
+        assert!(dense >= c - 1e-9, "{q}: dense {dense} < exact {c}");
+        worst_gap = worst_gap.max(dense - c);
+    }
+    // What the 65 samples of the old check made of the same tips: clearance seen where the
+    // surface is higher.
+    let overestimate = samples
+        .iter()
+        .map(|(c, q)| sampled_clearance(&s, q, r) - c)
+        .fold(0.0f64, f64::max);
+    let blind = samples
+        .iter()
+        .filter(|(c, q)| sampled_clearance(&s, q, r) - c > 0.003)
+        .count();
+    println!(
+        "fold: {} samples, lowest tip clearance {lowest:.6} mm, largest gap exact vs dense {:.2e} mm; the 65-point samples see up to {:.4} mm more clearance ({blind} samples over 3 µm)",
+        samples.len(),
+        worst_gap,
+        overestimate,
+    );
+    assert!(worst_gap < 1e-4, "{worst_gap}");
+    assert!(overestimate > 0.003, "{overestimate}");
+    let accuracy = conduit::conform::replay::accuracy(
+        &written.parsed,
+        &written.machine,
+        &s,
+        nozzle,
+        &planned.corners,
+        planned.report.geometry.length_3d,
+    );
+    assert!(
+        (accuracy.tip_above_surface.min - lowest).abs() < 1e-9,
+        "{accuracy:?}"
+    );
+}
+
+/// The Hilbert loop and the spiral on generated surfaces: the written dispensing moves pass
+/// through every corner of the design on the surface to 1 µm, and are as long as the design on
+/// the surface to 0.1 % — the spiral everywhere, the Hilbert loop on a gentle swell. Where a
+/// Hilbert loop turns on a slope the deposit model's shift changes (d_o/2 ahead going down,
+/// none across, d/2 going up) and with it the tip's height over the surface, which adds
+/// 0.6–0.8 % on the ramp, the bump and the wrinkled film: measured and printed.
+#[test]
+fn issue_25_printed_paths_keep_the_designs_length_and_corners() {
+    let mut surfaces = generated_surfaces();
+    surfaces.push((
+        "gentle swell".to_owned(),
+        surface(height_field(0.0, 0.0, 40.0, 40.0, 160, &|x, y| {
+            1.0 + 0.4 * (x / 6.0).sin() * (y / 7.0).cos()
+        })),
+    ));
+    let gentle = ["gentle swell"];
+    let steep = ["ramp 30°", "bump r = 20.00 mm", "wrinkled film"];
+    let designs = [
+        ("hilbert loop", design(vec![hilbert_loop(4, 30.0)])),
+        ("spiral", design(vec![spiral(1.5, 300.0)])),
+    ];
+    let p = params(Corrections::default(), Mapping::Projection);
+    let cfg = Config::default();
+    let mut results = Vec::new();
+    for (sn, s) in surfaces
+        .iter()
+        .filter(|(n, _)| gentle.contains(&n.as_str()) || steep.contains(&n.as_str()))
+    {
+        for (dn, d) in &designs {
+            let planned = match plan(s, d, &placement_on(s, d), &p, |_| {}) {
+                Ok(x) => x,
+                Err(e) => panic!("{sn}, {dn}: {e}"),
+            };
+            let written = match write_and_replay(&planned.paths, &cfg, s, &p) {
+                Ok(x) => x,
+                Err(e) => panic!("{sn}, {dn}: {e}"),
+            };
+            let a = conduit::conform::replay::accuracy(
+                &written.parsed,
+                &written.machine,
+                s,
+                &p.nozzle,
+                &planned.corners,
+                planned.report.geometry.length_3d,
+            );
+            println!(
+                "{sn:18} {dn:12} printed {:9.3} mm on the surface {:9.3} mm ratio {:.5} corners {} deviation {:.2e} mm tip above {:.4}/{:.4}/{:.4}",
+                a.printed_length,
+                a.surface_length,
+                a.length_ratio,
+                a.corners,
+                a.corner_deviation_max,
+                a.tip_above_surface.min,
+                a.tip_above_surface.median,
+                a.tip_above_surface.max,
+            );
+            // The design's own length, in the plane, is kept through resampling.
+            let planar = planned.report.geometry.length_2d;
+            let drawn: f64 = d.paths[0]
+                .points
+                .windows(2)
+                .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+                .sum::<f64>()
+                * placement_on(s, d).scale;
+            assert!((planar - drawn).abs() < 1e-9 * drawn, "{planar} {drawn}");
+            results.push((gentle.contains(&sn.as_str()), format!("{sn}, {dn}"), a));
+        }
+    }
+    assert_eq!(results.len(), 8);
+    for (is_gentle, name, a) in &results {
+        assert!(a.corners > 50, "{name}: {a:?}");
+        assert!(a.corner_deviation_max <= 0.001, "{name}: {a:?}");
+        assert!(a.tip_above_surface.min > 0.0, "{name}: {a:?}");
+        if *is_gentle || name.ends_with("spiral") {
+            assert!((a.length_ratio - 1.0).abs() < 0.001, "{name}: {a:?}");
+        }
+    }
+}
+
+/// Issue 25: a film over the machine's origin and a G-code that homes before its first move.
+/// Homing puts the nozzle at `printer.home` (by default the bed's origin at the top), not at
+/// (0, 0, 0) inside the film.
+#[test]
+fn issue_25_homing_before_the_first_move_makes_no_phantom_contact() {
+    use conduit::conform::replay::{ReplayMachine, replay};
+    let s = surface(height_field(-20.0, -20.0, 20.0, 20.0, 40, &|x, y| {
+        1.0 + 0.1 * (x * 0.3).sin() * (y * 0.2).cos()
+    }));
+    let text = "G28\nG1 Z5 F600\nG1 X5 Y5 F3000\nG28 X Y\nG1 X6 Y6 Z5 F3000\nG92 Z3\nG1 X7 F3000\n";
+    let g = match conduit_gcode::parse(text.as_bytes()) {
+        Ok(g) => g,
+        Err(e) => panic!("{e}"),
+    };
+    let nozzle = params(Corrections::default(), Mapping::Projection).nozzle;
+    let machine = |home: [f64; 3]| ReplayMachine {
+        flavor: conduit::program::machine::Flavor::Marlin,
+        home,
+        print_feed: 5.0,
+        body: 1..usize::MAX,
+    };
+    let cfg = Config::default();
+    let homed = replay(&g, &machine(cfg.printer.home_position()), &s, &nozzle);
+    assert_eq!(cfg.printer.home_position(), [0.0, 0.0, 250.0]);
+    assert_eq!(
+        (homed.printing, homed.travel, homed.custom),
+        (0, 0, 0),
+        "{homed:?}"
+    );
+    // Homed to the origin (what the replay used to assume): the move down from there and the
+    // `G28 X Y` return start inside the film.
+    let origin = replay(&g, &machine([0.0; 3]), &s, &nozzle);
+    println!(
+        "G28 replay: {} travel contacts at the origin, {} homed",
+        origin.travel, homed.travel
+    );
+    assert!(origin.travel > 0, "{origin:?}");
+    // `G92 Z3` sets the position: the last move runs at z = 3, clear of the film, in every
+    // replay; a home below the film's top is in it.
+    let low = replay(&g, &machine([0.0, 0.0, 0.5]), &s, &nozzle);
+    assert!(low.travel > 0, "{low:?}");
 }

@@ -68,7 +68,7 @@ const NON_HEATING_MACROS: &[&str] = &[
 pub(super) fn replay(g: &Gcode, p: &CheckParams) -> CheckReport {
     let mut m = Checker {
         p,
-        machine: Machine::new(p.flavor, p.default_feedrate),
+        machine: Machine::new(p.flavor, p.default_feedrate).with_home(p.home),
         heaters: Vec::new(),
         macro_seen: None,
         planner: Planner::new(p.max_acceleration, p.jerk),

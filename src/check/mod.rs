@@ -16,7 +16,7 @@
 //!   mode. `M82`/`M83` absolute/relative E.
 //! - `G92` sets the named axes (`G92 E0`), `G20`/`G21` inches/millimetres (every length,
 //!   E and F included, is scaled by 25.4 in inch mode), `G28` homes the named axes (all when
-//!   none is named) to 0. Positions are unknown before they are homed, set by `G92` or moved to
+//!   none is named) to the home position ([`CheckParams::home`], `printer.home`). Positions are unknown before they are homed, set by `G92` or moved to
 //!   absolutely; moves with unknown positions are not bounds-checked.
 //! - `G0`/`G1` linear moves, `G2`/`G3` arcs in the XY plane with `I`/`J` (centre offset from
 //!   the start) or `R` (radius; negative for the long way round), helical when Z changes; arc
@@ -63,7 +63,7 @@ pub mod air;
 pub mod electrical;
 mod machine;
 
-pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves};
+pub use conduit_gcode::{Firmware, Machine, Move, Moves, Position, moves, moves_on};
 pub use electrical::{ElectricalParams, ElectricalReport, Frame, check_electrical};
 
 use std::collections::BTreeMap;
@@ -85,6 +85,9 @@ pub struct CheckParams {
     pub bed_size: [f64; 2],
     /// Highest allowed Z, mm.
     pub max_height: f64,
+    /// Where `G28` puts the axes [X, Y, Z], mm (`printer.home`, by default the bed's
+    /// front-left corner at `max_height`).
+    pub home: [f64; 3],
     /// How far outside the bed (XY) and above `max_height` moves may go without a finding, mm:
     /// slicers prime at the bed edge (PrusaSlicer's MK3 prime line runs at Y = −3). Default 5.
     pub bed_margin: f64,
@@ -155,6 +158,7 @@ impl CheckParams {
             bed_origin: p.bed_origin,
             bed_size: p.bed_size,
             max_height: p.max_height,
+            home: p.home_position(),
             bed_margin: 5.0,
             tools: tools
                 .iter()

@@ -49,6 +49,24 @@
 //! - A shift that would bring the whole nozzle within [`CLEARANCE`] of the surface is cut
 //!   back to the largest shift that keeps it (the clearance pass handles points already in
 //!   contact).
+//!
+//! # Along the path, never past a corner
+//!
+//! Every shift along the travel (M·V, M'·V, U) and the share of a lateral escape that lies
+//! along the path carry the tip *along the path seen from above* by that distance, not along
+//! the straight line of Vᵢ: on a straight stretch the two are the same; where the path
+//! turns, a straight shift would run the tip past the corner and back (0.25 mm at every
+//! corner of a Hilbert curve, 2 % more path). So the tip:
+//!
+//! - never passes the next corner (a turn of more than 30°: it stops on the corner's
+//!   bisector, the corner itself) nor the path's end; a gentler turn (a curve cut into
+//!   segments) it follows, and the path's vertices it went past are tips too;
+//! - never goes backwards: not behind its own design point, not behind the tip before it.
+//!   Tips held at one place (at a corner, at the end) are one tip, the last.
+//!
+//! The escape's share across the path stays an offset. So the printed path is the design on
+//! the surface (without the first shift at each path's start), and its length is the surface
+//! path's within the G-code's rounding.
 
 use super::Corrections;
 use super::nozzle::Nozzle;
@@ -91,16 +109,16 @@ pub struct CorrectionCounts {
     pub uphill: usize,
 }
 
-/// One point's correction: the tip after the lateral escape, and the shift along the
-/// horizontal direction of travel still to add.
+/// One point's correction: the tip after the lateral escape, and the shift along the path
+/// still to add.
 #[derive(Debug, Clone, Copy)]
 struct Move {
     base: Point3,
     along: f64,
-    travel: Vector3,
 }
 
-/// The corrected tip positions of one path.
+/// The corrected tip positions of one path: [`place_tips`], then the tips held at one place
+/// made one and the path's vertices the tips went past added ([`printed_path`]).
 pub fn correct(
     surface: &Surface,
     nozzle: &Nozzle,
@@ -110,44 +128,276 @@ pub fn correct(
     local: &[Local],
     counts: &mut CorrectionCounts,
 ) -> Vec<Point3> {
-    let mut moves: Vec<Move> = t
+    let track = Track::new(t);
+    let placed = place_tips(surface, nozzle, tolerance, mode, t, local, counts, &track);
+    printed_path(&track, &placed)
+}
+
+/// One tip placed along the path: its arc length along the path seen from above, the tip, its
+/// offset across the path.
+#[derive(Debug, Clone, Copy)]
+struct Placed {
+    sigma: f64,
+    tip: Point3,
+    across: Vector3,
+}
+
+/// The tip of every point of `t`, one each (module docs): the standoff and lateral escape of
+/// [`point_move`], the shift cut back where it would meet the surface and ramped down, carried
+/// along `track`, bounded by its corners, never backwards.
+#[allow(clippy::too_many_arguments)]
+fn place_tips(
+    surface: &Surface,
+    nozzle: &Nozzle,
+    tolerance: f64,
+    mode: Corrections,
+    t: &[Point3],
+    local: &[Local],
+    counts: &mut CorrectionCounts,
+    track: &Track,
+) -> Vec<Placed> {
+    let moves: Vec<Move> = t
         .iter()
         .zip(local)
         .map(|(ti, g)| point_move(surface, nozzle, tolerance, mode, ti, g, counts))
         .collect();
-    if !mode.on_deposit_model() {
-        return moves.iter().map(|m| m.base + m.travel * m.along).collect();
-    }
-    for i in (1..moves.len()).rev() {
-        let spacing = (t[i] - t[i - 1]).xy().norm();
-        moves[i - 1].along = moves[i - 1].along.min(moves[i].along + RAMP * spacing);
-    }
-    moves
+    let mut shift: Vec<f64> = moves.iter().map(|m| m.along).collect();
+    // The lateral escape split into its share along the path (joined to the shift) and
+    // across it (kept as an offset).
+    let split: Vec<(f64, Vector3)> = moves
         .iter()
-        .map(|m| {
-            let tip = m.base + m.travel * m.along;
-            if m.along <= 0.0
-                || nozzle.solid.shortfall(surface, &tip, CLEARANCE) <= 0.0
-                || nozzle.solid.shortfall(surface, &m.base, CLEARANCE) > 0.0
+        .enumerate()
+        .map(|(i, m)| {
+            let dir = track.direction(i);
+            let escape = Vector3::new(m.base.x - t[i].x, m.base.y - t[i].y, 0.0);
+            let ahead = escape.dot(&dir);
+            (ahead, escape - dir * ahead)
+        })
+        .collect();
+    // The tip of point i at arc length `sigma`.
+    let tip_at = |i: usize, sigma: f64| {
+        let q = track.at(sigma) + split[i].1;
+        Point3::new(q.x, q.y, moves[i].base.z)
+    };
+    if mode.on_deposit_model() {
+        for i in 0..moves.len() {
+            // A shift that brings the nozzle within the clearance is cut back to the largest
+            // that keeps it (from the point's own place: never behind it, never past the next
+            // corner).
+            let (s, ahead) = (track.s[i], split[i].0);
+            let own = |along: f64| tip_at(i, (s + ahead + along).clamp(s, track.limit(i).max(s)));
+            let along = shift[i];
+            if along > 0.0
+                && nozzle.solid.shortfall(surface, &own(along), CLEARANCE) > 0.0
+                && nozzle.solid.shortfall(surface, &own(0.0), CLEARANCE) <= 0.0
             {
-                return tip;
-            }
-            let (mut free, mut hit) = (0.0, m.along);
-            for _ in 0..CUT_STEPS {
-                let mid = 0.5 * (free + hit);
-                if nozzle
-                    .solid
-                    .shortfall(surface, &(m.base + m.travel * mid), CLEARANCE)
-                    > 0.0
-                {
-                    hit = mid;
-                } else {
-                    free = mid;
+                let (mut free, mut hit) = (0.0, along);
+                for _ in 0..CUT_STEPS {
+                    let mid = 0.5 * (free + hit);
+                    if nozzle.solid.shortfall(surface, &own(mid), CLEARANCE) > 0.0 {
+                        hit = mid;
+                    } else {
+                        free = mid;
+                    }
                 }
+                shift[i] = free;
             }
-            m.base + m.travel * free
+        }
+        for i in (1..shift.len()).rev() {
+            let spacing = (t[i] - t[i - 1]).xy().norm();
+            shift[i - 1] = shift[i - 1].min(shift[i] + RAMP * spacing);
+        }
+    }
+    let mut placed: Vec<Placed> = Vec::with_capacity(t.len());
+    let mut reached = f64::MIN;
+    for (i, along) in shift.iter().enumerate() {
+        let lo = reached.max(track.s[i]);
+        let hi = track.limit(i).max(lo);
+        let sigma = (track.s[i] + split[i].0 + along).clamp(lo, hi);
+        reached = sigma;
+        placed.push(Placed {
+            sigma,
+            tip: tip_at(i, sigma),
+            across: split[i].1,
+        });
+    }
+    placed
+}
+
+/// The printed path of tips placed along `track`: tips held at the same place (at a corner, at
+/// the path's end) are one tip, the last (whose design point is nearest); the path's vertices
+/// a tip went past since the tip before are tips too, so the printed path keeps the design's
+/// shape between them.
+fn printed_path(track: &Track, placed: &[Placed]) -> Vec<Point3> {
+    let mut out: Vec<Placed> = Vec::with_capacity(placed.len());
+    for &p in placed {
+        if let Some(last) = out.last_mut()
+            && (last.tip.xy() - p.tip.xy()).norm() < 1e-9
+        {
+            *last = p;
+            continue;
+        }
+        if let Some(&Placed {
+            sigma: s0,
+            tip: p0,
+            across: a0,
+        }) = out.last()
+        {
+            for &sv in track.vertices_between(s0, p.sigma) {
+                let f = (sv - s0) / (p.sigma - s0);
+                let off = a0 + (p.across - a0) * f;
+                let q = track.at(sv) + off;
+                let z = p0.z + (p.tip.z - p0.z) * f;
+                out.push(Placed {
+                    sigma: sv,
+                    tip: Point3::new(q.x, q.y, z),
+                    across: off,
+                });
+            }
+        }
+        out.push(p);
+    }
+    out.into_iter().map(|p| p.tip).collect()
+}
+
+/// The vertices of the zero-standoff paths `t` seen from above where they turn, xy in mm:
+/// where the printed path must pass. Path ends are left out, and so are the vertices within
+/// `skip` mm (along the path) of its start, where a shift along the path starts the first tip.
+pub fn corners(t: &[Vec<Point3>], skip: f64) -> Vec<[f64; 2]> {
+    t.iter()
+        .flat_map(|p| {
+            let track = Track::new(p);
+            track
+                .vertex_index
+                .iter()
+                .zip(&track.vertex_s)
+                .filter(|&(_, &s)| s > skip)
+                .filter_map(|(&k, _)| track.points.get(k).copied())
+                .collect::<Vec<_>>()
         })
         .collect()
+}
+
+/// Turn (radians) above which a vertex of the path is a corner: the shift never carries a tip
+/// past it. Gentler turns (a curve cut into segments) are followed.
+const CORNER_TURN: f64 = std::f64::consts::FRAC_PI_6;
+
+/// Turn (radians) above which a point of the path is a vertex (the points between a
+/// segment's ends are on it to rounding).
+const VERTEX_TURN: f64 = 1e-6;
+
+/// The zero-standoff path seen from above, for moving tips along it: arc length at each
+/// point, its vertices, and the arc length of the corner each point must not pass.
+struct Track {
+    points: Vec<[f64; 2]>,
+    /// Horizontal arc length at each point, mm.
+    s: Vec<f64>,
+    /// For each point, the arc length of the first corner at or after it (the path's end
+    /// when there is none).
+    limits: Vec<f64>,
+    /// The points where the path turns (ends left out), ascending.
+    vertex_index: Vec<usize>,
+    /// Their arc lengths.
+    vertex_s: Vec<f64>,
+}
+
+impl Track {
+    fn new(t: &[Point3]) -> Self {
+        let points: Vec<[f64; 2]> = t.iter().map(|p| [p.x, p.y]).collect();
+        let mut s = Vec::with_capacity(points.len());
+        let mut acc = 0.0;
+        for (i, p) in points.iter().enumerate() {
+            if i > 0 {
+                acc += (p[0] - points[i - 1][0]).hypot(p[1] - points[i - 1][1]);
+            }
+            s.push(acc);
+        }
+        let n = points.len();
+        let mut limits = vec![acc; n];
+        let mut vertex_index = Vec::new();
+        let mut next = acc;
+        for i in (0..n).rev() {
+            if i > 0 && i + 1 < n {
+                let a = [
+                    points[i][0] - points[i - 1][0],
+                    points[i][1] - points[i - 1][1],
+                ];
+                let b = [
+                    points[i + 1][0] - points[i][0],
+                    points[i + 1][1] - points[i][1],
+                ];
+                let turn = (a[0] * b[1] - a[1] * b[0])
+                    .atan2(a[0] * b[0] + a[1] * b[1])
+                    .abs();
+                if turn > CORNER_TURN {
+                    next = s[i];
+                }
+                if turn > VERTEX_TURN {
+                    vertex_index.push(i);
+                }
+            }
+            limits[i] = next;
+        }
+        vertex_index.reverse();
+        let vertex_s = vertex_index.iter().map(|&i| s[i]).collect();
+        Self {
+            points,
+            s,
+            limits,
+            vertex_index,
+            vertex_s,
+        }
+    }
+
+    /// Arc lengths of the vertices strictly between `a` and `b`.
+    fn vertices_between(&self, a: f64, b: f64) -> &[f64] {
+        let i = self.vertex_s.partition_point(|&x| x <= a);
+        let j = self.vertex_s.partition_point(|&x| x < b).max(i);
+        &self.vertex_s[i..j]
+    }
+
+    /// The arc length point `i` may be carried to.
+    fn limit(&self, i: usize) -> f64 {
+        self.limits.get(i).copied().unwrap_or(0.0)
+    }
+
+    /// The unit direction of the path leaving point `i` (arriving, at the last point).
+    fn direction(&self, i: usize) -> Vector3 {
+        let n = self.points.len();
+        let (a, b) = if i + 1 < n {
+            (i, i + 1)
+        } else {
+            (i.saturating_sub(1), i)
+        };
+        let (Some(p), Some(q)) = (self.points.get(a), self.points.get(b)) else {
+            return Vector3::zeros();
+        };
+        Vector3::new(q[0] - p[0], q[1] - p[1], 0.0)
+            .try_normalize(1e-12)
+            .unwrap_or_else(Vector3::zeros)
+    }
+
+    /// The point at arc length `sigma` (within the path), z = 0.
+    fn at(&self, sigma: f64) -> Vector3 {
+        let n = self.points.len();
+        let k = self
+            .s
+            .partition_point(|&x| x <= sigma)
+            .clamp(1, n.max(2) - 1);
+        let (Some(p), Some(q)) = (self.points.get(k - 1), self.points.get(k)) else {
+            return self
+                .points
+                .first()
+                .map_or_else(Vector3::zeros, |p| Vector3::new(p[0], p[1], 0.0));
+        };
+        let len = self.s[k] - self.s[k - 1];
+        let u = if len > 0.0 {
+            ((sigma - self.s[k - 1]) / len).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        Vector3::new(p[0] + u * (q[0] - p[0]), p[1] + u * (q[1] - p[1]), 0.0)
+    }
 }
 
 /// The deposit modes' standoff over Tᵢ and shift along the travel (module docs). `trail` is
@@ -236,7 +486,6 @@ fn point_move(
     let unmoved = Move {
         base: tip,
         along: 0.0,
-        travel: v,
     };
     if mode == Corrections::None {
         return unmoved;
@@ -265,7 +514,6 @@ fn point_move(
             Move {
                 base: Point3::new(tip.x + l * qx, tip.y + l * qy, tip.z),
                 along,
-                travel: v,
             }
         }
         None if on_model => Move {
@@ -398,9 +646,15 @@ mod tests {
         (t, local)
     }
 
+    /// The tip of every point of `t` (one each, before tips held at one place are merged).
     fn run(s: &Surface, mode: Corrections, t: &[Point3], local: &[Local]) -> Vec<Point3> {
         let mut counts = CorrectionCounts::default();
-        correct(s, &Nozzle::for_tests(), 0.1, mode, t, local, &mut counts)
+        let track = Track::new(t);
+        let n = Nozzle::for_tests();
+        place_tips(s, &n, 0.1, mode, t, local, &mut counts, &track)
+            .iter()
+            .map(|p| p.tip)
+            .collect()
     }
 
     /// The back edge `trail` behind `tip` along +x, at the tip's height.
@@ -524,13 +778,59 @@ mod tests {
                 assert!(shift <= 0.0625 * (k + 1.0) + 1e-9, "{ti} {tip}");
             }
         }
-        // The published method stops its shift at once: the tip stands still there.
+        // The published method stops its shift at once: the tip waits there (it never runs
+        // backwards), and the printed path holds it once.
         let published = run(&s, Corrections::Slope, &t, &local);
         let least = published
             .windows(2)
             .map(|w| w[1].x - w[0].x)
             .fold(f64::MAX, f64::min);
-        assert!(least < 1e-9, "{least}");
+        assert!(least.abs() < 1e-9, "{least}");
+        let mut counts = CorrectionCounts::default();
+        let n = Nozzle::for_tests();
+        let printed = correct(&s, &n, 0.1, Corrections::Slope, &t, &local, &mut counts);
+        assert!(printed.len() < published.len());
+        for w in printed.windows(2) {
+            assert!(w[1].x - w[0].x > 1e-9, "{} {}", w[0], w[1]);
+        }
+    }
+
+    #[test]
+    fn a_shift_stops_at_a_corner_and_the_printed_path_passes_through_it() {
+        // Down a 30° slope along +x to a corner at x = 5, then across the slope along +y:
+        // going down the tips are d_o/2 ahead of their points, but none passes the corner
+        // (a straight shift along the travel would reach x = 5.25 and come back).
+        let slope = 30f64.to_radians().tan();
+        let s = extruded(-1.0, 11.0, |x| -slope * x);
+        let mut t: Vec<Point3> = (0..=40)
+            .map(|i| {
+                let x = 0.125 * i as f64;
+                Point3::new(x, 0.0, -slope * x)
+            })
+            .collect();
+        t.extend((1..=40).map(|i| Point3::new(5.0, 0.125 * i as f64, -slope * 5.0)));
+        let normals: Vec<Vector3> = t
+            .iter()
+            .map(|p| s.top(p.x, p.y).map_or_else(Vector3::z, |h| h.1))
+            .collect();
+        let local = spline::local_geometry(&t, &normals);
+        let mut counts = CorrectionCounts::default();
+        let n = Nozzle::for_tests();
+        let printed = correct(&s, &n, 0.1, Corrections::Deposit, &t, &local, &mut counts);
+        assert!(printed.iter().all(|p| p.x <= 5.0 + 1e-12));
+        assert!(
+            printed
+                .iter()
+                .any(|p| (p.x - 5.0).abs() < 1e-12 && p.y.abs() < 1e-12)
+        );
+        // Seen from above, the printed path is the design less the first shift (d_o/2).
+        let len = |p: &[Point3]| p.windows(2).map(|w| (w[1] - w[0]).xy().norm()).sum::<f64>();
+        assert!(
+            (len(&t) - len(&printed) - 0.25).abs() < 1e-9,
+            "{}",
+            len(&printed)
+        );
+        assert!((printed[0].x - 0.25).abs() < 1e-12, "{}", printed[0]);
     }
 
     #[test]

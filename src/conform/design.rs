@@ -70,37 +70,30 @@ pub fn place(design: &conduit_svg::Design, place: &Placement) -> Vec<PlanarPath>
         .collect()
 }
 
-/// `path` resampled at equal arc-length steps of at most `step` (n = ⌈L/step⌉ segments, so
-/// with `step = d/2` there are two points per inner diameter); every original vertex's
-/// position along the path is kept only approximately, corners are cut by at most `step`.
+/// `path` resampled at steps of at most `step` (with `step = d/2`, two points per inner
+/// diameter): every segment of the design is cut into ⌈l/step⌉ equal parts, so every vertex of
+/// the design is a point of the result — corners are kept, and the length is the design's.
 pub fn discretise(path: &PlanarPath, step: f64) -> PlanarPath {
-    let total = path.length();
-    let n = ((total / step).ceil() as usize).max(1);
-    let mut out = Vec::with_capacity(n + 1);
-    let mut seg = 0;
-    let mut seg_start = 0.0;
-    for k in 0..=n {
-        let s = total * k as f64 / n as f64;
-        while seg + 2 < path.points.len() {
-            let [a, b] = [path.points[seg], path.points[seg + 1]];
-            let l = (b[0] - a[0]).hypot(b[1] - a[1]);
-            if seg_start + l >= s {
-                break;
-            }
-            seg_start += l;
-            seg += 1;
-        }
-        let (a, b) = (
-            path.points[seg],
-            path.points[(seg + 1).min(path.points.len() - 1)],
-        );
+    let mut out: Vec<[f64; 2]> = Vec::with_capacity(path.points.len());
+    if let Some(first) = path.points.first() {
+        out.push(*first);
+    }
+    for w in path.points.windows(2) {
+        let [a, b] = [w[0], w[1]];
         let l = (b[0] - a[0]).hypot(b[1] - a[1]);
-        let t = if l > 0.0 {
-            ((s - seg_start) / l).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+        if l <= 0.0 {
+            continue;
+        }
+        let n = ((l / step).ceil() as usize).max(1);
+        for k in 1..n {
+            let t = k as f64 / n as f64;
+            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+        }
+        out.push(b);
+    }
+    if out.len() == 1 {
+        // A path of one point repeated: two points, as every path has.
+        out.push(out[0]);
     }
     PlanarPath {
         points: out,
@@ -122,5 +115,19 @@ mod tests {
         assert_eq!(d.points.len(), 81);
         assert!((d.length() - 10.0).abs() < 1e-12);
         assert!((d.points[1][0] - 0.125).abs() < 1e-12);
+    }
+
+    #[test]
+    fn corners_are_kept_and_the_length_is_the_designs() {
+        // An L of 1.0 and 0.3 mm: 8 and 3 parts of 0.125 and 0.1 mm, the corner a point.
+        let p = PlanarPath {
+            points: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 0.3]],
+            closed: false,
+        };
+        let d = discretise(&p, 0.125);
+        assert_eq!(d.points.len(), 12);
+        assert_eq!(d.points[8], [1.0, 0.0]);
+        assert!((d.length() - 1.3).abs() < 1e-12, "{}", d.length());
+        assert!((d.points[9][1] - 0.1).abs() < 1e-12);
     }
 }

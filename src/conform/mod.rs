@@ -13,10 +13,13 @@
 //! 6. [`correct`]: standoff, tip-disk contact escape, shift along the travel (the tip placed
 //!    on the deposit model, or the published method's curvature-scaled downhill formula); then
 //!    a clearance pass with the whole nozzle ([`nozzle`]: its bore and its tool solid, checked
-//!    against the surface by [`crate::surface::contact`]) lifts what still touches.
+//!    against the surface by [`crate::surface::contact`], exactly per triangle) lifts what
+//!    still touches. Every shift runs along the path, never past a corner nor backwards.
 //! 7. [`deposit`]: expected deposit thickness and its errors, for every corrections mode.
 //! 8. [`report`]: the JSON report; [`replay`] re-checks the written G-code for contacts (the
-//!    replay walk of [`crate::surface::replay`] with the surface as obstacle).
+//!    replay walk of [`crate::surface::replay`] with the surface as obstacle, `G28` homing to
+//!    the printer's home) and measures its accuracy: the tip above the surface, the printed
+//!    length against the design's on the surface, the corners' deviation.
 //!
 //! Robot and five-axis work builds on the same stages: [`orient`] sets a tool axis per point
 //! (surface normal, vertical or fixed) for the robot emitters in [`crate::emit::robot`];
@@ -192,7 +195,13 @@ fn check_design(
     for (k, p) in placed.iter().enumerate() {
         let l = p.length();
         length += l;
-        points += (l / step).ceil().max(1.0) + 1.0;
+        // As `design::discretise` cuts it: every segment in ⌈l/step⌉ parts.
+        let parts: f64 = p
+            .points
+            .windows(2)
+            .map(|w| ((w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / step).ceil())
+            .sum();
+        points += parts.max(1.0) + 1.0;
         if points > MAX_DESIGN_POINTS as f64 {
             // The rest is summed for the message only.
             let rest: f64 = placed[k + 1..].iter().map(design::PlanarPath::length).sum();
@@ -287,6 +296,13 @@ impl ConformParams {
     }
 }
 
+/// How far along a path its first tip may start ahead of the design (the largest shift of the
+/// corrections: d_o/2 + d, the published method's most), mm: the corners of the accuracy report
+/// are counted from there.
+pub fn corner_skip(params: &ConformParams) -> f64 {
+    params.nozzle.tip_radius() + params.nozzle.inner
+}
+
 /// The planned paths of a run.
 #[derive(Debug, Clone)]
 pub struct Planned {
@@ -294,6 +310,9 @@ pub struct Planned {
     pub paths: Vec<Vec<Point3>>,
     /// The report (registration and replay are filled in by the caller).
     pub report: ConformReport,
+    /// The vertices of the design on the surface seen from above ([`correct::corners`]): where
+    /// the printed path must pass, for the report's accuracy.
+    pub corners: Vec<[f64; 2]>,
 }
 
 /// Tip paths of `t` (zero-standoff paths with their local geometry) under `mode`.
@@ -456,7 +475,11 @@ pub fn plan(
         deposit: deposit::deposit(surface, &paths, &params.nozzle, &params.thresholds),
         comparison,
     });
-    Ok(Planned { paths, report })
+    Ok(Planned {
+        paths,
+        report,
+        corners: correct::corners(&on.projected.paths, corner_skip(params)),
+    })
 }
 
 /// The planned paths as a one-layer Program for `cfg`'s writer: conductive traces of tool

@@ -7,7 +7,8 @@
 //! written G-code ([`super::replay`]). Beyond the published method, which checks only the tip
 //! disc, the whole nozzle is checked: a needle of the outer diameter rising `needle_length`
 //! above the tip, then a cone widening at `cone_angle` from the vertical for `cone_height` —
-//! a [`ToolSolid`] checked against the surface by [`crate::surface::contact`].
+//! a [`ToolSolid`] checked against the surface by [`crate::surface::contact`] (exactly: the
+//! highest point of the surface inside each footprint, [`crate::surface::clearance`]).
 
 use crate::surface::ToolSolid;
 

@@ -1,8 +1,9 @@
 //! The JSON report of a conform run: surface, registration, design, path geometry, corrections,
-//! remaining nozzle contacts, deposit thickness (method and controls) and the replay.
+//! remaining nozzle contacts, deposit thickness (method and controls), the replay and the
+//! accuracy of the written G-code (tip above the surface, length, corners).
 //!
 //! Place in the pipeline: step 9, the last; [`super::plan`] fills everything it knows, the CLI
-//! adds the registration, the markers and the replay of the written G-code.
+//! adds the registration, the markers, the replay of the written G-code and its accuracy.
 
 use super::ConformParams;
 use super::Corrections;
@@ -12,7 +13,7 @@ use super::design::PlanarPath;
 use super::markers::Marker;
 use super::project::Projected;
 use super::register::Registration;
-use super::replay::ReplayContacts;
+use super::replay::{Accuracy, ReplayContacts};
 use super::spline::Local;
 use crate::geom::Point3;
 use crate::surface::{CloudInfo, Surface};
@@ -124,6 +125,8 @@ pub struct ConformReport {
     pub comparison: Comparison,
     /// Contacts found by replaying the written G-code.
     pub replay: Option<ReplayContacts>,
+    /// How closely the written G-code follows the design on the surface (3-axis G-code only).
+    pub accuracy: Option<Accuracy>,
 }
 
 /// What [`build`] needs.
@@ -186,5 +189,6 @@ pub(super) fn build(i: Inputs<'_>) -> ConformReport {
         deposit: i.deposit,
         comparison: i.comparison,
         replay: None,
+        accuracy: None,
     }
 }

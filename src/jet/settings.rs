@@ -78,9 +78,9 @@ pub struct JetSettings {
     pub start_gcode: String,
     /// Written once after the job (after the shutter closes). Default `M84 ; motors off`.
     pub end_gcode: String,
-    /// Write `E` words (the deposited volume, width × layer height × length, mm³, relative) so
-    /// replays such as `conduit check` and `conduit preview` see the jetted lines; false
-    /// writes moves without `E`. Default true.
+    /// Write `E` words (the jetted length: each jetted move's `E` is its length, mm,
+    /// relative) so replays such as `conduit check` and `conduit preview` see the jetted lines;
+    /// false writes moves without `E`. Default true.
     pub e_words: bool,
     /// Factor on the accumulation model's prediction: the bare mass-conservation model
     /// over-predicts the inside/outside height difference by about an order of magnitude

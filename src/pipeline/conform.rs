@@ -15,7 +15,7 @@ use crate::config::Config;
 use crate::conform::markers::{Marker, MarkerError, auto_register, find_markers};
 use crate::conform::orient::{self, OrientParams, OrientationReport};
 use crate::conform::register::RegisterError;
-use crate::conform::replay::{self, ReplayContacts};
+use crate::conform::replay::{self, ReplayContacts, ReplayMachine};
 use crate::conform::scan::Scan;
 use crate::conform::{
     self, ConformError, ConformParams, ConformReport, Placement, Registration, Surface,
@@ -194,10 +194,18 @@ pub fn run(
     progress(Stage::Write);
     let (program, moves) = match job.dialect {
         None => {
-            let (gcode, contacts) = write_and_replay(&planned.paths, cfg, &surface, &job.params)
+            let written = write_and_replay(&planned.paths, cfg, &surface, &job.params)
                 .map_err(ConformWalkError::Write)?;
-            report.replay = Some(contacts);
-            (gcode, None)
+            report.replay = Some(written.contacts);
+            report.accuracy = Some(replay::accuracy(
+                &written.parsed,
+                &written.machine,
+                &surface,
+                &job.params.nozzle,
+                &planned.corners,
+                report.geometry.length_3d,
+            ));
+            (written.gcode, None)
         }
         Some(dialect) => {
             let lowest = planned
@@ -247,15 +255,29 @@ fn register(
     }
 }
 
+/// A written conform G-code and its replay.
+#[derive(Debug)]
+pub struct Written {
+    /// The G-code.
+    pub gcode: Vec<u8>,
+    /// It, parsed back.
+    pub parsed: conduit_gcode::Gcode,
+    /// The machine it was replayed on.
+    pub machine: ReplayMachine,
+    /// What the replay found.
+    pub contacts: ReplayContacts,
+}
+
 /// The G-code of `paths` for `cfg` over `surface`, and its replay: every move of the written
-/// file checked against the surface with the whole nozzle. The program's first travel arrives at
-/// the surface's top plus `conform.travel_clearance`.
+/// file checked against the surface with the whole nozzle, on the machine of `[printer]`
+/// (`G28` homes to `printer.home`). The program's first travel arrives at the surface's top
+/// plus `conform.travel_clearance`.
 pub fn write_and_replay(
     paths: &[Vec<Point3>],
     cfg: &Config,
     surface: &Surface,
     params: &ConformParams,
-) -> Result<(Vec<u8>, ReplayContacts), ConformError> {
+) -> Result<Written, ConformError> {
     let lowest = paths.iter().flatten().map(|p| p.z).fold(f64::MAX, f64::min);
     let safe_z = surface.max().z + cfg.conform.travel_clearance;
     let program = conform::program(paths, &cfg.conform, safe_z);
@@ -263,15 +285,19 @@ pub fn write_and_replay(
     let mut gcode = Vec::new();
     write_gcode(&program, &writer, &mut gcode)?;
     let parsed = conduit_gcode::parse(&gcode)?;
-    let contacts = replay::replay(
-        &parsed,
-        cfg.printer.flavor,
-        surface,
-        &params.nozzle,
-        cfg.conform.feed,
-        replay::body_lines(&String::from_utf8_lossy(&gcode)),
-    );
-    Ok((gcode, contacts))
+    let machine = ReplayMachine {
+        flavor: cfg.printer.flavor,
+        home: cfg.printer.home_position(),
+        print_feed: cfg.conform.feed,
+        body: replay::body_lines(&String::from_utf8_lossy(&gcode)),
+    };
+    let contacts = replay::replay(&parsed, &machine, surface, &params.nozzle);
+    Ok(Written {
+        gcode,
+        parsed,
+        machine,
+        contacts,
+    })
 }
 
 /// `program` as a robot or five-axis program in `dialect`, named `name`, and its moves. The

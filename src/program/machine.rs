@@ -40,6 +40,14 @@ pub struct Printer {
     pub bed_origin: [f64; 2],
     /// Highest printable Z, mm. Default 250.
     pub max_height: f64,
+    /// Where `G28` puts the axes [X, Y, Z], mm, as the firmware's endstops do: what `conduit
+    /// check` and the replays of conform and the viewer take as the position after homing
+    /// (`G28 X Y` homes only the named axes). Absent = the bed's front-left corner at the top,
+    /// [`bed_origin[0]`, `bed_origin[1]`, `max_height`] (a Z endstop at the top keeps the
+    /// nozzle clear of whatever is on the bed, and so does this default). Default absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(example = [0.0, 0.0, 250.0])]
+    pub home: Option<[f64; 3]>,
     /// Bed temperature after the first layer, °C (0 = bed heater off). Default 60.
     pub bed_temperature: f64,
     /// Bed temperature for the first layer, °C. Default 60.
@@ -166,6 +174,14 @@ pub struct Tool {
     pub travel_lift: Option<f64>,
 }
 
+impl Printer {
+    /// Where `G28` puts the axes: `home`, or the bed's front-left corner at `max_height`.
+    pub fn home_position(&self) -> [f64; 3] {
+        self.home
+            .unwrap_or([self.bed_origin[0], self.bed_origin[1], self.max_height])
+    }
+}
+
 impl Default for Printer {
     fn default() -> Self {
         Self {
@@ -173,6 +189,7 @@ impl Default for Printer {
             bed_size: [250.0, 250.0],
             bed_origin: [0.0, 0.0],
             max_height: 250.0,
+            home: None,
             bed_temperature: 60.0,
             first_layer_bed_temperature: 60.0,
             start_gcode: DEFAULT_START_GCODE.to_owned(),

@@ -4,22 +4,23 @@
 //!
 //! Place in the pipeline: vocabulary for conformal printing — its corrections (the tip disc,
 //! [`ToolSolid::disc_contact`]), the clearance pass after them ([`ToolSolid::shortfall`]), the
-//! report ([`ToolSolid::penetration`], and [`ToolSolid::penetration_along`] for tilted tool
-//! axes) and the replay of the written G-code ([`super::replay::walk`] with the [`Surface`] as
-//! obstacle).
+//! report ([`ToolSolid::penetration`], [`ToolSolid::tip_clearance`], and
+//! [`ToolSolid::penetration_along`] for tilted tool axes) and the replay of the written G-code
+//! ([`super::replay::walk`] with the [`Surface`] as obstacle).
 //!
-//! A tool coming from above on a 3-axis machine meets the top surface: the vertical check
-//! samples the top height on rings around the axis and compares it with the solid's lowest
-//! point at that distance from the axis. Samples: a disc on four rings of 16 points plus the
-//! centre; a cone on rings every half millimetre of radius (24 points, every other ring turned
-//! by half a step), asked only when the surface anywhere reaches the solid's shoulder. A
-//! cylinder (the needle) stands on the tip disc and is covered by its samples.
+//! A tool coming from above on a 3-axis machine meets the top surface. The vertical check is
+//! exact ([`super::clearance`]): each disc or cylinder by the highest point of the surface over
+//! its footprint against its floor, each cone by the highest the surface reaches over its
+//! annulus against its rising underside. A piece away from the tip is asked only when a coarse
+//! bound of the surface's height around it reaches its floor.
 //!
-//! Along a tilted axis the rings are perpendicular to it: the disc as above, a cylinder every
-//! `step` along it (16 points on its radius; a ring above the surface's top ends the search),
-//! a cone every half millimetre along it (24 points). A sample lies in the part when the top
-//! surface at its (x, y) is higher than it; the depth is that height difference. A ring whose
-//! lowest point is above a bound of the surface's height around it is skipped.
+//! Along a tilted axis the solid is checked by its cross-sections perpendicular to the axis,
+//! each a whole disc checked exactly: the tip, a cylinder every `step` along it (a section
+//! above the surface's top ends the search), a cone every half millimetre along it. A section
+//! whose lowest point is above a bound of the surface's height around it is skipped.
+//!
+//! The corrections' [`ToolSolid::disc_contact`] wants a place, not a depth: the weighted
+//! centroid of the tip disc's samples (4 rings of 16 points and the centre) under the surface.
 
 use super::mesh::Surface;
 use super::replay::{Obstacle, Sample, Stretch};
@@ -30,38 +31,28 @@ use crate::geom::{Point3, Vector3};
 const DISC_ANGLES: usize = 16;
 /// Rings of a disc (at ¼, ½, ¾ and 1 of its radius).
 const DISC_RINGS: usize = 4;
-/// Ring spacing on a cone, mm (of radius when vertical, along the axis when tilted).
+/// Cross-section spacing along a tilted cone, mm.
 const CONE_RING_MM: f64 = 0.5;
-/// Angles per cone ring.
+/// Points per rim of a cone's cross-section on an axis standing on edge.
 const CONE_ANGLES: usize = 24;
-/// Points per ring of a cylinder along a tilted axis.
+/// Points per rim of a cylinder's cross-section on an axis standing on edge.
 const CYLINDER_ANGLES: usize = 16;
 
-/// Unit directions of the disc rings and of the cone rings (even rings, then odd rings turned
-/// by half a step), computed once.
-static DIRECTIONS: std::sync::LazyLock<[Vec<[f64; 2]>; 3]> = std::sync::LazyLock::new(|| {
-    let dirs = |n: usize, offset: f64| -> Vec<[f64; 2]> {
-        (0..n)
-            .map(|a| {
-                let t = std::f64::consts::TAU * (a as f64 + offset) / n as f64;
-                [t.cos(), t.sin()]
-            })
-            .collect()
-    };
-    [
-        dirs(DISC_ANGLES, 0.0),
-        dirs(CONE_ANGLES, 0.0),
-        dirs(CONE_ANGLES, 0.5),
-    ]
+/// Unit directions of the disc rings, computed once.
+static DIRECTIONS: std::sync::LazyLock<Vec<[f64; 2]>> = std::sync::LazyLock::new(|| {
+    (0..DISC_ANGLES)
+        .map(|a| {
+            let t = std::f64::consts::TAU * a as f64 / DISC_ANGLES as f64;
+            [t.cos(), t.sin()]
+        })
+        .collect()
 });
 
-/// One sample of a vertical check: offset from the axis and the solid's lowest height there.
+/// One sample of the tip disc: offset from the axis and its area weight.
 #[derive(Debug, Clone, Copy)]
 struct RingSample {
     dx: f64,
     dy: f64,
-    /// Height of the solid's underside above the tip at this offset.
-    floor: f64,
     /// Area weight (the ring's radius) for centroids.
     weight: f64,
 }
@@ -72,42 +63,14 @@ fn disc_samples(piece: &Piece) -> Vec<RingSample> {
     let mut s = vec![RingSample {
         dx: 0.0,
         dy: 0.0,
-        floor: piece.bottom,
         weight: ro / (2.0 * DISC_RINGS as f64),
     }];
     for k in 1..=DISC_RINGS {
         let r = ro * k as f64 / DISC_RINGS as f64;
-        for u in &DIRECTIONS[0] {
+        for u in DIRECTIONS.iter() {
             s.push(RingSample {
                 dx: r * u[0],
                 dy: r * u[1],
-                floor: piece.bottom,
-                weight: r,
-            });
-        }
-    }
-    s
-}
-
-/// A cone piece's samples: rings every [`CONE_RING_MM`] of radius out to its widest, each
-/// [`CONE_ANGLES`] long.
-fn cone_samples(piece: &Piece) -> Vec<RingSample> {
-    let PieceShape::Cone {
-        radius: ro, tan, ..
-    } = piece.shape
-    else {
-        return Vec::new();
-    };
-    let reach = piece.height * tan;
-    let rings = (reach / CONE_RING_MM).ceil() as usize;
-    let mut s = Vec::new();
-    for k in 1..=rings {
-        let r = ro + reach * k as f64 / rings as f64;
-        for u in &DIRECTIONS[1 + k % 2] {
-            s.push(RingSample {
-                dx: r * u[0],
-                dy: r * u[1],
-                floor: piece.floor_at(r),
                 weight: r,
             });
         }
@@ -123,11 +86,6 @@ impl ToolSolid {
             .filter(|p| matches!(p.shape, PieceShape::Disc { .. }))
             .flat_map(disc_samples)
             .collect()
-    }
-
-    /// The samples of the solid's cones, ring after ring.
-    fn cone_samples(&self) -> Vec<RingSample> {
-        self.pieces().iter().flat_map(cone_samples).collect()
     }
 
     /// Where the tip disc at `tip` meets the surface (surface at or above the tip's height):
@@ -148,41 +106,56 @@ impl ToolSolid {
 
     /// How far the surface reaches into the whole solid with its tip at `tip` (vertical axis),
     /// mm; ≤ 0: no contact (the clearance, or a lower bound of it where a coarse bound of the
-    /// surface's height already shows there is no contact).
+    /// surface's height already shows there is no contact). Exact ([`super::clearance`]): the
+    /// tip and every disc or cylinder at the tip by the highest point of the surface over
+    /// their footprint, a cone (or a piece higher up, when the surface reaches its floor) by
+    /// the highest point over its annulus less its rise there.
     pub fn penetration(&self, surface: &Surface, tip: &Point3) -> f64 {
-        let ro = self.tip_radius();
-        let shoulder = self.shoulder();
-        let Some(near) = surface.max_height_near(tip.x, tip.y, self.widest()) else {
+        if surface
+            .max_height_near(tip.x, tip.y, self.widest())
+            .is_none()
+        {
             return f64::MIN;
-        };
-        let disc_bound = surface
-            .max_height_near(tip.x, tip.y, ro)
-            .map_or(f64::MIN, |h| h - tip.z);
-        if near < tip.z + shoulder && disc_bound < 0.0 {
-            return disc_bound.max(near - tip.z - shoulder);
         }
+        let field = surface.height_field();
         let mut worst = f64::MIN;
-        let mut check = |samples: &[RingSample]| {
-            for s in samples {
-                if let Some(h) = surface.height(tip.x + s.dx, tip.y + s.dy) {
-                    worst = worst.max(h - (tip.z + s.floor));
-                }
+        for piece in self.pieces() {
+            let base = tip.z + piece.bottom;
+            let Some(bound) = surface
+                .max_height_near(tip.x, tip.y, piece.widest())
+                .map(|h| h - base)
+            else {
+                continue;
+            };
+            let at_tip = piece.bottom <= 0.0 && !matches!(piece.shape, PieceShape::Cone { .. });
+            if bound < 0.0 && !at_tip {
+                worst = worst.max(bound);
+                continue;
             }
-        };
-        if disc_bound >= 0.0 {
-            check(&self.disc_samples());
-        }
-        if near >= tip.z + shoulder {
-            // Ring by ring: a ring whose height bound stays under the solid there is skipped.
-            let samples = self.cone_samples();
-            for ring in samples.chunks(CONE_ANGLES) {
-                let Some(s0) = ring.first() else { continue };
-                let r = s0.dx.hypot(s0.dy);
-                if surface
-                    .max_height_near(tip.x, tip.y, r)
-                    .is_some_and(|h| h >= tip.z + s0.floor)
-                {
-                    check(ring);
+            match piece.shape {
+                PieceShape::Disc { radius } | PieceShape::Cylinder { radius } => {
+                    if let Some(h) = field.max_in_disc(tip.x, tip.y, radius) {
+                        worst = worst.max(h - base);
+                    }
+                }
+                PieceShape::Cone { radius, tan, .. } => {
+                    if radius > 0.0
+                        && let Some(h) = field.max_in_disc(tip.x, tip.y, radius)
+                    {
+                        worst = worst.max(h - base);
+                    }
+                    if tan <= 0.0 {
+                        continue;
+                    }
+                    // Floor at ρ ≥ radius: base + (ρ − radius)/tan.
+                    let k = 1.0 / tan;
+                    let lift = base - radius * k;
+                    let wide = piece.widest();
+                    if let Some(h) =
+                        field.max_over_cone(tip.x, tip.y, radius, wide, k, worst + lift)
+                    {
+                        worst = worst.max(h - lift);
+                    }
                 }
             }
         }
@@ -197,9 +170,20 @@ impl ToolSolid {
         self.penetration(surface, &Point3::new(tip.x, tip.y, tip.z - margin))
     }
 
+    /// How far the tip disc at `tip` (vertical axis) is above the highest point of the surface
+    /// under it, exactly, mm (< 0: the surface reaches into it); `None` off the surface.
+    pub fn tip_clearance(&self, surface: &Surface, tip: &Point3) -> Option<f64> {
+        surface
+            .max_height_in_disc(tip.x, tip.y, self.tip_radius())
+            .map(|h| tip.z - h)
+    }
+
     /// How far the surface reaches into the solid with its tip at `tip` and its axis (unit,
-    /// tip toward the body) `axis`, mm, measured vertically; cylinders are sampled every
-    /// `step` along the axis; ≤ 0 or `f64::MIN`: no contact.
+    /// tip toward the body) `axis`, mm, measured vertically; ≤ 0 or `f64::MIN`: no contact.
+    /// The solid is checked by its cross-sections perpendicular to the axis, each a whole disc
+    /// checked exactly ([`super::clearance`]): the tip, a cylinder every `step` along the
+    /// axis, a cone every half millimetre. An axis within 0.06° of the horizontal (a disc
+    /// standing on edge) is sampled on the cross-sections' rims instead.
     pub fn penetration_along(
         &self,
         surface: &Surface,
@@ -214,17 +198,25 @@ impl ToolSolid {
         let v = axis.cross(&u);
         let lean = axis.x.hypot(axis.y);
         let top = surface.max().z;
+        let field = surface.height_field();
+        let on_edge = axis.z.abs() < 1e-3;
         let mut worst = f64::MIN;
-        let mut ring = |s: f64, r: f64, n: usize| -> bool {
+        let mut section = |s: f64, r: f64, n: usize| -> bool {
             let c = tip + axis * s;
             let lowest = c.z - r * lean;
             if lowest > top {
-                // Higher rings are higher still: nothing above can touch.
+                // Higher sections are higher still: nothing above can touch.
                 return false;
             }
             match surface.max_height_near(c.x, c.y, r) {
                 Some(h) if h >= lowest => {}
                 _ => return true,
+            }
+            if !on_edge {
+                if let Some(h) = field.max_above_disc(&c, &u, &v, r) {
+                    worst = worst.max(h);
+                }
+                return true;
             }
             for k in 0..n.max(1) {
                 let t = std::f64::consts::TAU * k as f64 / n.max(1) as f64;
@@ -238,20 +230,13 @@ impl ToolSolid {
         for piece in self.pieces() {
             match piece.shape {
                 PieceShape::Disc { radius } => {
-                    ring(piece.bottom, 0.0, 1);
-                    for k in 1..=DISC_RINGS {
-                        ring(
-                            piece.bottom,
-                            radius * k as f64 / DISC_RINGS as f64,
-                            DISC_ANGLES,
-                        );
-                    }
+                    section(piece.bottom, radius, DISC_ANGLES);
                 }
                 PieceShape::Cylinder { radius } => {
                     let stations = (piece.height / step).ceil() as usize;
                     for k in 1..=stations {
                         let s = (k as f64 * step).min(piece.height);
-                        if !ring(piece.bottom + s, radius, CYLINDER_ANGLES) {
+                        if !section(piece.bottom + s, radius, CYLINDER_ANGLES) {
                             return worst;
                         }
                     }
@@ -260,8 +245,9 @@ impl ToolSolid {
                     let rings = (piece.height / CONE_RING_MM).ceil() as usize;
                     for k in 1..=rings {
                         let h = piece.height * k as f64 / rings as f64;
-                        // The cone widens, so a ring above the surface does not end the search.
-                        ring(piece.bottom + h, radius + h * tan, CONE_ANGLES);
+                        // The cone widens, so a section above the surface does not end the
+                        // search.
+                        section(piece.bottom + h, radius + h * tan, CONE_ANGLES);
                     }
                 }
             }
@@ -293,6 +279,55 @@ mod tests {
     /// The conform tests' nozzle: d_o = 0.5, a 6 mm needle under a 30° cone 10 mm high.
     fn nozzle() -> ToolSolid {
         ToolSolid::needle_nozzle(0.5, 6.0, 30.0, 10.0)
+    }
+
+    /// A V-crease of flanks at `slope_deg` along the direction `angle_deg` from x through the
+    /// origin (the crease at z = 0), 8 mm each way, cut in strips 0.05 mm wide.
+    fn crease(slope_deg: f64, angle_deg: f64) -> Surface {
+        let s = slope_deg.to_radians().tan();
+        let (sin, cos) = angle_deg.to_radians().sin_cos();
+        // (a, b): a across the crease, b along it.
+        let at = |a: f64, b: f64| Point3::new(a * -sin + b * cos, a * cos + b * sin, s * a.abs());
+        let n = 320;
+        let mut t = Vec::new();
+        for i in 0..n {
+            let (a0, a1) = (
+                -8.0 + 16.0 * i as f64 / n as f64,
+                -8.0 + 16.0 * (i + 1) as f64 / n as f64,
+            );
+            t.push([at(a0, -8.0), at(a1, -8.0), at(a1, 8.0)]);
+            t.push([at(a0, -8.0), at(a1, 8.0), at(a0, 8.0)]);
+        }
+        match Surface::from_triangles(t) {
+            Ok(s) => s,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    #[test]
+    fn the_rim_over_a_crease_between_sample_angles_is_found_to_a_tenth_of_a_micrometre() {
+        // Issue 25: 47° flanks, the crease turned half a sample step (11.25°) from the samples'
+        // directions. Over the crease the highest point of the disc is on its rim across the
+        // crease: r·tan 47° above the crease; the 16 rim samples nearest it are 11.25° off and
+        // 5 µm lower.
+        let surface = crease(47.0, 90.0 + 11.25);
+        let n = nozzle();
+        let rim = 0.25 * 47f64.to_radians().tan();
+        let tip = Point3::new(0.0, 0.0, rim - 0.002);
+        let pen = n.penetration(&surface, &tip);
+        assert!((pen - 0.002).abs() < 1e-7, "{pen}");
+        let clear = n.tip_clearance(&surface, &tip).unwrap_or(f64::NAN);
+        assert!((clear + 0.002).abs() < 1e-7, "{clear}");
+        // The samples the check used to take: every one clear of the surface.
+        let sampled = disc_samples(&n.pieces()[0])
+            .iter()
+            .filter_map(|s| surface.height(tip.x + s.dx, tip.y + s.dy))
+            .fold(f64::MIN, f64::max);
+        assert!(sampled < tip.z - 0.003, "{}", sampled - tip.z);
+        // A tilted axis 0.1° from the vertical gives the same to rounding of the tilt.
+        let axis = Vector3::new(0.0, 0.1f64.to_radians().sin(), 0.1f64.to_radians().cos());
+        let along = n.penetration_along(&surface, &tip, &axis, 0.0625);
+        assert!((along - 0.002).abs() < 0.0005, "{along}");
     }
 
     #[test]

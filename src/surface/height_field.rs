@@ -186,6 +186,39 @@ impl HeightField {
         (clamp(fx, self.dims[0]), clamp(fy, self.dims[1]))
     }
 
+    /// Indices of the triangles filed in the grid cells the square of half-side `r` about
+    /// (x, y) overlaps, ascending, each once (empty when the square is off the grid).
+    pub fn near(&self, x: f64, y: f64, r: f64) -> Vec<usize> {
+        let ext = [
+            self.origin[0] + self.cell * self.dims[0] as f64,
+            self.origin[1] + self.cell * self.dims[1] as f64,
+        ];
+        if self.cells.is_empty()
+            || !(x.is_finite() && y.is_finite() && r.is_finite())
+            || x + r < self.origin[0]
+            || y + r < self.origin[1]
+            || x - r > ext[0]
+            || y - r > ext[1]
+        {
+            return Vec::new();
+        }
+        let (cx0, cy0) = self.cell_of(x - r, y - r);
+        let (cx1, cy1) = self.cell_of(x + r, y + r);
+        let mut out = Vec::new();
+        for cy in cy0..=cy1 {
+            for cx in cx0..=cx1 {
+                out.extend(
+                    self.cells[cy * self.dims[0] + cx]
+                        .iter()
+                        .map(|&i| i as usize),
+                );
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
     /// The upward-facing triangles.
     pub fn triangles(&self) -> &[SurfaceTriangle] {
         &self.triangles

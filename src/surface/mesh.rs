@@ -402,6 +402,18 @@ impl Surface {
         (m > f64::MIN).then_some(m)
     }
 
+    /// The exact height field of the triangles turned to face up (what [`Surface::height`]
+    /// and the exact clearance queries of [`super::clearance`] read).
+    pub fn height_field(&self) -> &HeightField {
+        &self.heights
+    }
+
+    /// The highest the surface reaches over the disc of radius `r` about (x, y), exactly
+    /// ([`HeightField::max_in_disc`]); `None` when no triangle lies under the disc.
+    pub fn max_height_in_disc(&self, x: f64, y: f64, r: f64) -> Option<f64> {
+        self.heights.max_in_disc(x, y, r)
+    }
+
     /// Top height at (x, y), mm.
     pub fn height(&self, x: f64, y: f64) -> Option<f64> {
         self.heights.at(x, y).map(|h| h.z)

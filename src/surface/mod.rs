@@ -16,9 +16,12 @@
 //! - [`replay`]: the one replay walk ([`walk`]): tip positions sampled along moves, beads or
 //!   paths, each asked against an [`Obstacle`] (a scanned surface, or material printed so far),
 //!   what each stretch printed laid down after it.
+//! - [`clearance`]: the exact highest point of the surface inside a disc (the tip, a tilted
+//!   tool's cross-section) or a cone's annulus, per triangle from the [`HeightField`]'s grid.
 //! - [`contact`]: the tool solid against a scanned surface (tip disc, whole solid vertical or
 //!   along a tilted axis), and the [`Surface`] as an obstacle of the walk.
 
+pub mod clearance;
 pub mod contact;
 pub mod height_field;
 pub mod mesh;

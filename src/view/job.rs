@@ -20,7 +20,7 @@ use conduit_gcode::{Gcode, Move, Moves};
 use serde::Serialize;
 
 use super::encode::{PositionStream, RunStream, varints_base64};
-use crate::check::{CheckParams, CheckReport, Severity, check, moves};
+use crate::check::{CheckParams, CheckReport, Machine, Severity, check, moves_on};
 use crate::emit::preview::{CUSTOM_ROLE, UNNAMED_ROLE, layered_by_markers, role_colour, tint};
 use conduit_gcode::events::{PartEvent, part_events};
 use conduit_pnp::octopnp::{OctoPart, read_block};
@@ -190,7 +190,8 @@ struct GroupBuild {
 /// The view of `gcode` replayed as `conduit check` replays it with `params` (layers numbered
 /// as the previews number them), or `None` when no move has X or Y: nothing to draw.
 pub fn job_of(name: &str, gcode: &Gcode, params: &CheckParams) -> Option<JobView> {
-    let replay = layered_by_markers(gcode, moves(gcode, params.flavor));
+    let machine = Machine::new(params.flavor, 25.0).with_home(params.home);
+    let replay = layered_by_markers(gcode, moves_on(gcode, machine));
     if replay.moves.iter().all(|m| !m.has_xy) {
         return None;
     }

@@ -57,7 +57,7 @@ mod summary;
 mod corpus_tests;
 
 pub use line::{Line, LineEnding, STRING_ARG_COMMANDS, Word};
-pub use machine::{Command, Firmware, Machine, Move, Moves, Position, Reading, moves};
+pub use machine::{Command, Firmware, Machine, Move, Moves, Position, Reading, moves, moves_on};
 pub use number::{E_DECIMALS, XYZ_DECIMALS, fmt_e, fmt_f, fmt_fixed, fmt_xyz};
 pub use parse::{BGCODE_MAGIC, Gcode, GcodeError, is_binary_gcode, parse};
 pub use summary::{Bounds, ExtrusionMode, Flavour, LayerSource, Summary, Units, summarize};

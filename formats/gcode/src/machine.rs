@@ -19,7 +19,7 @@
 //! - `G20`/`G21` inches/millimetres: every length, E and F included, is scaled by 25.4 in inch
 //!   mode.
 //! - `G92` sets the named axes (`G92 E0`); `G28` homes the named axes (all when none is named)
-//!   to 0.
+//!   to the machine's home position ([`Machine::with_home`]; 0 unless set).
 //! - `T<n>` selects a tool; `F` sets the feed rate (mm/min in the file, kept in mm/s).
 //! - Comment lines `;TYPE:<role>` / `; FEATURE: <role>` set the feature role, `;WIDTH:<mm>` the
 //!   extrusion width, and `;DISPENSE:ON` / `;DISPENSE:OFF` open and close a paste tool's valve
@@ -207,7 +207,21 @@ impl Moves {
 /// # Ok::<(), conduit_gcode::GcodeError>(())
 /// ```
 pub fn moves(gcode: &Gcode, firmware: impl Into<Firmware>) -> Moves {
-    let mut machine = Machine::new(firmware, 25.0);
+    moves_on(gcode, Machine::new(firmware, 25.0))
+}
+
+/// [`moves`] stepped on `machine` (its firmware, home position, start state).
+///
+/// ```
+/// use conduit_gcode::{Firmware, Machine, moves_on};
+///
+/// let g = conduit_gcode::parse(b"G28\nG1 X10\nG28 X\nG1 Y5\n")?;
+/// let m = moves_on(&g, Machine::new(Firmware::Marlin, 25.0).with_home([0.0, 0.0, 250.0]));
+/// assert_eq!(m.moves[0].from, [Some(0.0), Some(0.0), Some(250.0)]);
+/// assert_eq!(m.moves[1].from, [Some(0.0), Some(0.0), Some(250.0)]);
+/// # Ok::<(), conduit_gcode::GcodeError>(())
+/// ```
+pub fn moves_on(gcode: &Gcode, mut machine: Machine) -> Moves {
     let mut moves: Vec<Move> = gcode.lines.iter().filter_map(|l| machine.step(l)).collect();
     let level = |m: &Move| -> Option<i64> {
         m.to[2]
@@ -242,6 +256,8 @@ pub struct Machine {
     firmware: Firmware,
     reading: Reading,
     pos: Position,
+    /// Where `G28` puts each axis, mm.
+    home: [f64; 3],
     e: f64,
     coord_relative: bool,
     e_relative_flag: bool,
@@ -264,6 +280,7 @@ impl Machine {
             firmware: firmware.into(),
             reading: Reading::Firmware,
             pos: [None; 3],
+            home: [0.0; 3],
             e: 0.0,
             coord_relative: false,
             e_relative_flag: false,
@@ -288,6 +305,18 @@ impl Machine {
     pub fn with_position(mut self, position: Position) -> Self {
         self.pos = position;
         self
+    }
+
+    /// This machine with its home position at `home` [X, Y, Z] (mm): where `G28` puts the axes
+    /// it homes, as the firmware's endstops do (`[0, 0, 0]` unless set).
+    pub fn with_home(mut self, home: [f64; 3]) -> Self {
+        self.home = home;
+        self
+    }
+
+    /// The home position [X, Y, Z], mm.
+    pub fn home(&self) -> [f64; 3] {
+        self.home
     }
 
     /// The active tool (0 until a tool is selected).
@@ -441,10 +470,10 @@ impl Machine {
                     .map(|(i, _)| i)
                     .collect();
                 if named.is_empty() {
-                    self.pos = [Some(0.0); 3];
+                    self.pos = self.home.map(Some);
                 }
                 for i in named {
-                    self.pos[i] = Some(0.0);
+                    self.pos[i] = Some(self.home[i]);
                 }
             }
             Command::Absolute => {

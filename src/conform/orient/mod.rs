@@ -210,6 +210,9 @@ pub struct Oriented {
     pub report: ConformReport,
     /// The orientation figures.
     pub orientation: OrientationReport,
+    /// The vertices of the design on the surface seen from above (see
+    /// [`super::Planned::corners`]).
+    pub corners: Vec<[f64; 2]>,
 }
 
 /// Plans `design` placed by `place` on `surface` with tool axes per `o` (see the module docs).
@@ -221,7 +224,11 @@ pub fn plan(
     o: &OrientParams,
 ) -> Result<Oriented, ConformError> {
     if o.axis == ToolAxis::Vertical {
-        let Planned { paths, report } = super::plan(surface, design, place, params, |_| {})?;
+        let Planned {
+            paths,
+            report,
+            corners,
+        } = super::plan(surface, design, place, params, |_| {})?;
         let axes: Vec<Vec<Vector3>> = paths.iter().map(|p| vec![Vector3::z(); p.len()]).collect();
         let half = params.nozzle.tip_radius();
         // Normals under the tips; the whole-nozzle check of a vertical nozzle is the plan's own.
@@ -247,6 +254,7 @@ pub fn plan(
             axes,
             report,
             orientation,
+            corners,
         });
     }
     let d = params.nozzle.inner;
@@ -323,6 +331,7 @@ pub fn plan(
         axes,
         report,
         orientation,
+        corners: super::correct::corners(&projected.paths, super::corner_skip(params)),
     })
 }
 
