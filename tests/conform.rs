@@ -895,10 +895,10 @@ fn the_readme_example_prints_the_monopole_on_the_sample_film() {
     assert!(views.join("side_xz.svg").is_file() && views.join("layer_0001.svg").is_file());
 }
 
-/// Issue 25's fold: creases along a direction 11.25° off the y axis (half a step of the old 16
+/// The creased fold: creases along a direction 11.25° off the y axis (half a step of the old 16
 /// rim samples), flanks of 30°, 47° and 60° in turn, 1 mm high: every crease (V and Λ) far
 /// sharper than the 0.5 mm tip disc.
-fn issue_25_fold() -> Surface {
+fn creased_fold() -> Surface {
     let (sin, cos) = 11.25f64.to_radians().sin_cos();
     let flanks = [30f64, 47.0, 60.0].map(|a| a.to_radians().tan());
     let profile = move |a: f64| {
@@ -1017,8 +1017,8 @@ fn printed_moves(written: &conduit::pipeline::conform::Written) -> Vec<[Point3; 
 }
 
 #[test]
-fn issue_25_the_fold_is_printed_without_contact_by_the_exact_query_and_dense_sampling_agrees() {
-    let s = issue_25_fold();
+fn accuracy_the_fold_is_printed_without_contact_by_the_exact_query_and_dense_sampling_agrees() {
+    let s = creased_fold();
     let p = params(Corrections::default(), Mapping::Projection);
     let cfg = Config::default();
     // Lines across the creases and along them, and a zigzag.
@@ -1111,7 +1111,7 @@ fn issue_25_the_fold_is_printed_without_contact_by_the_exact_query_and_dense_sam
 /// none across, d/2 going up) and with it the tip's height over the surface, which adds
 /// 0.6–0.8 % on the ramp, the bump and the wrinkled film: measured and printed.
 #[test]
-fn issue_25_printed_paths_keep_the_designs_length_and_corners() {
+fn accuracy_printed_paths_keep_the_designs_length_and_corners() {
     let mut surfaces = generated_surfaces();
     surfaces.push((
         "gentle swell".to_owned(),
@@ -1183,11 +1183,11 @@ fn issue_25_printed_paths_keep_the_designs_length_and_corners() {
     }
 }
 
-/// Issue 25: a film over the machine's origin and a G-code that homes before its first move.
+/// A film over the machine's origin and a G-code that homes before its first move.
 /// Homing puts the nozzle at `printer.home` (by default the bed's origin at the top), not at
 /// (0, 0, 0) inside the film.
 #[test]
-fn issue_25_homing_before_the_first_move_makes_no_phantom_contact() {
+fn accuracy_homing_before_the_first_move_makes_no_phantom_contact() {
     use conduit::conform::replay::{ReplayMachine, replay};
     let s = surface(height_field(-20.0, -20.0, 20.0, 20.0, 40, &|x, y| {
         1.0 + 0.1 * (x * 0.3).sin() * (y * 0.2).cos()

@@ -306,7 +306,7 @@ mod tests {
 
     #[test]
     fn the_rim_over_a_crease_between_sample_angles_is_found_to_a_tenth_of_a_micrometre() {
-        // Issue 25: 47° flanks, the crease turned half a sample step (11.25°) from the samples'
+        // A fold with 47° flanks, the crease turned half a sample step (11.25°) from the samples'
         // directions. Over the crease the highest point of the disc is on its rim across the
         // crease: r·tan 47° above the crease; the 16 rim samples nearest it are 11.25° off and
         // 5 µm lower.
