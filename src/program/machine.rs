@@ -43,7 +43,7 @@ pub struct Printer {
     /// Where `G28` puts the axes [X, Y, Z], mm, as the firmware's endstops do: what `conduit
     /// check` and the replays of conform and the viewer take as the position after homing
     /// (`G28 X Y` homes only the named axes). Absent = the bed's front-left corner at the top,
-    /// [`bed_origin[0]`, `bed_origin[1]`, `max_height`] (a Z endstop at the top keeps the
+    /// (`bed_origin[0]`, `bed_origin[1]`, `max_height`) (a Z endstop at the top keeps the
     /// nozzle clear of whatever is on the bed, and so does this default). Default absent.
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schemars(example = [0.0, 0.0, 250.0])]
