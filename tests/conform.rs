@@ -957,7 +957,7 @@ fn creased_fold() -> Surface {
 /// found to a fraction of a micrometre, as a rim contact is by the rings.
 fn dense_disc_max(s: &Surface, x: f64, y: f64, r: f64, rings: usize, angles: usize) -> f64 {
     let mut best = (s.height(x, y).unwrap_or(f64::MIN), [x, y]);
-    let mut take = |q: [f64; 2], best: &mut (f64, [f64; 2])| {
+    let take = |q: [f64; 2], best: &mut (f64, [f64; 2])| {
         if (q[0] - x).hypot(q[1] - y) <= r
             && let Some(h) = s.height(q[0], q[1])
             && h > best.0

@@ -70,12 +70,16 @@ fn circle_crossings(a: [f64; 2], b: [f64; 2], r: f64) -> impl Iterator<Item = f6
     roots.into_iter().filter(|t| (0.0..=1.0).contains(t))
 }
 
+/// The gradient of an affine function over a triangle and the triangle's frame: its edges
+/// from the first corner and their cross product.
+type Frame = ([f64; 2], [f64; 2], [f64; 2], f64);
+
 /// An affine function over a triangle: its value at the corners and its gradient.
 struct Affine {
     p: [[f64; 2]; 3],
     vals: [f64; 3],
     /// Gradient and the triangle's frame, when the triangle is two-dimensional.
-    frame: Option<([f64; 2], [f64; 2], [f64; 2], f64)>,
+    frame: Option<Frame>,
 }
 
 impl Affine {
