@@ -35,6 +35,7 @@ use super::congestion::History;
 use super::graph::{
     Eroded, Grown, LayerGeometry, LayerInput, PENALTY_FACTOR, bbox, box_union, boxes_meet, prepare,
 };
+use super::index::{dist, lerp};
 use super::{
     Blockage, NearPad, PadCopper, Phase, RoundLog, RouteProgress, Strategy, Unrouted, wire_order,
 };
@@ -115,11 +116,7 @@ fn exit_bound(start: &Wire, taps: &[Tap], frame: [i64; 4]) -> f64 {
             } else {
                 // The piece crosses the line at `x`: its near part is reached over the line,
                 // its far part straight.
-                let t = sp as f64 / (sp - sq) as f64;
-                let x = Point2::new(
-                    p.x + ((q.x - p.x) as f64 * t).round() as i64,
-                    p.y + ((q.y - p.y) as f64 * t).round() as i64,
-                );
+                let x = lerp(p, q, sp as f64 / (sp - sq) as f64);
                 let (near, far) = if sp >= 0 { (p, q) } else { (q, p) };
                 segment_distance(m, near, x).min(segment_distance(a, x, far))
             };
@@ -138,7 +135,7 @@ fn least_length(start: &Wire, taps: &[Tap]) -> f64 {
         .iter()
         .map(|t| segment_distance(a, t.a, t.b))
         .fold(f64::INFINITY, f64::min);
-    unscaled(1) * tap.min(segment_distance(a, target, target))
+    unscaled(1) * tap.min(dist(a, target))
 }
 
 /// `pads` grouped by layer and [`PAD_GROUP_MM`] cell of their centres, in a fixed order.
@@ -770,14 +767,14 @@ impl<'a> Board<'a> {
         // the full window is cheaper, so only the wires that need the room pay for it (their
         // tight search is the price, about a tenth more time where the layers are plain and
         // the search itself dominates, as on the 100-net benchmark).
+        let window = self.window(wire, traces, None);
         if matches!(traces, Traces::Obstacles) {
-            let full = bbox(&self.window(wire, traces, None));
             let tight = self.window(wire, traces, Some(tight_grow(wire)));
             let frame = bbox(&tight);
             let reach = exit_bound(&start, &taps, frame) - 2.0 * self.params.align_tolerance;
             // A window every route leaves (a trace of the net close by, outside it) is not
             // worth a search.
-            if !tight.is_empty() && frame != full && reach > least_length(&start, &taps) {
+            if !tight.is_empty() && frame != bbox(&window) && reach > least_length(&start, &taps) {
                 let bound = min_weight(self.params) * reach;
                 match self.run(
                     i,
@@ -794,7 +791,6 @@ impl<'a> Board<'a> {
                 }
             }
         }
-        let window = self.window(wire, traces, None);
         self.run(i, range, &start, taps, &window, traces, f64::INFINITY)
             .unwrap_or_else(|| self.out_of_time(i))
     }
