@@ -457,7 +457,7 @@ fn every_design_on_every_surface_prints_without_contact_and_below_no_corrections
         "{all:?}"
     );
     assert!(full < 0.9 * none, "{full} {none}");
-    // The published curvature term moves the deposit by micrometres: within 3 µm (three steps
+    // The published curvature term moves the deposit by micrometres: within 5 µm (five steps
     // of the G-code's grid) of its slope-only control on every surface; it helps in valleys
     // and folds and costs a little on convex bumps, where the method's downhill shift already
     // falls short.
@@ -468,7 +468,7 @@ fn every_design_on_every_surface_prints_without_contact_and_below_no_corrections
     }
     for r in &runs {
         assert!(
-            (r.mae[2] - r.mae[3]).abs() < 0.003,
+            (r.mae[2] - r.mae[3]).abs() < 0.005,
             "{}: {:?}",
             r.name,
             r.mae

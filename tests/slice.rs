@@ -1432,35 +1432,45 @@ fn header_seconds(text: &str) -> f64 {
 
 #[test]
 fn the_header_estimate_is_the_time_check_plans() {
-    // One motion model for both: they differ only by the start G-code's moves (the prime line),
-    // which `check` replays and the writer passes through as text.
+    // One motion model for both, the custom G-code's moves included: the start G-code's homing
+    // and prime line, the tool-change snippets' lifts.
     let dir = temp_dir();
-    let mut cases: Vec<(&str, Vec<PathBuf>, Vec<&str>)> = vec![
-        ("cube", vec![sample("cube_20mm.stl")], vec![]),
+    let two_tool = sample("two_tool_printer.toml");
+    let two_tool_arg = two_tool.to_string_lossy().into_owned();
+    let mut cases: Vec<(&str, Vec<PathBuf>, Vec<&str>, Option<&Path>)> = vec![
+        ("cube", vec![sample("cube_20mm.stl")], vec![], None),
         (
             "bracket",
             vec![sample("l_bracket.obj")],
             vec!["--set", "slice.infill_pattern=grid"],
+            None,
         ),
-        ("thin", vec![sample("thin_walls.stl")], vec![]),
+        ("thin", vec![sample("thin_walls.stl")], vec![], None),
+        (
+            "two_tool",
+            vec![sample("l_bracket.obj")],
+            vec!["-c", &two_tool_arg],
+            Some(&two_tool),
+        ),
     ];
     if let Some(corpus) = corpus() {
         let benchy = corpus.join("bench-models/3DBenchy.stl");
         if benchy.exists() {
-            cases.push(("benchy", vec![benchy], vec![]));
+            cases.push(("benchy", vec![benchy], vec![], None));
         }
     }
-    for (name, models, extra) in cases {
+    for (name, models, extra, config) in cases {
         let s = slice(dir.path(), name, &models, &extra);
         let header = header_seconds(&s.gcode);
-        let (code, v) = check_cli(&dir.path().join(format!("{name}.gcode")), None);
+        let (code, v) = check_cli(&dir.path().join(format!("{name}.gcode")), config);
         assert_eq!(code, Some(0), "{name}: {v}");
         let planned = v["stats"]["estimated_time_s"]
             .as_f64()
             .expect("estimated_time_s");
         println!("{name}: header {header} s, check {planned:.1} s");
+        // The header rounds to the second.
         assert!(
-            (header - planned).abs() <= 0.01 * planned + 5.0,
+            (header - planned).abs() <= 1.0,
             "{name}: header {header} s, check {planned} s"
         );
     }

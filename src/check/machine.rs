@@ -306,14 +306,8 @@ impl Checker<'_> {
         let (length, de, has_xy, path) = (mv.length, mv.e, mv.has_xy, &mv.path);
 
         // Time.
-        let v = mv.feed.min(self.p.max_feedrate);
-        if length > 0.0 {
-            let dir_in = direction(path.first(), path.get(1));
-            let dir_out = direction(path.iter().rev().nth(1), path.last());
-            self.planner.push(mv.line, length, v, dir_in, dir_out);
-        } else {
-            self.planner.push(mv.line, de.abs(), v, [0.0; 3], [0.0; 3]);
-        }
+        self.planner
+            .push_gcode_move(mv.line, mv, self.p.max_feedrate);
 
         // XY moves that extrude, or that dispense paste between `;DISPENSE:` markers.
         let extruding = mv.extruding;
@@ -573,25 +567,5 @@ impl Checker<'_> {
             stats: self.stats,
             move_times: std::mem::take(&mut self.planner.times),
         }
-    }
-}
-
-/// Unit vector from `a` to `b`, zero when either is unknown or they coincide.
-fn direction(a: Option<&Position>, b: Option<&Position>) -> [f64; 3] {
-    let (Some(a), Some(b)) = (a, b) else {
-        return [0.0; 3];
-    };
-    let mut d = [0.0; 3];
-    for k in 0..3 {
-        d[k] = match (a[k], b[k]) {
-            (Some(p), Some(q)) => q - p,
-            _ => 0.0,
-        };
-    }
-    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    if len > 0.0 {
-        d.map(|c| c / len)
-    } else {
-        [0.0; 3]
     }
 }

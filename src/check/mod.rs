@@ -181,7 +181,7 @@ impl CheckParams {
             max_acceleration: p.max_acceleration,
             jerk: crate::program::motion::JERK_MM_S,
             max_feedrate: crate::program::motion::MAX_FEEDRATE_MM_S,
-            default_feedrate: 25.0,
+            default_feedrate: crate::program::motion::DEFAULT_FEEDRATE_MM_S,
             max_findings_per_kind: 20,
         }
     }

@@ -211,7 +211,9 @@ fn place_tips(
     let mut placed: Vec<Placed> = Vec::with_capacity(t.len());
     let mut reached = f64::MIN;
     for (i, along) in shift.iter().enumerate() {
-        let lo = reached.max(track.s[i]);
+        // Never behind the tip before (a lateral escape may take a tip behind its own
+        // design point, away from the surface it met, but the path never runs backwards).
+        let lo = if i == 0 { track.s[0] } else { reached };
         let hi = track.limit(i).max(lo);
         let sigma = (track.s[i] + split[i].0 + along).clamp(lo, hi);
         reached = sigma;

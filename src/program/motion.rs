@@ -20,6 +20,10 @@ pub const JERK_MM_S: f64 = 10.0;
 /// Highest feed rate planned, mm/s: a cap on the machine's speed, far above any print move.
 pub const MAX_FEEDRATE_MM_S: f64 = 500.0;
 
+/// Feed rate of a move before any `F` word, mm/s: what `check` assumes at power-on and the
+/// writer for custom G-code moving before the writer's first `F`.
+pub const DEFAULT_FEEDRATE_MM_S: f64 = 25.0;
+
 /// One planned move.
 #[derive(Debug, Clone, Copy)]
 struct Block {
@@ -62,6 +66,21 @@ impl Planner {
             entry: None,
             total: 0.0,
             times: Vec::new(),
+        }
+    }
+
+    /// Queues a move of a G-code file as the firmware runs it, with id `id`: its path (arcs as
+    /// sampled) at its feed capped at `max_feedrate` mm/s, or its E change when it does not
+    /// move. `check` plans every move so, and the writer the moves of custom G-code.
+    pub fn push_gcode_move(&mut self, id: usize, mv: &conduit_gcode::Move, max_feedrate: f64) {
+        let v = mv.feed.min(max_feedrate);
+        if mv.length > 0.0 {
+            let path = &mv.path;
+            let dir_in = direction(path.first(), path.get(1));
+            let dir_out = direction(path.iter().rev().nth(1), path.last());
+            self.push(id, mv.length, v, dir_in, dir_out);
+        } else {
+            self.push(id, mv.e.abs(), v, [0.0; 3], [0.0; 3]);
         }
     }
 
@@ -183,6 +202,27 @@ pub(crate) fn trapezoid_time(length: f64, v: f64, a: f64) -> f64 {
         return length / v;
     }
     block_time(length, v, 0.0, 0.0, a)
+}
+
+/// Unit direction from `a` to `b` over their known axes (zero when either is missing or they
+/// coincide).
+fn direction(a: Option<&conduit_gcode::Position>, b: Option<&conduit_gcode::Position>) -> [f64; 3] {
+    let (Some(a), Some(b)) = (a, b) else {
+        return [0.0; 3];
+    };
+    let mut d = [0.0; 3];
+    for k in 0..3 {
+        d[k] = match (a[k], b[k]) {
+            (Some(p), Some(q)) => q - p,
+            _ => 0.0,
+        };
+    }
+    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    if len > 0.0 {
+        d.map(|c| c / len)
+    } else {
+        [0.0; 3]
+    }
 }
 
 #[cfg(test)]

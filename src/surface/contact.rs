@@ -37,6 +37,9 @@ const CONE_RING_MM: f64 = 0.5;
 const CONE_ANGLES: usize = 24;
 /// Points per rim of a cylinder's cross-section on an axis standing on edge.
 const CYLINDER_ANGLES: usize = 16;
+/// Depth of a tilted check within which the surface touches the tool (rounding of the tilted
+/// frame), mm: a nanometre, a thousandth of the G-code's grid.
+const TOUCH: f64 = 1e-9;
 
 /// Unit directions of the disc rings, computed once.
 static DIRECTIONS: std::sync::LazyLock<Vec<[f64; 2]>> = std::sync::LazyLock::new(|| {
@@ -237,7 +240,7 @@ impl ToolSolid {
                     for k in 1..=stations {
                         let s = (k as f64 * step).min(piece.height);
                         if !section(piece.bottom + s, radius, CYLINDER_ANGLES) {
-                            return worst;
+                            return settle(worst);
                         }
                     }
                 }
@@ -252,8 +255,15 @@ impl ToolSolid {
                 }
             }
         }
-        worst
+        settle(worst)
     }
+}
+
+/// A tilted check's depth with rounding settled: a tilted disc whose rim rests on the plane it
+/// leans to touches it exactly, and the frame's rounding leaves femtometres either way, which
+/// are a touch ([`TOUCH`]), not a contact.
+fn settle(depth: f64) -> f64 {
+    if depth.abs() < TOUCH { 0.0 } else { depth }
 }
 
 /// The scanned surface as an obstacle: the contact is [`ToolSolid::penetration`] (> 0: the

@@ -732,3 +732,33 @@ fn a_switch_lead_time_runs_in_and_switches_off_before_the_end() {
     let s = stats.switched.expect("switched totals");
     assert!((s.printed_mm - (1.0 + std::f64::consts::FRAC_PI_2)).abs() < 1e-12);
 }
+
+#[test]
+fn tool_change_snippets_that_move_the_nozzle_leave_every_extrusion_at_its_layer() {
+    // A wipe and lift in the tool-change G-code: the writer follows the snippet's moves, so
+    // the next tool's first travel writes its own Z and F again instead of printing at the
+    // snippet's height and speed.
+    let mut cfg = two_tool_config();
+    cfg.printer.after_tool_change_gcode = "G1 Z{layer_z} F600\nG91\nG1 Z8\nG90\nG1 X150 Y5 F9000".to_owned();
+    let (text, _) = write(&two_tool_program(), &cfg);
+    let (_, moves) = replay(&text);
+    let layer_of = |z: f64| if z < 0.3 { 0.2 } else { 0.4 };
+    let extrusions: Vec<&Move> = moves.iter().filter(|m| m.de > 0.0 && m.moves_xy()).collect();
+    assert!(extrusions.len() >= 16, "{text}");
+    for m in extrusions {
+        let z = m.to[2];
+        assert!((z - layer_of(z)).abs() < 1e-9, "extrusion at z {z}: {text}");
+        assert!(m.from[0] < 100.0 && m.to[0] < 100.0, "extrusion from the wipe: {text}");
+    }
+    // Every travel after a snippet names its feed: the snippet's F9000 is not the travel's.
+    let lines: Vec<&str> = text.lines().collect();
+    for (i, l) in lines.iter().enumerate() {
+        if l.starts_with("G1 X150 Y5") {
+            let next_move = lines[i + 1..]
+                .iter()
+                .find(|l| l.starts_with("G1 X") || l.starts_with("G1 Z"))
+                .expect("a move after the snippet");
+            assert!(next_move.contains(" F"), "{next_move}: {text}");
+        }
+    }
+}

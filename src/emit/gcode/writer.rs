@@ -15,7 +15,7 @@ use super::sink::{GcodeSink, Motion, MotionKind};
 use super::{EmitError, GcodeStats, Resume, ToolStats};
 use crate::geom::Point3;
 use crate::program::machine::{Flavor, ToolKind};
-use crate::program::motion::{JERK_MM_S, MAX_FEEDRATE_MM_S, Planner};
+use crate::program::motion::{DEFAULT_FEEDRATE_MM_S, JERK_MM_S, MAX_FEEDRATE_MM_S, Planner};
 use crate::program::{Event, Feed, Layer, LayerItem, Program, Toolpath};
 
 /// Largest distance between an arc of a path's segments and the chords the FFF style writes
@@ -84,8 +84,13 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     dialect: Dialect,
     relative_e: bool,
     tools: Vec<ToolState>,
-    /// Nozzle position (machine coordinates); `None` until the first XY move.
+    /// Nozzle position (machine coordinates) the writer's moves start from; `None` until the
+    /// first XY move and after custom G-code that moved it somewhere unknown.
     pos: Option<Point3>,
+    /// Nozzle position as the motion model follows it, custom G-code's moves included
+    /// (`G28` to `printer.home`, the start G-code's prime line): where the next planned move
+    /// starts; `None` while an axis is unknown.
+    at: Option<Point3>,
     /// Z written last, when known, and as written.
     z: Option<f64>,
     z_str: Option<String>,
@@ -171,6 +176,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             relative_e: cfg.printer.use_relative_e_distances,
             tools,
             pos: None,
+            at: None,
             z: None,
             z_str: None,
             e: 0.0,
@@ -198,11 +204,77 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         self.sink.line(line);
     }
 
+    /// Writes custom G-code (templates, part events) as is and follows it as the firmware
+    /// runs it: its moves are planned from where the nozzle is (after `G28`, from
+    /// `printer.home`), so the header's estimate includes them as `check`'s does. A block that
+    /// moves the nozzle away from where the writer knows it leaves the writer's position, Z and
+    /// feed as the block left them (unknown when the block leaves them so), so the next move
+    /// writes its own.
     fn lines(&mut self, lines: &[String]) {
+        use conduit_gcode::{Line, LineEnding, Machine};
+        let start = self
+            .at
+            .map_or([None; 3], |p| [Some(p.x), Some(p.y), Some(p.z)]);
+        let feed = self
+            .feed
+            .as_deref()
+            .and_then(|f| f.parse::<f64>().ok())
+            .map_or(DEFAULT_FEEDRATE_MM_S, |f| f / 60.0);
+        let mut machine = Machine::new(self.cfg.printer.flavor, feed)
+            .with_home(self.cfg.printer.home_position())
+            .with_position(start);
+        let e_mode = if self.relative_e { "M83" } else { "M82" };
+        machine.step(&Line::new(e_mode, LineEnding::Lf));
+        machine.step(&Line::new(
+            format!("G92 E{}", fmt_e(self.e)),
+            LineEnding::Lf,
+        ));
+        let (mut moved_xy, mut moved_z, mut sets_feed) = (false, false, false);
         for l in lines {
             self.plan_command(l);
+            let parsed = Line::new(l.as_str(), LineEnding::Lf);
+            sets_feed |= parsed.get(b'F').is_some();
+            if let Some(mv) = machine.step(&parsed) {
+                moved_xy |= mv.from[0] != mv.to[0] || mv.from[1] != mv.to[1];
+                moved_z |= mv.from[2] != mv.to[2];
+                self.plan_custom(&mv);
+            }
             self.sink.line(l);
         }
+        let end = machine.position();
+        self.at = match end {
+            [Some(x), Some(y), Some(z)] => Some(Point3::new(x, y, z)),
+            _ => None,
+        };
+        // The writer's own state where the block changed it: a position it knew and the block
+        // moved (the next travel starts there), a Z it wrote (the next move writes Z again
+        // when the block left it elsewhere), the F in force.
+        if moved_xy && self.pos.is_some() {
+            self.pos = self.at;
+        }
+        if moved_z && self.z.is_some() {
+            match end[2] {
+                Some(z) => self.set_z(z),
+                None => {
+                    self.z = None;
+                    self.z_str = None;
+                }
+            }
+            if let (Some(p), Some(z)) = (self.pos.as_mut(), end[2]) {
+                p.z = z;
+            }
+        }
+        if sets_feed {
+            self.feed = None;
+        }
+    }
+
+    /// Plans a move of custom G-code as `check` does.
+    fn plan_custom(&mut self, mv: &conduit_gcode::Move) {
+        self.planner
+            .push_gcode_move(self.next_move, mv, MAX_FEEDRATE_MM_S);
+        self.next_move += 1;
+        self.planned.push_back(None);
     }
 
     /// The motion model's side of a command line written as is (custom G-code, events): the
@@ -260,12 +332,12 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         feed: f64,
         role: Option<crate::program::Role>,
     ) {
-        let distance = match (kind, self.pos) {
+        let distance = match (kind, self.at) {
             (MotionKind::Retract | MotionKind::Unretract, _) => e.abs(),
             (_, Some(from)) => (to - from).norm(),
             (_, None) => 0.0,
         };
-        let direction = match (kind, self.pos) {
+        let direction = match (kind, self.at) {
             (MotionKind::Retract | MotionKind::Unretract, _) => [0.0; 3],
             (_, Some(from)) if distance > 0.0 => {
                 let d = (to - from) / distance;
@@ -299,6 +371,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             feed,
         };
         self.sink.motion(&m);
+        if !matches!(kind, MotionKind::Retract | MotionKind::Unretract) {
+            self.at = Some(to);
+        }
     }
 
     /// The F word for `mm_s`, or nothing when it is the one in force.
@@ -415,6 +490,21 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             let to = Point3::new(p.x, p.y, z);
             self.motion(MotionKind::Travel, to, 0.0, speed, None);
             self.pos = Some(to);
+        } else if let Some(a) = self.at {
+            // Where custom G-code left the nozzle: timed, though the writer's moves do not
+            // start there.
+            let length = (z - a.z).abs();
+            let dir = [0.0, 0.0, (z - a.z).signum()];
+            self.planner.push(
+                self.next_move,
+                length,
+                speed.min(MAX_FEEDRATE_MM_S),
+                dir,
+                dir,
+            );
+            self.next_move += 1;
+            self.planned.push_back(None);
+            self.at = Some(Point3::new(a.x, a.y, z));
         }
     }
 
@@ -586,6 +676,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         }
         self.tool = Some(at.tool);
         self.pos = Some(at.position);
+        self.at = Some(at.position);
         self.set_z(at.position.z);
         self.e = at.e;
         self.relative_e = at.relative_e;
