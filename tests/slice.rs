@@ -1437,7 +1437,9 @@ fn the_header_estimate_is_the_time_check_plans() {
     let dir = temp_dir();
     let two_tool = sample("two_tool_printer.toml");
     let two_tool_arg = two_tool.to_string_lossy().into_owned();
-    let mut cases: Vec<(&str, Vec<PathBuf>, Vec<&str>, Option<&Path>)> = vec![
+    // Name, models, extra arguments, configuration for `check`.
+    type Case<'a> = (&'a str, Vec<PathBuf>, Vec<&'a str>, Option<&'a Path>);
+    let mut cases: Vec<Case> = vec![
         ("cube", vec![sample("cube_20mm.stl")], vec![], None),
         (
             "bracket",

@@ -309,6 +309,11 @@ impl Search {
         self.cost_limit = self.cost_limit.min(cap);
     }
 
+    /// Gives up after `n` expansions too (failing with [`Unrouted::SearchLimit`]).
+    pub(crate) fn cap_expansions(&mut self, n: usize) {
+        self.params.max_expansions = self.params.max_expansions.min(n);
+    }
+
     /// Where the search stands.
     pub fn state(&self) -> SearchState {
         self.state

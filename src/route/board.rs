@@ -61,6 +61,10 @@ const TOUCH_MM2: f64 = 1e-6;
 /// attempt of their own, down to this many levels.
 const RIP_UP_DEPTH: usize = 2;
 
+/// Expansions of the short look from a wire's far pad (see [`Board::search`]): a pad boxed in
+/// by other nets' traces is proven so in a few dozen.
+const ENCLOSURE_EXPANSIONS: usize = 400;
+
 /// Extra margin of a wire's routing window beyond the farthest its route may go, mm.
 const WINDOW_MARGIN_MM: f64 = 2.0;
 
@@ -291,6 +295,10 @@ pub(crate) struct Board<'a> {
     /// Layer geometry of negotiation rounds by (layer, net, routing window): the material less
     /// other nets' pads, the same in every round.
     geometry: HashMap<(usize, String, BBox), Rc<LayerGeometry>>,
+    /// Layer geometry of the wire being searched by (layer, net, routing window): the board as
+    /// it stands is the same for every search of one wire (from either pad), so it is built
+    /// once; emptied when the next wire's search starts.
+    wire_geometry: HashMap<(usize, String, BBox), Rc<LayerGeometry>>,
     /// When routing must stop.
     deadline: Option<Instant>,
     /// Whether the deadline stopped any work.
@@ -343,6 +351,7 @@ impl<'a> Board<'a> {
             eroded: vec![OnceCell::new(); layers.len()],
             routes: vec![None; wires.len()],
             geometry: HashMap::new(),
+            wire_geometry: HashMap::new(),
             deadline,
             stopped: false,
         }
@@ -739,6 +748,7 @@ impl<'a> Board<'a> {
     /// A search still running at the deadline gives up: the wire is out of time.
     fn search(&mut self, i: usize, traces: &Traces) -> WireRoute {
         let wire = &self.wires[i].clone();
+        self.wire_geometry.clear();
         let Some(range) = layer_range(self.layers, wire, self.params) else {
             return trace::unrouted(wire, Unrouted::NoLayer);
         };
@@ -791,8 +801,60 @@ impl<'a> Board<'a> {
                 }
             }
         }
-        self.run(i, range, &start, taps, &window, traces, f64::INFINITY)
-            .unwrap_or_else(|| self.out_of_time(i))
+        // With no trace of the net to end on, the route may be searched from either pad, and
+        // the two searches differ: a pad boxed in by other nets' traces is proven unreachable
+        // from its own side in a few dozen expansions, where the search from the other side
+        // floods everything within the detour limit first; and each search's grid is laid out
+        // from its own start, so a narrow gap one of them misses the other may pass. So the
+        // far pad gets a short look first, and the whole search from it when the near one
+        // runs out of detour.
+        let reverse = taps.is_empty().then(|| Wire {
+            net: start.net.clone(),
+            from: start.to,
+            to: start.from,
+        });
+        if let Some(reverse) = &reverse {
+            let look = self.run_limited(
+                i,
+                range.clone(),
+                reverse,
+                Vec::new(),
+                &window,
+                traces,
+                Some(ENCLOSURE_EXPANSIONS),
+            );
+            match look {
+                None => return self.out_of_time(i),
+                Some(r) if r.routed || r.reason == Some(Unrouted::NoPath) => return r,
+                Some(_) => {}
+            }
+        }
+        let Some(route) = self.run(
+            i,
+            range.clone(),
+            &start,
+            taps,
+            &window,
+            traces,
+            f64::INFINITY,
+        ) else {
+            return self.out_of_time(i);
+        };
+        match reverse {
+            Some(reverse) if route.reason == Some(Unrouted::Detour) => self
+                .run(
+                    i,
+                    range,
+                    &reverse,
+                    Vec::new(),
+                    &window,
+                    traces,
+                    f64::INFINITY,
+                )
+                .filter(|r| r.routed)
+                .unwrap_or(route),
+            _ => route,
+        }
     }
 
     /// Runs the search of wire `i` (from `start`, ending on its far pad or `taps`) on the
@@ -809,6 +871,46 @@ impl<'a> Board<'a> {
         traces: &Traces,
         cap: f64,
     ) -> Option<WireRoute> {
+        self.run_capped(i, range, start, taps, window, traces, cap, None)
+    }
+
+    /// [`Self::run`] without a cost cap, giving up after `expansions` expansions if given.
+    #[allow(clippy::too_many_arguments)]
+    fn run_limited(
+        &mut self,
+        i: usize,
+        range: std::ops::RangeInclusive<usize>,
+        start: &Wire,
+        taps: Vec<Tap>,
+        window: &[ExPolygon],
+        traces: &Traces,
+        expansions: Option<usize>,
+    ) -> Option<WireRoute> {
+        self.run_capped(
+            i,
+            range,
+            start,
+            taps,
+            window,
+            traces,
+            f64::INFINITY,
+            expansions,
+        )
+    }
+
+    /// [`Self::run`], giving up after `expansions` expansions if given.
+    #[allow(clippy::too_many_arguments)]
+    fn run_capped(
+        &mut self,
+        i: usize,
+        range: std::ops::RangeInclusive<usize>,
+        start: &Wire,
+        taps: Vec<Tap>,
+        window: &[ExPolygon],
+        traces: &Traces,
+        cap: f64,
+        expansions: Option<usize>,
+    ) -> Option<WireRoute> {
         let wire = &self.wires[i];
         // In a negotiation round the layer's geometry (the material less other nets' pads) is
         // the same in every round, only the prices change: it is built once per layer, net and
@@ -817,25 +919,33 @@ impl<'a> Board<'a> {
         let frame = bbox(window);
         let keys: Vec<(usize, String, BBox)> =
             range.map(|l| (l, wire.net.clone(), frame)).collect();
-        let known: Vec<Option<Rc<LayerGeometry>>> = keys
-            .iter()
-            .map(|k| keep.then(|| self.geometry.get(k).cloned()).flatten())
-            .collect();
+        let kept = if keep {
+            &self.geometry
+        } else {
+            &self.wire_geometry
+        };
+        let known: Vec<Option<Rc<LayerGeometry>>> =
+            keys.iter().map(|k| kept.get(k).cloned()).collect();
         let inputs: Vec<LayerInput> = keys
             .iter()
             .zip(&known)
             .map(|(k, g)| self.input(k.0, wire, traces, window, g.is_some()))
             .collect();
         let layers = prepare(&inputs, known, self.params);
-        if keep {
-            for (key, layer) in keys.into_iter().zip(&layers) {
-                self.geometry
-                    .entry(key)
-                    .or_insert_with(|| Rc::clone(&layer.geometry));
-            }
+        let kept = if keep {
+            &mut self.geometry
+        } else {
+            &mut self.wire_geometry
+        };
+        for (key, layer) in keys.into_iter().zip(&layers) {
+            kept.entry(key)
+                .or_insert_with(|| Rc::clone(&layer.geometry));
         }
         let mut search = Search::with_prepared(layers, self.layers, start, self.params, taps);
         search.cap_cost(cap);
+        if let Some(n) = expansions {
+            search.cap_expansions(n);
+        }
         let mut steps = 0usize;
         while search.step() == SearchState::Running {
             steps += 1;

@@ -716,3 +716,22 @@ fn an_impossible_board_names_what_blocks_each_unrouted_wire() {
     assert!(!blockage.way_without_traces);
     assert!(blockage.traces.is_empty());
 }
+
+#[test]
+fn a_pad_on_an_island_of_its_own_is_proven_unreachable_from_its_side() {
+    // The near pad's search would flood the plate up to the detour limit; the short look from
+    // the far pad, boxed in on its island, runs out of material at once.
+    let layers = stack(
+        vec![
+            solid(rect(0.0, 0.0, 40.0, 40.0)),
+            solid(rect(43.0, 18.0, 47.0, 22.0)),
+        ],
+        3,
+    );
+    let z = top(&layers);
+    let wires = [wire("boxed", (37.0, 20.0, z), (45.0, 20.0, z))];
+    let result = route(&layers, &wires, &end_pads(&wires), &RouteParams::default());
+    let boxed = &result.wires[0];
+    assert!(!boxed.routed);
+    assert_eq!(boxed.reason, Some(Unrouted::NoPath));
+}

@@ -739,16 +739,23 @@ fn tool_change_snippets_that_move_the_nozzle_leave_every_extrusion_at_its_layer(
     // the next tool's first travel writes its own Z and F again instead of printing at the
     // snippet's height and speed.
     let mut cfg = two_tool_config();
-    cfg.printer.after_tool_change_gcode = "G1 Z{layer_z} F600\nG91\nG1 Z8\nG90\nG1 X150 Y5 F9000".to_owned();
+    cfg.printer.after_tool_change_gcode =
+        "G1 Z{layer_z} F600\nG91\nG1 Z8\nG90\nG1 X150 Y5 F9000".to_owned();
     let (text, _) = write(&two_tool_program(), &cfg);
     let (_, moves) = replay(&text);
     let layer_of = |z: f64| if z < 0.3 { 0.2 } else { 0.4 };
-    let extrusions: Vec<&Move> = moves.iter().filter(|m| m.de > 0.0 && m.moves_xy()).collect();
+    let extrusions: Vec<&Move> = moves
+        .iter()
+        .filter(|m| m.de > 0.0 && m.moves_xy())
+        .collect();
     assert!(extrusions.len() >= 16, "{text}");
     for m in extrusions {
         let z = m.to[2];
         assert!((z - layer_of(z)).abs() < 1e-9, "extrusion at z {z}: {text}");
-        assert!(m.from[0] < 100.0 && m.to[0] < 100.0, "extrusion from the wipe: {text}");
+        assert!(
+            m.from[0] < 100.0 && m.to[0] < 100.0,
+            "extrusion from the wipe: {text}"
+        );
     }
     // Every travel after a snippet names its feed: the snippet's F9000 is not the travel's.
     let lines: Vec<&str> = text.lines().collect();
