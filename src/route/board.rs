@@ -65,6 +65,21 @@ const RIP_UP_DEPTH: usize = 2;
 /// by other nets' traces is proven so in a few dozen.
 const ENCLOSURE_EXPANSIONS: usize = 400;
 
+/// What one search may spend beyond its own limits: routes up to `cost`, `expansions` steps.
+#[derive(Debug, Clone, Copy)]
+struct Budget {
+    cost: f64,
+    expansions: usize,
+}
+
+impl Budget {
+    /// No more than the search's own detour and expansion limits.
+    const FULL: Budget = Budget {
+        cost: f64::INFINITY,
+        expansions: usize::MAX,
+    };
+}
+
 /// Extra margin of a wire's routing window beyond the farthest its route may go, mm.
 const WINDOW_MARGIN_MM: f64 = 2.0;
 
@@ -760,12 +775,7 @@ impl<'a> Board<'a> {
         } else {
             let (from_taps, to_taps) = (self.taps(&from_wires), self.taps(&to_wires));
             if from_taps.len() > to_taps.len() {
-                let reversed = Wire {
-                    net: wire.net.clone(),
-                    from: wire.to,
-                    to: wire.from,
-                };
-                (reversed, from_taps)
+                (wire.reversed(), from_taps)
             } else {
                 (wire.clone(), to_taps)
             }
@@ -785,7 +795,10 @@ impl<'a> Board<'a> {
             // A window every route leaves (a trace of the net close by, outside it) is not
             // worth a search.
             if !tight.is_empty() && frame != bbox(&window) && reach > least_length(&start, &taps) {
-                let bound = min_weight(self.params) * reach;
+                let budget = Budget {
+                    cost: min_weight(self.params) * reach,
+                    ..Budget::FULL
+                };
                 match self.run(
                     i,
                     range.clone(),
@@ -793,7 +806,7 @@ impl<'a> Board<'a> {
                     taps.clone(),
                     &tight,
                     traces,
-                    bound,
+                    budget,
                 ) {
                     None => return self.out_of_time(i),
                     Some(route) if route.routed => return route,
@@ -808,20 +821,20 @@ impl<'a> Board<'a> {
         // from its own start, so a narrow gap one of them misses the other may pass. So the
         // far pad gets a short look first, and the whole search from it when the near one
         // runs out of detour.
-        let reverse = taps.is_empty().then(|| Wire {
-            net: start.net.clone(),
-            from: start.to,
-            to: start.from,
-        });
+        let reverse = taps.is_empty().then(|| start.reversed());
         if let Some(reverse) = &reverse {
-            let look = self.run_limited(
+            let budget = Budget {
+                expansions: ENCLOSURE_EXPANSIONS,
+                ..Budget::FULL
+            };
+            let look = self.run(
                 i,
                 range.clone(),
                 reverse,
                 Vec::new(),
                 &window,
                 traces,
-                Some(ENCLOSURE_EXPANSIONS),
+                budget,
             );
             match look {
                 None => return self.out_of_time(i),
@@ -836,7 +849,7 @@ impl<'a> Board<'a> {
             taps,
             &window,
             traces,
-            f64::INFINITY,
+            Budget::FULL,
         ) else {
             return self.out_of_time(i);
         };
@@ -849,7 +862,7 @@ impl<'a> Board<'a> {
                     Vec::new(),
                     &window,
                     traces,
-                    f64::INFINITY,
+                    Budget::FULL,
                 )
                 .filter(|r| r.routed)
                 .unwrap_or(route),
@@ -858,8 +871,8 @@ impl<'a> Board<'a> {
     }
 
     /// Runs the search of wire `i` (from `start`, ending on its far pad or `taps`) on the
-    /// layers of `range` within `window`, giving up on routes that cost more than `cap`;
-    /// `None` if the deadline passed while it ran.
+    /// layers of `range` within `window`, within `budget`; `None` if the deadline passed while
+    /// it ran.
     #[allow(clippy::too_many_arguments)]
     fn run(
         &mut self,
@@ -869,47 +882,7 @@ impl<'a> Board<'a> {
         taps: Vec<Tap>,
         window: &[ExPolygon],
         traces: &Traces,
-        cap: f64,
-    ) -> Option<WireRoute> {
-        self.run_capped(i, range, start, taps, window, traces, cap, None)
-    }
-
-    /// [`Self::run`] without a cost cap, giving up after `expansions` expansions if given.
-    #[allow(clippy::too_many_arguments)]
-    fn run_limited(
-        &mut self,
-        i: usize,
-        range: std::ops::RangeInclusive<usize>,
-        start: &Wire,
-        taps: Vec<Tap>,
-        window: &[ExPolygon],
-        traces: &Traces,
-        expansions: Option<usize>,
-    ) -> Option<WireRoute> {
-        self.run_capped(
-            i,
-            range,
-            start,
-            taps,
-            window,
-            traces,
-            f64::INFINITY,
-            expansions,
-        )
-    }
-
-    /// [`Self::run`], giving up after `expansions` expansions if given.
-    #[allow(clippy::too_many_arguments)]
-    fn run_capped(
-        &mut self,
-        i: usize,
-        range: std::ops::RangeInclusive<usize>,
-        start: &Wire,
-        taps: Vec<Tap>,
-        window: &[ExPolygon],
-        traces: &Traces,
-        cap: f64,
-        expansions: Option<usize>,
+        budget: Budget,
     ) -> Option<WireRoute> {
         let wire = &self.wires[i];
         // In a negotiation round the layer's geometry (the material less other nets' pads) is
@@ -942,10 +915,8 @@ impl<'a> Board<'a> {
                 .or_insert_with(|| Rc::clone(&layer.geometry));
         }
         let mut search = Search::with_prepared(layers, self.layers, start, self.params, taps);
-        search.cap_cost(cap);
-        if let Some(n) = expansions {
-            search.cap_expansions(n);
-        }
+        search.cap_cost(budget.cost);
+        search.cap_expansions(budget.expansions);
         let mut steps = 0usize;
         while search.step() == SearchState::Running {
             steps += 1;

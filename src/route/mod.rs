@@ -95,6 +95,17 @@ pub struct Wire {
     pub to: Point3,
 }
 
+impl Wire {
+    /// The same connection from its end pad to its start pad.
+    pub fn reversed(&self) -> Wire {
+        Wire {
+            net: self.net.clone(),
+            from: self.to,
+            to: self.from,
+        }
+    }
+}
+
 /// The copper of one pad: an obstacle to the traces of every net but its own.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PadCopper {

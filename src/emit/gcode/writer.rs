@@ -231,8 +231,8 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         ));
         let (mut moved_xy, mut moved_z, mut sets_feed) = (false, false, false);
         for l in lines {
-            self.plan_command(l);
             let parsed = Line::new(l.as_str(), LineEnding::Lf);
+            self.plan_parsed(&parsed);
             sets_feed |= parsed.get(b'F').is_some();
             if let Some(mv) = machine.step(&parsed) {
                 moved_xy |= mv.from[0] != mv.to[0] || mv.from[1] != mv.to[1];
@@ -273,11 +273,30 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
     fn plan_custom(&mut self, mv: &conduit_gcode::Move) {
         self.planner
             .push_gcode_move(self.next_move, mv, MAX_FEEDRATE_MM_S);
-        self.next_move += 1;
-        self.planned.push_back(None);
+        self.count_planned(None);
     }
 
-    /// The motion model's side of a command line written as is (custom G-code, events): the
+    /// Plans a straight move of `length` mm at `feed` mm/s (capped) along `direction`,
+    /// extruded by `tool` if any.
+    fn plan_straight(&mut self, length: f64, feed: f64, direction: [f64; 3], tool: Option<usize>) {
+        self.planner.push(
+            self.next_move,
+            length,
+            feed.min(MAX_FEEDRATE_MM_S),
+            direction,
+            direction,
+        );
+        self.count_planned(tool);
+    }
+
+    /// Records the move just pushed to the planner: its id, and the tool that extruded in it.
+    fn count_planned(&mut self, tool: Option<usize>) {
+        self.next_move += 1;
+        self.planned.push_back(tool);
+    }
+
+    /// The motion model's side of a command line the writer writes (custom G-code is followed
+    /// by [`Self::lines`], which plans its parsed lines the same way): the
     /// firmware empties its queue at a dwell, a heat-up wait, homing and a tool change, and
     /// `check` plans it so; a dwell's time counts. Moves (`G0`/`G1`, the bulk of the file) are
     /// planned where they are written ([`Self::motion`]) and skipped here unparsed; other lines
@@ -292,7 +311,14 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         {
             return;
         }
-        let parsed = conduit_gcode::Line::new(line, conduit_gcode::LineEnding::Lf);
+        self.plan_parsed(&conduit_gcode::Line::new(
+            line,
+            conduit_gcode::LineEnding::Lf,
+        ));
+    }
+
+    /// [`Self::plan_command`] of a line already parsed.
+    fn plan_parsed(&mut self, parsed: &conduit_gcode::Line) {
         match parsed.command() {
             Some((b'G', 4.0)) => {
                 self.planner.flush();
@@ -346,15 +372,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             _ => [0.0; 3],
         };
         let extruding = kind == MotionKind::Extrude;
-        self.planner.push(
-            self.next_move,
-            distance,
-            feed.min(MAX_FEEDRATE_MM_S),
-            direction,
-            direction,
-        );
-        self.next_move += 1;
-        self.planned.push_back(self.tool.filter(|_| extruding));
+        self.plan_straight(distance, feed, direction, self.tool.filter(|_| extruding));
         if extruding
             && let Some(tool) = self.tool
             && let Some(ts) = self.tools.get_mut(tool)
@@ -493,17 +511,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         } else if let Some(a) = self.at {
             // Where custom G-code left the nozzle: timed, though the writer's moves do not
             // start there.
-            let length = (z - a.z).abs();
-            let dir = [0.0, 0.0, (z - a.z).signum()];
-            self.planner.push(
-                self.next_move,
-                length,
-                speed.min(MAX_FEEDRATE_MM_S),
-                dir,
-                dir,
-            );
-            self.next_move += 1;
-            self.planned.push_back(None);
+            self.plan_straight((z - a.z).abs(), speed, [0.0, 0.0, (z - a.z).signum()], None);
             self.at = Some(Point3::new(a.x, a.y, z));
         }
     }
