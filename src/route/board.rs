@@ -22,15 +22,20 @@
 //! short is undone like any other that routes no more wires.
 //!
 //! Each ordered search runs first in a tight window round its pads (a third of their distance
-//! plus a few mm), accepting only a route cheaper than any that leaves it, and in the full
-//! window only if that finds none: most wires of a board run close to their straight line, and
-//! a small window's layers are much quicker to carve.
+//! plus a few mm), accepting only a route cheaper than any that leaves it (its length out and
+//! back, plus the layer changes every route between its pads needs), and in the full window
+//! only if that finds none: most wires of a board run close to their straight line, and a
+//! small window's layers are much quicker to carve.
+//!
+//! With more than one thread, the first pass searches wires whose tight windows lie apart side
+//! by side, and keeps each search only if the wires placed before it in turn left what it
+//! looked at untouched: the routes are the same on any number of threads.
 //!
 //! Each search may end on the traces already connected to the wire's far pad ([`Tap`]s): the
 //! board follows the routed wires of the net from each pad and starts the search at the pad
 //! whose side has less copper, so the target has the most.
 
-use super::astar::{Search, SearchState, Tap, cost_limit, layer_range, min_weight};
+use super::astar::{Search, SearchState, Tap, change_cost, cost_limit, layer_range, min_weight};
 use super::congestion::History;
 use super::graph::{
     Eroded, Grown, LayerGeometry, LayerInput, PENALTY_FACTOR, bbox, box_union, boxes_meet, prepare,
@@ -43,10 +48,9 @@ use super::{RouteLayer, RouteParams, Wire, WireRoute, channels, layer_of, trace}
 use crate::geom::{
     ExPolygon, Point2, Point3, intersection, scaled, segment_distance, union, unscaled,
 };
-use std::cell::{OnceCell, RefCell};
+use rayon::prelude::*;
 use std::collections::HashMap;
-use std::rc::Rc;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 use std::time::Instant;
 
 mod negotiate;
@@ -79,6 +83,14 @@ impl Budget {
         expansions: usize::MAX,
     };
 }
+
+/// Wires searched ahead per thread in the first pass (see [`Board::first_pass`]): enough
+/// that a thread rarely waits for a long search on the other, few enough that most searches
+/// made ahead are still valid in their turn.
+const LOOK_AHEAD: usize = 2;
+
+/// How far down the order the first pass looks for wires to search ahead.
+const LOOK_SCAN: usize = 12;
 
 /// Extra margin of a wire's routing window beyond the farthest its route may go, mm.
 const WINDOW_MARGIN_MM: f64 = 2.0;
@@ -220,6 +232,57 @@ impl Traces {
     }
 }
 
+/// The unions of pad groups' grown holes by (group, net), see [`Board::pad_union`].
+type PadUnions = HashMap<(usize, String), Arc<Grown>>;
+
+/// Layer geometry by (layer, net, routing window), shared by the searches that see the
+/// layers alike.
+type Geometries = HashMap<(usize, String, BBox), Arc<LayerGeometry>>;
+
+/// A wire's search and what of the board it looked at: the traces of other nets on `layers`
+/// (and the layers next to them) within `frame`. Placing a wire there elsewhere leaves the
+/// search as it was.
+#[derive(Debug)]
+struct Searched {
+    route: WireRoute,
+    frame: BBox,
+    /// `None` for a search that looked at no layer.
+    layers: Option<std::ops::RangeInclusive<usize>>,
+}
+
+impl Searched {
+    /// A search that looked at no trace (no layer for it, or no time).
+    fn unlooked(route: WireRoute) -> Self {
+        Self {
+            route,
+            frame: bbox(&[]),
+            layers: None,
+        }
+    }
+}
+
+/// Where a wire is expected to look and place its channels: a box on a range of layers.
+#[derive(Debug, Clone)]
+struct Reach {
+    frame: BBox,
+    /// `None` for a wire that has no layer to be routed on.
+    layers: Option<std::ops::RangeInclusive<usize>>,
+}
+
+impl Reach {
+    /// Whether the two share a layer and a point.
+    fn meets(&self, other: &Reach) -> bool {
+        match (&self.layers, &other.layers) {
+            (Some(a), Some(b)) => {
+                a.start() <= b.end()
+                    && b.start() <= a.end()
+                    && boxes_meet(&self.frame, &other.frame)
+            }
+            _ => false,
+        }
+    }
+}
+
 /// What [`Board::route_all`] ran.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Summary {
@@ -245,7 +308,7 @@ struct Placed {
     /// Box of the keep-out (which holds the channel).
     bbox: BBox,
     /// The channel grown by every deflation inset, made when a search first needs it.
-    grown: OnceCell<Arc<Grown>>,
+    grown: OnceLock<Arc<Grown>>,
 }
 
 impl Placed {
@@ -302,18 +365,14 @@ pub(crate) struct Board<'a> {
     pad_groups: Vec<PadGroup>,
     /// Per pad group and net, the union of the group's grown holes of the pads of other nets,
     /// made when first needed.
-    pad_unions: RefCell<HashMap<(usize, String), Arc<Grown>>>,
+    pad_unions: Arc<Mutex<PadUnions>>,
     placed: Vec<Vec<Placed>>,
     /// Each layer's islands eroded by every deflation inset, made when first needed.
-    eroded: Vec<OnceCell<Arc<Eroded>>>,
+    eroded: Vec<OnceLock<Arc<Eroded>>>,
     routes: Vec<Option<WireRoute>>,
-    /// Layer geometry of negotiation rounds by (layer, net, routing window): the material less
-    /// other nets' pads, the same in every round.
-    geometry: HashMap<(usize, String, BBox), Rc<LayerGeometry>>,
-    /// Layer geometry of the wire being searched by (layer, net, routing window): the board as
-    /// it stands is the same for every search of one wire (from either pad), so it is built
-    /// once; emptied when the next wire's search starts.
-    wire_geometry: HashMap<(usize, String, BBox), Rc<LayerGeometry>>,
+    /// Layer geometry of negotiation rounds (see [`Geometries`]): the material less other
+    /// nets' pads, the same in every round.
+    geometry: Geometries,
     /// When routing must stop.
     deadline: Option<Instant>,
     /// Whether the deadline stopped any work.
@@ -361,12 +420,11 @@ impl<'a> Board<'a> {
             params,
             pads,
             pad_groups,
-            pad_unions: RefCell::new(HashMap::new()),
+            pad_unions: Arc::new(Mutex::new(HashMap::new())),
             placed: vec![Vec::new(); layers.len()],
-            eroded: vec![OnceCell::new(); layers.len()],
+            eroded: (0..layers.len()).map(|_| OnceLock::new()).collect(),
             routes: vec![None; wires.len()],
-            geometry: HashMap::new(),
-            wire_geometry: HashMap::new(),
+            geometry: Geometries::new(),
             deadline,
             stopped: false,
         }
@@ -384,10 +442,7 @@ impl<'a> Board<'a> {
             (summary.negotiation_rounds, summary.negotiation_conflicts) =
                 self.negotiate(&order, &mut summary.log);
         } else {
-            for (k, &i) in order.iter().enumerate() {
-                self.route_one(i);
-                self.tell(k + 1, 0);
-            }
+            self.first_pass(&order);
             summary.log.push(self.log_line(Phase::FirstPass, 1, 0));
         }
         for round in 1..=self.params.rip_up_rounds {
@@ -405,12 +460,127 @@ impl<'a> Board<'a> {
         summary
     }
 
+    /// Routes the wires of `order` one after another on the board as each leaves it.
+    ///
+    /// With more than one thread, the wires next in order are searched side by side, each on
+    /// the board as it stands when the batch starts, [`LOOK_AHEAD`] per thread. A wire's search
+    /// is kept for its turn if no wire placed in between lies where it looked
+    /// ([`Board::still_valid`]): it is then the search the wire would have had in its turn,
+    /// so the routes are the same on any number of threads. Wires far apart on a board, which
+    /// are most neighbours in the order, are routed in parallel; the others are searched
+    /// again in their turn.
+    fn first_pass(&mut self, order: &[usize]) {
+        let threads = rayon::current_num_threads();
+        // The wires placed so far, in turn, and the searches made ahead with how many of
+        // those had been placed when each was made.
+        let mut placed_in_turn: Vec<usize> = Vec::new();
+        let mut ahead: HashMap<usize, (Searched, usize)> = HashMap::new();
+        let reach: Vec<Reach> = if threads < 2 {
+            Vec::new()
+        } else {
+            (0..self.wires.len()).map(|w| self.reach(w)).collect()
+        };
+        for (k, &i) in order.iter().enumerate() {
+            let valid = |board: &Self, w: usize, (searched, since): &(Searched, usize)| {
+                placed_in_turn[*since..]
+                    .iter()
+                    .all(|&c| board.still_valid(c, w, searched))
+            };
+            let made = ahead.remove(&i).filter(|made| valid(self, i, made));
+            let searched = match made {
+                Some((searched, _)) => searched,
+                None if threads < 2 || self.past_deadline() => {
+                    self.route_one(i);
+                    placed_in_turn.push(i);
+                    self.tell(k + 1, 0);
+                    continue;
+                }
+                None => {
+                    // Worth a search ahead: a wire whose tight window meets none of those of
+                    // the wires before it, which are placed in them as a rule.
+                    let scan = &order[k..(k + LOOK_SCAN).min(order.len())];
+                    let apart =
+                        |m: usize| scan[..m].iter().all(|&w| !reach[w].meets(&reach[scan[m]]));
+                    let batch: Vec<usize> = std::iter::once(i)
+                        .chain(
+                            (1..scan.len())
+                                .filter(|&m| apart(m))
+                                .map(|m| scan[m])
+                                .filter(|w| {
+                                    !ahead.get(w).is_some_and(|made| valid(self, *w, made))
+                                }),
+                        )
+                        .take(threads * LOOK_AHEAD)
+                        .collect();
+                    let obstacles = Traces::Obstacles;
+                    let mut made: Vec<Searched> = batch
+                        .par_iter()
+                        .map(|&w| self.search(w, &obstacles, &mut Geometries::new()))
+                        .collect();
+                    let first = made.remove(0);
+                    let since = placed_in_turn.len();
+                    for (w, searched) in batch[1..].iter().zip(made) {
+                        ahead.insert(*w, (searched, since));
+                    }
+                    first
+                }
+            };
+            self.stopped |= matches!(searched.route.reason, Some(Unrouted::TimeLimit(_)));
+            self.place(i, searched.route);
+            placed_in_turn.push(i);
+            self.tell(k + 1, 0);
+        }
+    }
+
+    /// Where wire `i`'s channels lie when its tight search finds its route: the tight
+    /// window grown by a keep-out, on the layers of its search and the next ones.
+    fn reach(&self, i: usize) -> Reach {
+        let wire = &self.wires[i];
+        let Some(range) = layer_range(self.layers, wire, self.params) else {
+            return Reach {
+                frame: bbox(&[]),
+                layers: None,
+            };
+        };
+        let frame = bbox(&self.window(wire, &Traces::Obstacles, Some(tight_grow(wire))));
+        let d = scaled(channels::keep_out_radius(self.params));
+        Reach {
+            frame: [frame[0] - d, frame[1] - d, frame[2] + d, frame[3] + d],
+            layers: Some(range.start().saturating_sub(1)..=range.end() + 1),
+        }
+    }
+
+    /// Whether wire `j`'s search `searched`, made before wire `i` was placed, is still the one
+    /// it would have now: it did not run out of time, `i` is of another net (whose traces are
+    /// not `j`'s to end on), and no channel of `i` lies where the search looked.
+    fn still_valid(&self, i: usize, j: usize, searched: &Searched) -> bool {
+        if matches!(searched.route.reason, Some(Unrouted::TimeLimit(_)))
+            || self.wires[i].net == self.wires[j].net
+        {
+            return false;
+        }
+        let Some(layers) = &searched.layers else {
+            return true;
+        };
+        let near = layers.start().saturating_sub(1)..=layers.end().saturating_add(1);
+        !self.placed[..]
+            .iter()
+            .enumerate()
+            .filter(|(l, _)| near.contains(l))
+            .flat_map(|(_, placed)| placed)
+            .any(|p| p.wire == i && boxes_meet(&p.bbox, &searched.frame))
+    }
+
     /// Whether the deadline has passed; if so, routing stops (and says so).
     fn past_deadline(&mut self) -> bool {
-        let past =
-            self.deadline.is_some_and(|d| Instant::now() >= d) || crate::interrupt::requested();
+        let past = self.deadline_passed();
         self.stopped |= past;
         past
+    }
+
+    /// Whether the deadline has passed or a stop was requested (without saying so).
+    fn deadline_passed(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() >= d) || crate::interrupt::requested()
     }
 
     /// Whether the deadline stopped any work: a search not started or cut short, a round or
@@ -478,7 +648,7 @@ impl<'a> Board<'a> {
     /// What stands in the way of wire `i`: the traces its rip-up probe runs into, and the pads
     /// of other nets too close to its own; `None` if the deadline cut the probe short.
     fn blockage(&mut self, i: usize) -> Option<Blockage> {
-        let probe = self.search(i, &Traces::Probe);
+        let probe = self.searched(i, &Traces::Probe);
         if matches!(probe.reason, Some(Unrouted::TimeLimit(_))) {
             return None;
         }
@@ -581,7 +751,7 @@ impl<'a> Board<'a> {
         if depth == 0 || self.routes[f].as_ref().is_some_and(|r| r.routed) || self.past_deadline() {
             return false;
         }
-        let probe = self.search(f, &Traces::Probe);
+        let probe = self.searched(f, &Traces::Probe);
         if !probe.routed {
             return false; // unroutable even on an empty board
         }
@@ -627,8 +797,32 @@ impl<'a> Board<'a> {
         let result = if self.past_deadline() {
             self.out_of_time(i)
         } else {
-            self.search(i, traces)
+            self.searched(i, traces)
         };
+        self.place(i, result);
+    }
+
+    /// Wire `i`'s search on the board as it stands (see [`Board::search`]), saying so if the
+    /// deadline cut it short. A negotiation round's layer geometry (the material less other
+    /// nets' pads) is the same in every round, only the prices change: it is kept from search
+    /// to search; other searches build their own.
+    fn searched(&mut self, i: usize, traces: &Traces) -> WireRoute {
+        let keep = matches!(traces, Traces::Priced { .. });
+        let mut cache = if keep {
+            std::mem::take(&mut self.geometry)
+        } else {
+            Geometries::new()
+        };
+        let route = self.search(i, traces, &mut cache).route;
+        if keep {
+            self.geometry = cache;
+        }
+        self.stopped |= matches!(route.reason, Some(Unrouted::TimeLimit(_)));
+        route
+    }
+
+    /// Places wire `i`'s `result`: its channels on their layers, and the route.
+    fn place(&mut self, i: usize, result: WireRoute) {
         let half = self.params.channel_half_width();
         let keep_out_radius = channels::keep_out_radius(self.params);
         for (l, points) in &result.segments {
@@ -641,7 +835,7 @@ impl<'a> Board<'a> {
                 centreline: xy,
                 bbox: bbox(&keep_out),
                 keep_out,
-                grown: OnceCell::new(),
+                grown: OnceLock::new(),
             });
         }
         self.routes[i] = Some(result);
@@ -761,12 +955,15 @@ impl<'a> Board<'a> {
     /// has the most copper to aim at.
     ///
     /// A search still running at the deadline gives up: the wire is out of time.
-    fn search(&mut self, i: usize, traces: &Traces) -> WireRoute {
-        let wire = &self.wires[i].clone();
-        self.wire_geometry.clear();
+    ///
+    /// The layer geometry is taken from `cache` where it holds it, and what is built is added:
+    /// the board as it stands is the same for every search of one wire (from either pad).
+    fn search(&self, i: usize, traces: &Traces, cache: &mut Geometries) -> Searched {
+        let wire = &self.wires[i];
         let Some(range) = layer_range(self.layers, wire, self.params) else {
-            return trace::unrouted(wire, Unrouted::NoLayer);
+            return Searched::unlooked(trace::unrouted(wire, Unrouted::NoLayer));
         };
+        let out_of_time = || Searched::unlooked(self.out_of_time(i));
         let (from_pads, from_wires) = self.connected(&wire.net, wire.from);
         let (_, to_wires) = self.connected(&wire.net, wire.to);
         let (start, taps) = if from_pads.contains(&wire.to) {
@@ -788,6 +985,11 @@ impl<'a> Board<'a> {
         // tight search is the price, about a tenth more time where the layers are plain and
         // the search itself dominates, as on the 100-net benchmark).
         let window = self.window(wire, traces, None);
+        let seen = |route: WireRoute, window: &[ExPolygon]| Searched {
+            route,
+            frame: bbox(window),
+            layers: Some(range.clone()),
+        };
         if matches!(traces, Traces::Obstacles) {
             let tight = self.window(wire, traces, Some(tight_grow(wire)));
             let frame = bbox(&tight);
@@ -795,8 +997,12 @@ impl<'a> Board<'a> {
             // A window every route leaves (a trace of the net close by, outside it) is not
             // worth a search.
             if !tight.is_empty() && frame != bbox(&window) && reach > least_length(&start, &taps) {
+                // Every route, in the window or out of it, also changes layer at least as
+                // often as its start and nearest end lie apart, and each change costs at
+                // least `change_cost`.
+                let changes = self.layer_gap(&start, &taps) as f64;
                 let budget = Budget {
-                    cost: min_weight(self.params) * reach,
+                    cost: min_weight(self.params) * reach + change_cost(self.params) * changes,
                     ..Budget::FULL
                 };
                 match self.run(
@@ -807,9 +1013,10 @@ impl<'a> Board<'a> {
                     &tight,
                     traces,
                     budget,
+                    cache,
                 ) {
-                    None => return self.out_of_time(i),
-                    Some(route) if route.routed => return route,
+                    None => return out_of_time(),
+                    Some(route) if route.routed => return seen(route, &tight),
                     Some(_) => {}
                 }
             }
@@ -835,10 +1042,13 @@ impl<'a> Board<'a> {
                 &window,
                 traces,
                 budget,
+                cache,
             );
             match look {
-                None => return self.out_of_time(i),
-                Some(r) if r.routed || r.reason == Some(Unrouted::NoPath) => return r,
+                None => return out_of_time(),
+                Some(r) if r.routed || r.reason == Some(Unrouted::NoPath) => {
+                    return seen(r, &window);
+                }
                 Some(_) => {}
             }
         }
@@ -850,32 +1060,53 @@ impl<'a> Board<'a> {
             &window,
             traces,
             Budget::FULL,
+            cache,
         ) else {
-            return self.out_of_time(i);
+            return out_of_time();
         };
-        match reverse {
-            Some(reverse) if route.reason == Some(Unrouted::Detour) => self
-                .run(
+        let route = match reverse {
+            Some(reverse) if route.reason == Some(Unrouted::Detour) => {
+                match self.run(
                     i,
-                    range,
+                    range.clone(),
                     &reverse,
                     Vec::new(),
                     &window,
                     traces,
                     Budget::FULL,
-                )
-                .filter(|r| r.routed)
-                .unwrap_or(route),
+                    cache,
+                ) {
+                    None => return out_of_time(),
+                    Some(r) if r.routed => r,
+                    Some(_) => route,
+                }
+            }
             _ => route,
-        }
+        };
+        seen(route, &window)
+    }
+
+    /// The fewest layers between `start`'s pad and its end: its far pad or the nearest of
+    /// `taps` by layer.
+    fn layer_gap(&self, start: &Wire, taps: &[Tap]) -> usize {
+        let layer = |z: f64| layer_of(self.layers, z);
+        let Some(from) = layer(start.from.z) else {
+            return 0;
+        };
+        layer(start.to.z)
+            .into_iter()
+            .chain(taps.iter().map(|t| t.layer))
+            .map(|l| l.abs_diff(from))
+            .min()
+            .unwrap_or(0)
     }
 
     /// Runs the search of wire `i` (from `start`, ending on its far pad or `taps`) on the
-    /// layers of `range` within `window`, within `budget`; `None` if the deadline passed while
-    /// it ran.
+    /// layers of `range` within `window`, within `budget`, with the layer geometry `cache`
+    /// holds (and adding what it builds); `None` if the deadline passed while it ran.
     #[allow(clippy::too_many_arguments)]
     fn run(
-        &mut self,
+        &self,
         i: usize,
         range: std::ops::RangeInclusive<usize>,
         start: &Wire,
@@ -883,36 +1114,24 @@ impl<'a> Board<'a> {
         window: &[ExPolygon],
         traces: &Traces,
         budget: Budget,
+        cache: &mut Geometries,
     ) -> Option<WireRoute> {
         let wire = &self.wires[i];
-        // In a negotiation round the layer's geometry (the material less other nets' pads) is
-        // the same in every round, only the prices change: it is built once per layer, net and
-        // window, and kept.
-        let keep = matches!(traces, Traces::Priced { .. });
         let frame = bbox(window);
         let keys: Vec<(usize, String, BBox)> =
             range.map(|l| (l, wire.net.clone(), frame)).collect();
-        let kept = if keep {
-            &self.geometry
-        } else {
-            &self.wire_geometry
-        };
-        let known: Vec<Option<Rc<LayerGeometry>>> =
-            keys.iter().map(|k| kept.get(k).cloned()).collect();
+        let known: Vec<Option<Arc<LayerGeometry>>> =
+            keys.iter().map(|k| cache.get(k).cloned()).collect();
         let inputs: Vec<LayerInput> = keys
             .iter()
             .zip(&known)
             .map(|(k, g)| self.input(k.0, wire, traces, window, g.is_some()))
             .collect();
         let layers = prepare(&inputs, known, self.params);
-        let kept = if keep {
-            &mut self.geometry
-        } else {
-            &mut self.wire_geometry
-        };
         for (key, layer) in keys.into_iter().zip(&layers) {
-            kept.entry(key)
-                .or_insert_with(|| Rc::clone(&layer.geometry));
+            cache
+                .entry(key)
+                .or_insert_with(|| Arc::clone(&layer.geometry));
         }
         let mut search = Search::with_prepared(layers, self.layers, start, self.params, taps);
         search.cap_cost(budget.cost);
@@ -920,7 +1139,7 @@ impl<'a> Board<'a> {
         let mut steps = 0usize;
         while search.step() == SearchState::Running {
             steps += 1;
-            if steps % CLOCK_EVERY == 0 && self.past_deadline() {
+            if steps % CLOCK_EVERY == 0 && self.deadline_passed() {
                 return None;
             }
         }
@@ -983,7 +1202,12 @@ impl<'a> Board<'a> {
     /// use); `None` if all are of `net`.
     fn pad_union(&self, g: usize, net: &str) -> Option<Arc<Grown>> {
         let key = (g, net.to_owned());
-        if let Some(known) = self.pad_unions.borrow().get(&key) {
+        let unions = || {
+            self.pad_unions
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+        };
+        if let Some(known) = unions().get(&key) {
             return Some(Arc::clone(known));
         }
         let members: Vec<&Grown> = self.pad_groups[g]
@@ -997,8 +1221,8 @@ impl<'a> Board<'a> {
             return None;
         }
         let union = Arc::new(Grown::union(&members));
-        self.pad_unions.borrow_mut().insert(key, Arc::clone(&union));
-        Some(union)
+        // Two searches on two threads may both make it: the same union either way.
+        Some(Arc::clone(unions().entry(key).or_insert(union)))
     }
 
     /// Layer `l`'s islands eroded by every deflation inset (made on first use).

@@ -44,7 +44,6 @@ use crate::geom::{
 use rayon::prelude::*;
 use std::collections::{BTreeMap, HashMap};
 use std::hash::{BuildHasherDefault, Hasher};
-use std::rc::Rc;
 use std::sync::Arc;
 
 /// A small multiplicative hasher for the integer keys of the vertex maps (the std SipHash is
@@ -390,7 +389,7 @@ pub(crate) struct PreparedLayer {
     /// Top of the layer, mm.
     pub z: f64,
     /// The rings and the regions the router queries.
-    pub geometry: Rc<LayerGeometry>,
+    pub geometry: Arc<LayerGeometry>,
     /// Where links cost `penalty_factor` times more.
     pub penalty: RegionIndex,
     /// Cost multiplier of links in `penalty`.
@@ -411,12 +410,12 @@ impl PreparedLayer {
     /// Deflates the islands of `input` into rings and indexes the regions.
     #[cfg(test)]
     pub(crate) fn new(input: &LayerInput, params: &RouteParams) -> Self {
-        Self::with_geometry(input, Rc::new(LayerGeometry::new(input, params)))
+        Self::with_geometry(input, Arc::new(LayerGeometry::new(input, params)))
     }
 
     /// `input`'s layer with `geometry` already made from it (or from an input alike but for
     /// its penalty and history), and `input`'s prices.
-    pub(crate) fn with_geometry(input: &LayerInput, geometry: Rc<LayerGeometry>) -> Self {
+    pub(crate) fn with_geometry(input: &LayerInput, geometry: Arc<LayerGeometry>) -> Self {
         Self {
             index: input.index,
             z: input.z,
@@ -433,7 +432,7 @@ impl PreparedLayer {
 /// function of its input alone, so the result is the same on any number of threads.
 pub(crate) fn prepare(
     inputs: &[LayerInput],
-    known: Vec<Option<Rc<LayerGeometry>>>,
+    known: Vec<Option<Arc<LayerGeometry>>>,
     params: &RouteParams,
 ) -> Vec<PreparedLayer> {
     let missing: Vec<bool> = known.iter().map(Option::is_none).collect();
@@ -448,7 +447,7 @@ pub(crate) fn prepare(
         .map(|(input, pair)| {
             let geometry = match pair {
                 (Some(g), _) => g,
-                (None, new) => Rc::new(new.unwrap_or_else(|| LayerGeometry::new(input, params))),
+                (None, new) => Arc::new(new.unwrap_or_else(|| LayerGeometry::new(input, params))),
             };
             PreparedLayer::with_geometry(input, geometry)
         })

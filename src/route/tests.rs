@@ -735,3 +735,33 @@ fn a_pad_on_an_island_of_its_own_is_proven_unreachable_from_its_side() {
     assert!(!boxed.routed);
     assert_eq!(boxed.reason, Some(Unrouted::NoPath));
 }
+
+#[test]
+fn routes_are_the_same_on_any_number_of_threads() {
+    // Short wires spread over a plate (searched side by side) among long ones that cross them
+    // (searched in their turn), some of them changing layer.
+    let layers = stack(vec![solid(rect(0.0, 0.0, 60.0, 60.0))], 6);
+    let (z1, z4) = (layers[1].z, layers[4].z);
+    let mut wires = Vec::new();
+    for k in 0..4 {
+        for j in 0..3 {
+            let (x, y) = (6.0 + 15.0 * k as f64, 8.0 + 20.0 * j as f64);
+            let z = if (k + j) % 2 == 0 { z1 } else { z4 };
+            wires.push(wire(&format!("s{k}{j}"), (x, y, z4), (x + 6.0, y + 3.0, z)));
+        }
+    }
+    wires.push(wire("x", (3.0, 30.0, z4), (57.0, 32.0, z4)));
+    wires.push(wire("y", (30.0, 3.0, z1), (31.0, 57.0, z4)));
+    let params = RouteParams::default();
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
+        pool.install(|| route(&layers, &wires, &end_pads(&wires), &params))
+    };
+    let one = on(1);
+    assert_eq!(one.wires.iter().filter(|w| w.routed).count(), wires.len());
+    assert_eq!(on(2), one);
+    assert_eq!(on(3), one);
+}
