@@ -188,6 +188,11 @@ pub struct SliceSettings {
     /// the point nearest to the nozzle (least travel, seams scattered); `"random"` at a point
     /// that changes from layer to layer.
     pub seam_position: SeamRule,
+    /// How far short of its start a perimeter loop ends, as a fraction of `nozzle_diameter`,
+    /// 0 to 1 (OrcaSlicer's `seam_gap`; PrusaSlicer clips every loop by 15 %): the bead's round
+    /// end meets its start instead of running over it into a blob at the seam. Loops shorter
+    /// than ten gaps close fully. Default 0.15; 0 closes every loop.
+    pub seam_gap: f64,
     /// How the perimeter band is laid out: `"variable"` (default) keeps loops from running over
     /// themselves and fills what they leave with beads whose number and width follow the wall's
     /// local thickness, so a 0.3 mm fin or a tapering wall prints at its true thickness;
@@ -293,6 +298,9 @@ macro_rules! with_region_keys {
     };
 }
 
+/// Default `slice.seam_gap`: PrusaSlicer's loop clipping, 15 % of the nozzle diameter.
+pub const DEFAULT_SEAM_GAP: f64 = 0.15;
+
 impl Default for SliceSettings {
     /// The regions stage's defaults ([`RegionParams::default`]) and conduit's for the rest.
     fn default() -> Self {
@@ -303,6 +311,7 @@ impl Default for SliceSettings {
                     $($key: region.$key,)+
                     first_layer_height: 0.2,
                     seam_position: SeamRule::Aligned,
+                    seam_gap: DEFAULT_SEAM_GAP,
                     top_fill_pattern: SolidPattern::Rectilinear,
                     bottom_fill_pattern: SolidPattern::Rectilinear,
                     support_material: false,
@@ -740,6 +749,13 @@ impl Config {
                 ));
             }
         }
+        if !(0.0..=1.0).contains(&s.seam_gap) {
+            problems.push(format!(
+                "slice.seam_gap must be between 0 and 1 (a fraction of slice.nozzle_diameter), \
+                 got {}",
+                s.seam_gap
+            ));
+        }
         // A skirt farther out than the bed is wide would be printed off the bed.
         let bed = p.bed_size[0].max(p.bed_size[1]);
         if s.skirt_distance > bed {
@@ -963,6 +979,7 @@ impl Config {
                 seam: s.seam_position,
                 ..OrderParams::default()
             },
+            seam_gap: s.seam_gap * s.nozzle_diameter,
             ..ProgramParams::default()
         }
     }

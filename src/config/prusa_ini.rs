@@ -32,7 +32,8 @@
 //!   `infill_overlap`, `solid_infill_below_area`, `gap_fill_enabled`, `external_perimeters_first`, `support_material`, `skirts`,
 //!   `skirt_distance`, `brim_width`, `bridge_speed`, `gap_fill_speed`, `perimeter_generator` (`classic`, or `arachne`, also when
 //!   missing, for the variable generator) with `thin_walls` (classic only: Arachne prints thin
-//!   features anyway), `seam_position`, the speeds (a `%` speed is relative to its
+//!   features anyway), `seam_position`, OrcaSlicer's `seam_gap` (mm or `%` of the nozzle;
+//!   PrusaSlicer's loop clipping, 15 %, when missing), the speeds (a `%` speed is relative to its
 //!   PrusaSlicer parent: external perimeter → perimeter, solid infill → infill, top solid →
 //!   solid infill, first layer → perimeter, support → perimeter), `support_material_speed` (→
 //!   `support_speed` and `skirt_speed`, as PrusaSlicer prints skirts at support speed),
@@ -458,6 +459,8 @@ const RULES: &[(&str, Rule)] = &[
     ("brim_type", Rule::Custom(brim_type)),
     ("perimeter_generator", Rule::Custom(perimeter_generator)),
     ("seam_position", Rule::Custom(seam_position)),
+    // After the nozzle: a gap in mm is a fraction of it.
+    ("seam_gap", Rule::Custom(seam_gap)),
     // Widths (every role width is read with the generic one).
     ("extrusion_width", Rule::Custom(extrusion_widths)),
     // Speeds; a percentage is of the parent PrusaSlicer uses.
@@ -910,6 +913,16 @@ fn seam_position(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     Ok(())
 }
 
+/// `seam_gap` (OrcaSlicer's; PrusaSlicer clips every loop by 15 % of the nozzle, conduit's
+/// default): mm, or `%` of the nozzle diameter.
+fn seam_gap(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let nozzle = imp.cfg.slice.nozzle_diameter;
+    if let Some(mm) = imp.p.abs_or_percent(key, nozzle)? {
+        imp.cfg.slice.seam_gap = if nozzle > 0.0 { mm / nozzle } else { 0.0 };
+    }
+    Ok(())
+}
+
 /// `brim_type`: PrusaSlicer's `no_brim` (no brim whatever `brim_width` says), `outer_only`,
 /// `inner_only`, `outer_and_inner`, and OrcaSlicer's `brim_ears` (`auto_brim` is read as
 /// `outer_only`).
@@ -1250,6 +1263,26 @@ mod tests {
         );
         let (thin, _) = from_ini_str("perimeter_generator = classic\nthin_walls = 1\n")?;
         assert!(thin.slice.thin_walls);
+        Ok(())
+    }
+
+    #[test]
+    fn seam_gap_is_read_in_mm_or_percent_of_the_nozzle() -> Result<(), ConfigError> {
+        let (missing, _) = from_ini_str("layer_height = 0.2\n")?;
+        assert_eq!(missing.slice.seam_gap, 0.15);
+        let (mm, _) = from_ini_str("nozzle_diameter = 0.6\nseam_gap = 0.09\n")?;
+        assert!(
+            (mm.slice.seam_gap - 0.15).abs() < 1e-12,
+            "{}",
+            mm.slice.seam_gap
+        );
+        let (pct, _) = from_ini_str("nozzle_diameter = 0.6\nseam_gap = 10%\n")?;
+        assert!(
+            (pct.slice.seam_gap - 0.10).abs() < 1e-12,
+            "{}",
+            pct.slice.seam_gap
+        );
+        assert!((pct.program_params().seam_gap - 0.06).abs() < 1e-12);
         Ok(())
     }
 

@@ -226,6 +226,57 @@ impl Toolpath {
         }
     }
 
+    /// Opens a closed planar path at its start and ends it `gap` mm short of it, where the
+    /// loop began (PrusaSlicer's loop clipping, OrcaSlicer's `seam_gap`): the bead's round end
+    /// then meets its start instead of running over it, which leaves a blob at the seam.
+    /// The last move is cut at the point `gap` before the start, along an arc where the path
+    /// has arcs. A path with tool axes (non-planar), an open path, or a loop shorter than
+    /// [`MIN_CLIPPED_LOOP_GAPS`] gaps is left as it is; so is everything for a `gap` ≤ 0.
+    pub fn clip_loop_end(&mut self, gap: f64) {
+        let length = self.length();
+        if !self.closed
+            || self.tool_axis.is_some()
+            || self.points.len() < 3
+            || gap.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+            || length <= MIN_CLIPPED_LOOP_GAPS * gap
+        {
+            return;
+        }
+        let Some(&first) = self.points.first() else {
+            return;
+        };
+        let keep = length - gap;
+        if let Some(segments) = &self.segments {
+            let (head, _) = segment::split_at(segments, keep);
+            let n = head.len();
+            let Some(end) = head.last().map(Segment::end) else {
+                return;
+            };
+            let z = self.points.get(n).unwrap_or(&first).z;
+            self.points.truncate(n);
+            self.points.push(Point3::new(end[0], end[1], z));
+            self.segments = Some(head);
+        } else {
+            let mut ring = std::mem::take(&mut self.points);
+            ring.push(first);
+            let mut at = 0.0;
+            let mut out = Vec::with_capacity(ring.len());
+            out.push(first);
+            for w in ring.windows(2) {
+                let l = (w[1] - w[0]).norm();
+                if at + l >= keep {
+                    let t = if l > 0.0 { (keep - at) / l } else { 1.0 };
+                    out.push(w[0] + (w[1] - w[0]) * t);
+                    break;
+                }
+                out.push(w[1]);
+                at += l;
+            }
+            self.points = out;
+        }
+        self.closed = false;
+    }
+
     /// Makes a closed path start at its point `index` (points, tool axes and segments rotate
     /// together). Does nothing for an open path or an index out of range.
     pub fn rotate_start(&mut self, index: usize) {
@@ -245,6 +296,10 @@ impl Toolpath {
         }
     }
 }
+
+/// A loop shorter than this many seam gaps is not clipped ([`Toolpath::clip_loop_end`]): on a
+/// tiny loop the gap would be a visible hole rather than a hidden seam.
+pub const MIN_CLIPPED_LOOP_GAPS: f64 = 10.0;
 
 /// Something that happens between extrusions.
 #[derive(Debug, Clone, PartialEq)]
@@ -410,6 +465,78 @@ mod tests {
                     .collect(),
             ),
         }
+    }
+
+    #[test]
+    fn a_loop_clipped_at_its_seam_ends_the_gap_short_of_its_start() {
+        // A 10 mm square, straight and with its last corner rounded by an arc.
+        let pts = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]];
+        let mut straight = Toolpath {
+            points: pts.iter().map(|p| Point3::new(p[0], p[1], 0.2)).collect(),
+            closed: true,
+            role: Role::ExternalPerimeter,
+            tool: 0,
+            width: 0.45,
+            height: 0.2,
+            speed: 25.0,
+            tool_axis: None,
+            segments: None,
+        };
+        let mut arced = straight.clone();
+        straight.clip_loop_end(0.06);
+        assert!(!straight.closed);
+        assert_eq!(straight.points.len(), 5);
+        assert!(
+            (straight.length() - 39.94).abs() < 1e-12,
+            "{}",
+            straight.length()
+        );
+        let end = straight.points[4];
+        assert!(
+            (end.x - 0.0).abs() < 1e-12 && (end.y - 0.06).abs() < 1e-12,
+            "{end:?}"
+        );
+        // The closing side as a half circle bulging out to the left, radius 5 about (0, 5).
+        let line = |a: [f64; 2], b: [f64; 2]| Segment::Line { a, b };
+        arced.segments = Some(vec![
+            line(pts[0], pts[1]),
+            line(pts[1], pts[2]),
+            line(pts[2], pts[3]),
+            Segment::Arc {
+                a: pts[3],
+                b: pts[0],
+                c: [0.0, 5.0],
+                r: 5.0,
+                sweep: std::f64::consts::PI,
+            },
+        ]);
+        let before = arced.length();
+        arced.clip_loop_end(0.5);
+        assert!((before - arced.length() - 0.5).abs() < 1e-9);
+        assert_eq!(arced.points.len(), 5);
+        // 0.5 mm of arc back from (0, 0): 0.1 rad short of the end, on the circle.
+        let end = arced.points[4];
+        let (ex, ey) = (-5.0 * 0.1f64.sin(), 5.0 - 5.0 * 0.1f64.cos());
+        assert!(
+            (end.x - ex).abs() < 1e-9 && (end.y - ey).abs() < 1e-9,
+            "{end:?}"
+        );
+        // Tiny loops, open paths and no gap are left alone.
+        let mut tiny = Toolpath {
+            points: vec![
+                Point3::new(0.0, 0.0, 0.2),
+                Point3::new(0.1, 0.0, 0.2),
+                Point3::new(0.1, 0.1, 0.2),
+            ],
+            ..straight.clone()
+        };
+        tiny.closed = true;
+        let kept = tiny.clone();
+        tiny.clip_loop_end(0.06);
+        assert_eq!(tiny, kept);
+        let mut open = straight.clone();
+        open.clip_loop_end(0.06);
+        assert_eq!(open, straight);
     }
 
     #[test]

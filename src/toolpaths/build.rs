@@ -25,6 +25,8 @@
 //!   [`OrderParams::seam`]: by default the vertex nearest to where the nozzle is
 //!   ([`SeamRule::Nearest`](super::order::SeamRule::Nearest)); the config's
 //!   `slice.seam_position` picks [`SeamRule::Aligned`](super::order::SeamRule::Aligned).
+//! - **Seam gap.** Perimeter loops (not the skirt, not a paste tool's traces) end
+//!   [`ProgramParams::seam_gap`] short of their start.
 //! - **Speeds and widths.** Per tool ([`ToolPathParams`]): perimeters keep the width the
 //!   regions stage gave each loop; infill and skirt take the tool's widths; every path on the
 //!   program's first layer is printed at `first_layer_speed`.
@@ -170,6 +172,9 @@ pub struct ProgramParams {
     /// (Douglas–Peucker), PrusaSlicer's `gcode_resolution`: sliced meshes carry vertices far
     /// closer than any printer resolves. 0 keeps every vertex. Default 0.0125.
     pub resolution: f64,
+    /// How far short of its start each perimeter loop ends, mm
+    /// ([`Toolpath::clip_loop_end`]). Default 0: loops close.
+    pub seam_gap: f64,
 }
 
 impl Default for ProgramParams {
@@ -179,6 +184,7 @@ impl Default for ProgramParams {
             order: OrderParams::default(),
             start: Point3::origin(),
             resolution: DEFAULT_RESOLUTION_MM,
+            seam_gap: 0.0,
         }
     }
 }
@@ -577,6 +583,12 @@ pub fn build_program_with(
             paths.extend(island_paths);
             if paths.is_empty() {
                 continue;
+            }
+            // Ordered first: the loops' seams are where the ordering started them.
+            for path in &mut paths {
+                if matches!(path.role, Role::ExternalPerimeter | Role::Perimeter) {
+                    path.clip_loop_end(params.seam_gap);
+                }
             }
             if current_tool.is_some_and(|c| c != tool) {
                 items.push(LayerItem::Event(Event::ToolChange { tool }));
