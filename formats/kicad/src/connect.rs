@@ -168,7 +168,8 @@ impl Sheet<'_> {
         let segs: &[(Pt, Pt)] = if buses { &self.f.buses } else { &self.f.wires };
         for (i, &(a, b)) in segs.iter().enumerate() {
             if on_segment(p, a, b) {
-                g.dsu.union(n, if buses { self.bus(i) } else { self.wire(i) });
+                g.dsu
+                    .union(n, if buses { self.bus(i) } else { self.wire(i) });
             }
         }
         self.at.entry(p).or_default().push(n);

@@ -64,9 +64,7 @@ pub enum KicadError {
         column: u32,
     },
     /// The top list is not one of KiCad's files.
-    #[error(
-        "not a KiCad file: expected (kicad_pcb, (kicad_sch or (export, found ({found}"
-    )]
+    #[error("not a KiCad file: expected (kicad_pcb, (kicad_sch or (export, found ({found}")]
     NotKicad {
         /// Keyword of the top list (empty for an empty file).
         found: String,
@@ -89,7 +87,7 @@ pub enum KicadError {
         /// 1-based column of the list.
         column: u32,
         /// What is missing, e.g. `(at …)` or `the pad number`.
-        what: &'static str,
+        what: String,
     },
     /// A value is not what it should be.
     #[error("{path}, line {line}, column {column}: {value:?} is not {expected}")]

@@ -6,7 +6,7 @@
 //! angles); a pad's angle in the file includes the footprint's. [`Footprint::board_position`]
 //! puts a pad on the board.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 
 use crate::error::KicadError;
 use crate::netlist::Netlist;
@@ -192,7 +192,7 @@ impl Pcb {
             for p in &f.pads {
                 if let Some(net) = &p.net {
                     out.entry(net.clone())
-                        .or_insert_with(BTreeSet::new)
+                        .or_default()
                         .insert((f.reference.clone(), p.number.clone()));
                 }
             }
@@ -224,15 +224,14 @@ pub(crate) fn read(root: Node<'_>) -> Result<Pcb, KicadError> {
                 for g in item.lists() {
                     if g.keyword().starts_with("fp_") && g.keyword() != "fp_text" && on_edge_cuts(g)
                     {
-                        pcb.outline.push(outline_shape(g, &|x, y| fp.to_board(x, y))?);
+                        pcb.outline
+                            .push(outline_shape(g, &|x, y| fp.to_board(x, y))?);
                     }
                 }
                 pcb.footprints.push(fp);
             }
-            k if k.starts_with("gr_") => {
-                if on_edge_cuts(item) {
-                    pcb.outline.push(outline_shape(item, &|x, y| (x, y))?);
-                }
+            k if k.starts_with("gr_") && on_edge_cuts(item) => {
+                pcb.outline.push(outline_shape(item, &|x, y| (x, y))?);
             }
             _ => {}
         }
@@ -331,10 +330,7 @@ fn pad(p: Node<'_>, nets: &BTreeMap<u32, String>) -> Result<Pad, KicadError> {
             bounds: custom_bounds(p, width, height)?,
         },
         other => {
-            return Err(p.invalid(
-                other,
-                "circle, rect, oval, trapezoid, roundrect or custom",
-            ));
+            return Err(p.invalid(other, "circle, rect, oval, trapezoid, roundrect or custom"));
         }
     };
     let drill = match p.get("drill") {

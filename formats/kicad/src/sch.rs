@@ -136,9 +136,14 @@ pub(crate) fn read_file(root: Node<'_>) -> Result<SheetFile, KicadError> {
         }
         // `(extends "Base")` (KiCad 7+ keeps derived symbols so): the base's pins.
         for s in ls.all("symbol") {
-            if let (Some(name), Some(base)) = (s.atom(0), s.get("extends").and_then(|e| e.atom(0))) {
+            if let (Some(name), Some(base)) = (s.atom(0), s.get("extends").and_then(|e| e.atom(0)))
+            {
                 let prefix = name.rsplit_once(':').map_or("", |(l, _)| l);
-                let key = if prefix.is_empty() { base.to_owned() } else { format!("{prefix}:{base}") };
+                let key = if prefix.is_empty() {
+                    base.to_owned()
+                } else {
+                    format!("{prefix}:{base}")
+                };
                 if let Some(b) = lib.get(&key).cloned() {
                     if let Some(d) = lib.get_mut(name) {
                         d.pins = b.pins;
@@ -188,8 +193,14 @@ pub(crate) fn read_file(root: Node<'_>) -> Result<SheetFile, KicadError> {
             "symbol_instances" => {
                 for p in item.all("path") {
                     let path = p.req_atom(0, "the instance path")?.to_owned();
-                    let reference = p.get("reference").and_then(|r| r.atom(0)).unwrap_or_default();
-                    let unit = p.get("unit").map(|u| u.num(0, "a unit number")).transpose()?;
+                    let reference = p
+                        .get("reference")
+                        .and_then(|r| r.atom(0))
+                        .unwrap_or_default();
+                    let unit = p
+                        .get("unit")
+                        .map(|u| u.num(0, "a unit number"))
+                        .transpose()?;
                     f.symbol_instances
                         .insert(path, (reference.to_owned(), unit.map_or(1, round)));
                 }
@@ -215,15 +226,26 @@ fn lib_symbol(s: Node<'_>) -> Result<LibSymbol, KicadError> {
     for sub in s.all("symbol") {
         // `NAME_UNIT_STYLE`; unit 0 and style 0 are common to all.
         let name = sub.atom(0).unwrap_or_default();
-        let rest = name.strip_prefix(base).and_then(|r| r.strip_prefix('_')).unwrap_or(name);
+        let rest = name
+            .strip_prefix(base)
+            .and_then(|r| r.strip_prefix('_'))
+            .unwrap_or(name);
         let mut parts = rest.rsplitn(2, '_');
         let style = parts.next().and_then(|v| v.parse().ok()).unwrap_or(0);
         let unit = parts.next().and_then(|v| v.parse().ok()).unwrap_or(0);
         for p in sub.all("pin") {
             let (x, y, _) = p.at()?;
             out.pins.push(LibPin {
-                number: p.get("number").and_then(|n| n.atom(0)).unwrap_or_default().to_owned(),
-                name: p.get("name").and_then(|n| n.atom(0)).unwrap_or_default().to_owned(),
+                number: p
+                    .get("number")
+                    .and_then(|n| n.atom(0))
+                    .unwrap_or_default()
+                    .to_owned(),
+                name: p
+                    .get("name")
+                    .and_then(|n| n.atom(0))
+                    .unwrap_or_default()
+                    .to_owned(),
                 x,
                 y,
                 power_in: p.atom(0) == Some("power_in"),
@@ -238,7 +260,14 @@ fn lib_symbol(s: Node<'_>) -> Result<LibSymbol, KicadError> {
 
 /// Where a library point goes on the sheet for a symbol at `(ox, oy)` turned by `angle` and
 /// mirrored by `mirror` (`x`, `y` or none).
-pub(crate) fn place_point(x: f64, y: f64, ox: f64, oy: f64, angle: f64, mirror: Option<&str>) -> Pt {
+pub(crate) fn place_point(
+    x: f64,
+    y: f64,
+    ox: f64,
+    oy: f64,
+    angle: f64,
+    mirror: Option<&str>,
+) -> Pt {
     // Library y up → sheet y down.
     let (x, y) = (x, -y);
     // Counter-clockwise on screen, where y points down.
@@ -266,9 +295,17 @@ fn symbol(s: Node<'_>, lib: &BTreeMap<String, LibSymbol>) -> Result<Symbol, Kica
     };
     let (ox, oy, angle) = s.at()?;
     let mirror = s.get("mirror").and_then(|m| m.atom(0));
-    let unit = s.get("unit").map(|u| u.num(0, "a unit number")).transpose()?.map_or(1, round);
-    let style = s.get("convert").or_else(|| s.get("body_style"))
-        .map(|u| u.num(0, "a body style")).transpose()?.map_or(1, round);
+    let unit = s
+        .get("unit")
+        .map(|u| u.num(0, "a unit number"))
+        .transpose()?
+        .map_or(1, round);
+    let style = s
+        .get("convert")
+        .or_else(|| s.get("body_style"))
+        .map(|u| u.num(0, "a body style"))
+        .transpose()?
+        .map_or(1, round);
     let power = ls.power.is_some();
     let pins = ls
         .pins
@@ -287,8 +324,14 @@ fn symbol(s: Node<'_>, lib: &BTreeMap<String, LibSymbol>) -> Result<Symbol, Kica
     if let Some(inst) = s.get("instances") {
         for project in inst.all("project") {
             for p in project.all("path") {
-                let reference = p.get("reference").and_then(|r| r.atom(0)).unwrap_or_default();
-                let u = p.get("unit").map(|u| u.num(0, "a unit number")).transpose()?;
+                let reference = p
+                    .get("reference")
+                    .and_then(|r| r.atom(0))
+                    .unwrap_or_default();
+                let u = p
+                    .get("unit")
+                    .map(|u| u.num(0, "a unit number"))
+                    .transpose()?;
                 instances.push((
                     p.req_atom(0, "the instance path")?.to_owned(),
                     reference.to_owned(),
@@ -298,7 +341,11 @@ fn symbol(s: Node<'_>, lib: &BTreeMap<String, LibSymbol>) -> Result<Symbol, Kica
         }
     }
     Ok(Symbol {
-        uuid: s.get("uuid").and_then(|u| u.atom(0)).unwrap_or_default().to_owned(),
+        uuid: s
+            .get("uuid")
+            .and_then(|u| u.atom(0))
+            .unwrap_or_default()
+            .to_owned(),
         reference,
         value: s.property("Value").unwrap_or_default().to_owned(),
         footprint: s.property("Footprint").unwrap_or_default().to_owned(),
@@ -335,7 +382,11 @@ fn sheet(s: Node<'_>) -> Result<SheetRef, KicadError> {
         pins.push((p.req_atom(0, "the sheet pin's name")?.to_owned(), pt(x, y)));
     }
     Ok(SheetRef {
-        uuid: s.get("uuid").and_then(|u| u.atom(0)).unwrap_or_default().to_owned(),
+        uuid: s
+            .get("uuid")
+            .and_then(|u| u.atom(0))
+            .unwrap_or_default()
+            .to_owned(),
         name: name.to_owned(),
         file: file.to_owned(),
         pins,
@@ -387,7 +438,11 @@ pub(crate) fn hierarchy(
     let mut todo = vec![(0usize, vec![root_name.to_path_buf()])];
     while let Some((inst, branch)) = todo.pop() {
         let file = h.instances[inst].file;
-        let dir = branch.last().and_then(|p| p.parent()).map(Path::to_path_buf).unwrap_or_default();
+        let dir = branch
+            .last()
+            .and_then(|p| p.parent())
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
         let sheets = h.files[file].sheets.clone();
         for (i, s) in sheets.iter().enumerate() {
             let path = dir.join(&s.file);
@@ -458,7 +513,11 @@ impl Hierarchy {
                 .strip_prefix('/')
                 .map(|p| p.split_once('/').map_or("", |(_, rest)| rest))
                 .unwrap_or_default();
-            let rest = if rest.is_empty() { String::new() } else { format!("/{rest}") };
+            let rest = if rest.is_empty() {
+                String::new()
+            } else {
+                format!("/{rest}")
+            };
             if rest == sheet_path {
                 return (r.clone(), *u);
             }

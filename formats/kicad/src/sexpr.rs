@@ -141,10 +141,7 @@ impl Parser<'_> {
     }
 
     fn run(mut self) -> Result<Tree, KicadError> {
-        loop {
-            let Some(&c) = self.chars.peek() else {
-                break;
-            };
+        while let Some(&c) = self.chars.peek() {
             let (line, column) = (self.line, self.column);
             match c {
                 c if c.is_whitespace() => {
@@ -329,7 +326,8 @@ impl<'a> Node<'a> {
 
     /// The first sub-list named `keyword`, or [`KicadError::Missing`].
     pub fn req(&self, keyword: &'static str) -> Result<Node<'a>, KicadError> {
-        self.get(keyword).ok_or_else(|| self.missing(keyword))
+        self.get(keyword)
+            .ok_or_else(|| self.missing_owned(format!("({keyword} …)")))
     }
 
     /// The atoms after the keyword, in order.
@@ -419,6 +417,10 @@ impl<'a> Node<'a> {
 
     /// The error for something this list lacks.
     pub fn missing(&self, what: &'static str) -> KicadError {
+        self.missing_owned(what.to_owned())
+    }
+
+    fn missing_owned(&self, what: String) -> KicadError {
         KicadError::Missing {
             path: self.path(),
             line: self.line(),
@@ -445,13 +447,14 @@ mod tests {
 
     #[test]
     fn lists_atoms_strings_and_positions() {
-        let t = parse(b"(kicad_pcb (version 20211014)\n  (net 1 \"a \\\"b\\\"\") hide)").unwrap();
+        let t = parse(b"(kicad_pcb (version 20211014)\n  (net 1 \"a \\\"b\\\"\") hide)")
+            .expect("test data");
         let r = t.root();
         assert_eq!(r.keyword(), "kicad_pcb");
-        let net = r.get("net").unwrap();
+        let net = r.get("net").expect("test data");
         assert_eq!((net.line(), net.column()), (2, 3));
         assert_eq!(net.atom(1), Some("a \"b\""));
-        assert_eq!(net.num(0, "n").unwrap(), 1.0);
+        assert_eq!(net.num(0, "n").expect("test data"), 1.0);
         assert_eq!(net.path(), "kicad_pcb/net");
         assert!(r.flag("hide"));
         assert!(!net.flag("hide"));
@@ -459,18 +462,41 @@ mod tests {
 
     #[test]
     fn bad_input_is_refused_with_its_place() {
-        let e = parse(b"(a (b 1)").unwrap_err();
-        assert!(matches!(e, KicadError::UnexpectedEof { line: 1, column: 1, .. }), "{e}");
-        assert!(matches!(parse(b"(a))"), Err(KicadError::Syntax { line: 1, column: 4, .. })));
+        let e = parse(b"(a (b 1)").expect_err("must be refused");
+        assert!(
+            matches!(
+                e,
+                KicadError::UnexpectedEof {
+                    line: 1,
+                    column: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(matches!(
+            parse(b"(a))"),
+            Err(KicadError::Syntax {
+                line: 1,
+                column: 4,
+                ..
+            })
+        ));
         assert!(matches!(parse(b"( \"x\")"), Err(KicadError::Syntax { .. })));
         assert!(matches!(parse(b"(a \"x)"), Err(KicadError::Syntax { .. })));
         assert!(matches!(parse(b"(a)(b)"), Err(KicadError::Syntax { .. })));
         assert!(matches!(parse(b""), Err(KicadError::NotKicad { .. })));
-        assert!(matches!(parse(b"(a \xff)"), Err(KicadError::NotUtf8 { line: 1, column: 4 })));
+        assert!(matches!(
+            parse(b"(a \xff)"),
+            Err(KicadError::NotUtf8 { line: 1, column: 4 })
+        ));
         let deep = "(a ".repeat(MAX_DEPTH + 1);
-        assert!(matches!(parse(deep.as_bytes()), Err(KicadError::TooDeep { .. })));
-        let t = parse(b"(a (at 1 x))").unwrap();
-        let e = t.root().at().unwrap_err();
-        assert_eq!(e.to_string(), "a/at, line 1, column 9: \"x\" is not y, mm");
+        assert!(matches!(
+            parse(deep.as_bytes()),
+            Err(KicadError::TooDeep { .. })
+        ));
+        let t = parse(b"(a (at 1 x))").expect("test data");
+        let e = t.root().at().expect_err("must be refused");
+        assert_eq!(e.to_string(), "a/at, line 1, column 10: \"x\" is not y, mm");
     }
 }

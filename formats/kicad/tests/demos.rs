@@ -11,7 +11,9 @@ fn files(ext: &str) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let mut dirs = vec![PathBuf::from(DEMOS)];
     while let Some(d) = dirs.pop() {
-        let Ok(rd) = std::fs::read_dir(&d) else { continue };
+        let Ok(rd) = std::fs::read_dir(&d) else {
+            continue;
+        };
         for e in rd.flatten() {
             let p = e.path();
             if p.is_dir() {
@@ -40,12 +42,16 @@ fn every_demo_schematic_nets_match_its_board() {
     }
     let mut compared = 0;
     for pcb_path in files("kicad_pcb") {
-        let bytes = std::fs::read(&pcb_path).unwrap();
+        let bytes = std::fs::read(&pcb_path).expect("test data");
         let pcb = conduit_kicad::read_pcb(&bytes)
             .unwrap_or_else(|e| panic!("{}: {e}", pcb_path.display()));
         let sch_path = pcb_path.with_extension("kicad_sch");
         if !sch_path.exists() {
-            println!("{}: {} footprints, no schematic", pcb_path.display(), pcb.footprints.len());
+            println!(
+                "{}: {} footprints, no schematic",
+                pcb_path.display(),
+                pcb.footprints.len()
+            );
             continue;
         }
         let sch = conduit_kicad::read_schematic_file(&sch_path)
@@ -53,7 +59,7 @@ fn every_demo_schematic_nets_match_its_board() {
         let cmp = NetlistComparison::new(&sch.netlist(), &pcb.netlist());
         println!(
             "{}: {} sheets, {} parts, {} footprints, {} pads; nets connected sch {} pcb {}, equal {}, names equal {}",
-            pcb_path.file_stem().unwrap().to_string_lossy(),
+            pcb_path.file_stem().expect("test data").to_string_lossy(),
             sch.sheet_instances,
             sch.parts.len(),
             pcb.footprints.len(),
@@ -69,9 +75,22 @@ fn every_demo_schematic_nets_match_its_board() {
         for (n, pads) in &cmp.only_right {
             println!("  only pcb {n}: {pads:?}");
         }
+        assert!(
+            cmp.is_equal(),
+            "{}: the schematic's nets differ from the board's",
+            pcb_path.display()
+        );
+        assert_eq!(
+            sch.parts.len(),
+            pcb.footprints
+                .iter()
+                .filter(|f| sch.part(&f.reference).is_some())
+                .count()
+        );
         compared += 1;
     }
-    assert!(compared >= 10);
+    // Every project of kicad-demos 6.0 with both files.
+    assert_eq!(compared, 13);
 }
 
 #[test]
@@ -80,7 +99,7 @@ fn every_demo_schematic_reads() {
         return;
     }
     for p in files("kicad_sch") {
-        let bytes = std::fs::read(&p).unwrap();
+        let bytes = std::fs::read(&p).expect("test data");
         // Sub-sheets read as roots too (their own sheets, if any, beside them).
         conduit_kicad::read_schematic(&bytes, &p, &mut |q| std::fs::read(q))
             .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
