@@ -118,7 +118,8 @@ pub struct ConfigSource {
 
 /// Arguments of `conduit place`.
 #[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("how").required(true).args(["from_brd", "auto"])))]
+#[command(group(clap::ArgGroup::new("how").required(true).args(["from_brd", "from_pcb", "auto"])))]
+#[command(group(clap::ArgGroup::new("board").args(["from_brd", "from_pcb"])))]
 pub struct PlaceArgs {
     /// The model the parts go into (STL, 3MF, OBJ, OFF, PLY; its first object).
     #[arg(long, value_name = "MODEL")]
@@ -126,11 +127,19 @@ pub struct PlaceArgs {
     /// Lay the parts out as this EAGLE board has them.
     #[arg(long, value_name = "X.brd")]
     pub from_brd: Option<PathBuf>,
+    /// Lay the parts out as this KiCad board has them (as --from-brd does).
+    #[arg(long, value_name = "X.kicad_pcb")]
+    pub from_pcb: Option<PathBuf>,
     /// Pack the parts inside the model's solid, keeping nets short.
     #[arg(long)]
     pub auto: bool,
-    /// The circuit (.sch or .brd) the placement is for; with --from-brd, the board by default.
-    #[arg(long, value_name = "X.sch|X.brd", required_unless_present = "from_brd")]
+    /// The circuit (.sch, .brd, .kicad_sch, .kicad_pcb or .net) the placement is for; with
+    /// --from-brd or --from-pcb, the board by default.
+    #[arg(
+        long,
+        value_name = "X.sch|X.brd|X.kicad_sch|X.kicad_pcb|X.net",
+        required_unless_present_any = ["from_brd", "from_pcb"]
+    )]
     pub circuit: Option<PathBuf>,
     /// Settings (`route.wall_clearance`, `route.cavity_offset`, the trace width, the layers).
     #[command(flatten)]
@@ -153,36 +162,36 @@ pub struct PlaceArgs {
         allow_hyphen_values = true
     )]
     pub z_from_top: Option<f64>,
-    /// With --from-brd: where the board's centre goes, `X,Y` in model mm (default: the middle
+    /// With --from-brd or --from-pcb: where the board's centre goes, `X,Y` in model mm (default: the middle
     /// of the model's bounding box).
-    #[arg(long, value_name = "X,Y", value_parser = parse_xy, requires = "from_brd", allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y", value_parser = parse_xy, requires = "board", allow_hyphen_values = true)]
     pub at: Option<[f64; 2]>,
-    /// With --from-brd: turn the layout about the board's centre, degrees counter-clockwise.
+    /// With --from-brd or --from-pcb: turn the layout about the board's centre, degrees counter-clockwise.
     #[arg(
         long,
         value_name = "DEG",
         default_value_t = 0.0,
-        requires = "from_brd",
+        requires = "board",
         allow_hyphen_values = true
     )]
     pub rotate: f64,
-    /// With --from-brd: spread the layout (distances between parts times S; parts keep their
+    /// With --from-brd or --from-pcb: spread the layout (distances between parts times S; parts keep their
     /// size). The summary suggests the smallest scale that leaves traces room between pads.
-    #[arg(long, value_name = "S", default_value_t = 1.0, requires = "from_brd")]
+    #[arg(long, value_name = "S", default_value_t = 1.0, requires = "board")]
     pub scale: f64,
-    /// With --from-brd: seating plane of the bottom-side parts (face up); by default under
+    /// With --from-brd or --from-pcb: seating plane of the bottom-side parts (face up); by default under
     /// the top plane by the body height and `route.wall_clearance`.
     #[arg(
         long,
         value_name = "Z",
-        requires = "from_brd",
+        requires = "board",
         conflicts_with = "bottom",
         allow_hyphen_values = true
     )]
     pub bottom_z: Option<f64>,
-    /// With --from-brd: `refuse` fails on a board with bottom-side parts instead of placing
+    /// With --from-brd or --from-pcb: `refuse` fails on a board with bottom-side parts instead of placing
     /// them face up below the top parts.
-    #[arg(long, value_name = "below|refuse", value_parser = ["below", "refuse"], requires = "from_brd")]
+    #[arg(long, value_name = "below|refuse", value_parser = ["below", "refuse"], requires = "board")]
     pub bottom: Option<String>,
     /// Body height written for every part, mm (board files have none: measure your parts).
     #[arg(long, value_name = "H", default_value_t = 1.0)]

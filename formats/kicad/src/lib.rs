@@ -108,6 +108,40 @@ pub(crate) fn wrong_kind(found: &str, expected: &'static str) -> KicadError {
     KicadError::WrongKind { expected, found }
 }
 
+/// What a KiCad file contains.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Document {
+    /// A board (`.kicad_pcb`).
+    Pcb(Pcb),
+    /// A schematic (`.kicad_sch`) with its sheets.
+    Schematic(Schematic),
+    /// A netlist export (`.net`).
+    NetFile(NetFile),
+}
+
+/// Reads any KiCad file by its content; a schematic's sheets are read through `load`
+/// (paths relative to `path`'s folder).
+///
+/// # Errors
+/// [`KicadError::NotKicad`] for anything else, and those of the readers.
+pub fn read(
+    bytes: &[u8],
+    path: &Path,
+    load: &mut dyn FnMut(&Path) -> std::io::Result<Vec<u8>>,
+) -> Result<Document, KicadError> {
+    match sniff(bytes) {
+        Some(Kind::Pcb) => read_pcb(bytes).map(Document::Pcb),
+        Some(Kind::Schematic) => read_schematic(bytes, path, load).map(Document::Schematic),
+        Some(Kind::NetFile) => read_netfile(bytes).map(Document::NetFile),
+        None => {
+            let tree = sexpr::parse(bytes)?;
+            Err(KicadError::NotKicad {
+                found: tree.root().keyword().to_owned(),
+            })
+        }
+    }
+}
+
 /// Reads a `.kicad_pcb`.
 ///
 /// # Errors
