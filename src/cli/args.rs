@@ -37,7 +37,7 @@ pub struct Cli {
 /// The commands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Show what is in files: meshes, 3MF builds, EAGLE designs, G-code, point clouds, SVG designs.
+    /// Show what is in files: meshes, 3MF builds, EAGLE and KiCad designs, G-code, point clouds, SVG designs.
     Info(InfoArgs),
     /// Convert meshes between STL, 3MF and OBJ (reads STL, 3MF, OBJ, OFF, PLY), in parallel.
     Convert(ConvertArgs),
@@ -59,9 +59,9 @@ pub enum Command {
     /// Place a circuit's parts by hand in a 3D view in the browser, served on 127.0.0.1: drag
     /// parts, see the checks and rubberbands follow, route, save the placement TOML.
     Studio(StudioArgs),
-    /// Write a placement (TOML to edit) for a circuit in a model: an EAGLE board's layout moved
-    /// into the object (`--from-brd`), or the parts packed inside its solid (`--auto`); every
-    /// part is checked against the solid and the others.
+    /// Write a placement (TOML to edit) for a circuit in a model: an EAGLE or KiCad board's
+    /// layout moved into the object (`--from-brd`, `--from-pcb`), or the parts packed inside its
+    /// solid (`--auto`); every part is checked against the solid and the others.
     Place(PlaceArgs),
     /// Slicer plugin mode: read another slicer's G-code (PrusaSlicer, SuperSlicer, OrcaSlicer,
     /// Cura, Slic3r...) with its settings (unless `-c` is given) and edit it in place; without a
@@ -255,10 +255,15 @@ pub struct SliceArgs {
     /// also parts and, per wire, routed/length/lower bound/layer changes/perimeter crossings).
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
-    /// Circuit to build into the object: an EAGLE schematic or board (.sch, .brd). Needs
+    /// Circuit to build into the object: an EAGLE schematic or board (.sch, .brd) or a KiCad
+    /// schematic, board or netlist (.kicad_sch, .kicad_pcb, .net). Needs
     /// `--placement`. Also writes the pick-and-place files OUT.pos (KiCad's ASCII table, as
     /// OpenPnP imports it), OUT-pos.csv (KiCad's CSV) and OUT.board.xml (an OpenPnP board).
-    #[arg(long, value_name = "X.sch|X.brd", requires = "placement")]
+    #[arg(
+        long,
+        value_name = "X.sch|X.brd|X.kicad_sch|X.kicad_pcb|X.net",
+        requires = "placement"
+    )]
     pub circuit: Option<PathBuf>,
     /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.
     #[arg(long, value_name = "P.toml|P.3de", requires = "circuit")]
@@ -294,8 +299,9 @@ pub struct RouteArgs {
     /// Settings.
     #[command(flatten)]
     pub config: ConfigSource,
-    /// The circuit: an EAGLE schematic or board (.sch, .brd).
-    #[arg(long, value_name = "X.sch|X.brd")]
+    /// The circuit: an EAGLE schematic or board (.sch, .brd) or a KiCad
+    /// schematic, board or netlist (.kicad_sch, .kicad_pcb, .net).
+    #[arg(long, value_name = "X.sch|X.brd|X.kicad_sch|X.kicad_pcb|X.net")]
     pub circuit: PathBuf,
     /// Where the parts go: a placement TOML or an Electronic Slic3r .3de file.
     #[arg(long, value_name = "P.toml|P.3de")]
@@ -329,12 +335,17 @@ pub struct PostprocessArgs {
     /// settings written into the G-code).
     #[command(flatten)]
     pub config: ConfigSource,
-    /// Circuit to build into the print: an EAGLE schematic or board (.sch, .brd). Needs
+    /// Circuit to build into the print: an EAGLE schematic or board (.sch, .brd) or a KiCad
+    /// schematic, board or netlist (.kicad_sch, .kicad_pcb, .net). Needs
     /// `--placement`. Its parts get cavities cut from the host's extrusion, its wires are routed
     /// in channels and printed on the conductive tool at layer ends, with part events; the
     /// placement is in the host's bed coordinates (`origin = "model"`) or relative to the
     /// printed object's centre (`origin = "bbox_center"`).
-    #[arg(long, value_name = "X.sch|X.brd", requires = "placement")]
+    #[arg(
+        long,
+        value_name = "X.sch|X.brd|X.kicad_sch|X.kicad_pcb|X.net",
+        requires = "placement"
+    )]
     pub circuit: Option<PathBuf>,
     /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.
     #[arg(long, value_name = "P.toml|P.3de", requires = "circuit")]
@@ -531,7 +542,7 @@ pub struct CheckArgs {
     #[arg(long)]
     pub json: bool,
     /// Check the circuit in the G-code too: nets connected, no shorts, no conductive material
-    /// outside the solid, part events after their cavity (EAGLE `.sch` or `.brd`).
+    /// outside the solid, part events after their cavity (EAGLE `.sch`, `.brd`, or KiCad `.kicad_sch`, `.kicad_pcb`, `.net`).
     #[arg(long, value_name = "FILE", requires = "placement")]
     pub circuit: Option<PathBuf>,
     /// Where the circuit's parts sit (`.toml` or `.3de`), as given to slice or postprocess.
@@ -637,7 +648,7 @@ pub struct ViewArgs {
     /// places it with the same config.
     #[arg(long, value_name = "MODEL")]
     pub model: Option<PathBuf>,
-    /// Show the circuit (EAGLE `.sch`/`.brd`): parts as labelled boxes, cavities, and the
+    /// Show the circuit (EAGLE `.sch`/`.brd`, KiCad `.kicad_sch`/`.kicad_pcb`/`.net`): parts as labelled boxes, cavities, and the
     /// wires the first file's traces do not connect.
     #[arg(long, value_name = "FILE", requires = "placement")]
     pub circuit: Option<PathBuf>,
@@ -658,7 +669,7 @@ pub struct StudioArgs {
     /// The model the parts go into (STL, 3MF, OBJ, OFF, PLY).
     #[arg(value_name = "MODEL")]
     pub model: PathBuf,
-    /// The circuit (EAGLE `.sch` or `.brd`).
+    /// The circuit (EAGLE `.sch`, `.brd`, or KiCad `.kicad_sch`, `.kicad_pcb`, `.net`).
     #[arg(long, value_name = "FILE")]
     pub circuit: PathBuf,
     /// The placement to start from (`.toml` or `.3de`); without it the parts are laid out as
