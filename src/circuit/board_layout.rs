@@ -630,4 +630,36 @@ mod tests {
         // mirror has it.
         assert_eq!(face_up_rotation(&packages[0], 0.0), 180.0);
     }
+
+    /// A KiCad bottom footprint turned by θ is EAGLE's `MR(180° − θ)` of its top-side pads:
+    /// the layout's element puts every pad where the KiCad board has it.
+    #[test]
+    fn a_kicad_bottom_footprint_is_eagles_mirrored_element() {
+        let pcb = conduit_kicad::read_pcb(
+            br#"(kicad_pcb (version 20240108)
+              (footprint "X" (layer "B.Cu") (at 10 20 30) (property "Reference" "U1")
+                (pad "1" smd rect (at 1 2 30) (size 1 1) (layers "B.Cu"))
+                (pad "2" smd rect (at -1.5 0.5 30) (size 1 1) (layers "B.Cu")))
+              (gr_line (start 0 0) (end 40 -10) (layer "Edge.Cuts")))"#,
+        )
+        .expect("board");
+        let input = BoardInput::from_kicad(&pcb);
+        let e = &input.elements[0];
+        assert_eq!((e.x, e.y, e.degrees, e.mirror), (10.0, -20.0, 150.0, true));
+        assert_eq!(input.outline, [[0.0, 0.0], [40.0, 10.0]]);
+        let part = &Circuit::from_kicad_pcb(&pcb).parts[0];
+        let f = &pcb.footprints[0];
+        let (s, c) = e.degrees.to_radians().sin_cos();
+        for (pad, kicad) in part.pads.iter().zip(&f.pads) {
+            // EAGLE's MR<degrees>: turned, then x negated; y up.
+            let (x, y) = (pad.x, pad.y);
+            let eagle = [e.x - (x * c - y * s), e.y + x * s + y * c];
+            let (bx, by) = f.board_position(kicad);
+            assert!(
+                (eagle[0] - bx).abs() < 1e-9 && (eagle[1] + by).abs() < 1e-9,
+                "{}: {eagle:?} vs ({bx}, {by})",
+                pad.name
+            );
+        }
+    }
 }
