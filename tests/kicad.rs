@@ -125,6 +125,32 @@ fn the_sample_schematic_and_board_are_one_circuit() {
     );
 }
 
+/// A netlist export takes its pads from the board of its name beside it.
+#[test]
+fn a_netlist_export_beside_its_board_is_the_circuit() {
+    let dir = temp_dir();
+    let d = dir.path();
+    std::fs::copy(demo("led_coin.kicad_pcb"), d.join("led_coin.kicad_pcb")).expect("copy");
+    std::fs::write(
+        d.join("led_coin.net"),
+        r#"(export (version "E")
+  (design (source "led_coin.kicad_sch") (tool "Eeschema 8.0"))
+  (components
+    (comp (ref "BAT1") (value "CR2032") (footprint "conduit_demo:CR2032-SMD"))
+    (comp (ref "R1") (value "220R") (footprint "conduit_demo:R0805"))
+    (comp (ref "LED1") (value "red") (footprint "conduit_demo:LED-0805")))
+  (nets
+    (net (code "1") (name "/N1") (node (ref "LED1") (pin "A")) (node (ref "R1") (pin "2")))
+    (net (code "2") (name "GND") (node (ref "BAT1") (pin "-")) (node (ref "LED1") (pin "C")))
+    (net (code "3") (name "VCC") (node (ref "BAT1") (pin "+")) (node (ref "R1") (pin "1")))))
+"#,
+    )
+    .expect("net written");
+    let net = conduit::circuit::Circuit::load(&d.join("led_coin.net")).expect("netlist");
+    let pcb = conduit::circuit::Circuit::load(&demo("led_coin.kicad_pcb")).expect("board");
+    assert_eq!(net, pcb);
+}
+
 #[test]
 fn every_kicad_demo_loads_as_a_circuit() {
     let demos = Path::new("/usr/share/kicad/demos");
