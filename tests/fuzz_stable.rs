@@ -96,6 +96,7 @@ fuzz_tests!(
     ply,
     xyz,
     eagle,
+    kicad,
     gcode,
     svg,
     dxf,

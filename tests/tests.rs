@@ -21,6 +21,7 @@ mod fuzz_stable;
 mod golden;
 mod grammar;
 mod jet;
+mod kicad;
 mod outputs;
 mod overhangs;
 mod pack_corpus;

@@ -1,5 +1,6 @@
-//! An EAGLE board's layout moved into a printed object: where `conduit place --from-brd` puts
-//! each part, and the scale that leaves printed traces room between the parts.
+//! A board's layout (EAGLE or KiCad) moved into a printed object: where `conduit place
+//! --from-brd` / `--from-pcb` puts each part, and the scale that leaves printed traces room
+//! between the parts.
 //!
 //! Place in the pipeline: before everything else of the electronics line, it writes the
 //! [`Placement`] a user then edits and slices with. The board's centre (its outline's, or its
@@ -17,6 +18,90 @@ use super::placed::place;
 use super::placement::{Connection, Origin, PartPlacement, Placement, PlacingMethod};
 use super::{Circuit, Part, PlacedPart};
 use crate::geom::BoundingBox;
+
+/// An element of a board as the layout reads it, in EAGLE's frame: mm with y up, angles
+/// counter-clockwise; a bottom-side element is `mirror`ed as EAGLE's `MR<degrees>` (turned by
+/// `degrees`, then x negated) and its part's pads are those of its top side.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayoutElement {
+    /// The element's name, the circuit part's.
+    pub name: String,
+    /// Origin x, mm.
+    pub x: f64,
+    /// Origin y, mm (y up).
+    pub y: f64,
+    /// Rotation, degrees counter-clockwise.
+    pub degrees: f64,
+    /// On the bottom side.
+    pub mirror: bool,
+}
+
+/// A board as the layout reads it: its elements and the points of its outline.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BoardInput {
+    /// The elements in file order.
+    pub elements: Vec<LayoutElement>,
+    /// Points whose bounding box is the outline's (mm, y up); empty when the board has none.
+    pub outline: Vec<[f64; 2]>,
+}
+
+impl BoardInput {
+    /// An EAGLE board: its elements, and the ends of its Dimension wires.
+    pub fn from_eagle(board: &conduit_eagle::Board) -> Self {
+        BoardInput {
+            elements: board
+                .elements
+                .iter()
+                .map(|e| LayoutElement {
+                    name: e.name.clone(),
+                    x: e.x,
+                    y: e.y,
+                    degrees: e.rotation.degrees,
+                    mirror: e.rotation.mirror,
+                })
+                .collect(),
+            outline: board
+                .outline
+                .iter()
+                .flat_map(|s| [[s.x1, s.y1], [s.x2, s.y2]])
+                .collect(),
+        }
+    }
+
+    /// A KiCad board: its footprints with y turned up, and the points of its `Edge.Cuts`
+    /// drawings. A bottom footprint turned by θ holds its top-side pads mirrored in y, then
+    /// turned: EAGLE's `MR(180° − θ)`.
+    pub fn from_kicad(pcb: &conduit_kicad::Pcb) -> Self {
+        BoardInput {
+            elements: pcb
+                .footprints
+                .iter()
+                .map(|f| LayoutElement {
+                    name: f.reference.clone(),
+                    x: f.x,
+                    y: -f.y,
+                    degrees: if f.bottom {
+                        (180.0 - f.rotation).rem_euclid(360.0)
+                    } else {
+                        f.rotation
+                    },
+                    mirror: f.bottom,
+                })
+                .collect(),
+            outline: pcb
+                .outline
+                .iter()
+                .flat_map(conduit_kicad::OutlineShape::extent_points)
+                .map(|(x, y)| [x, -y])
+                .collect(),
+        }
+    }
+
+    /// The element named `name`.
+    pub fn element(&self, name: &str) -> Option<&LayoutElement> {
+        self.elements.iter().find(|e| e.name == name)
+    }
+}
 
 /// How a board's layout is moved into the object (model coordinates, mm and degrees).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -91,12 +176,8 @@ pub enum BoardLayoutError {
 /// wires of the Dimension layer), or, when it has none (a round board drawn as a circle), of
 /// the origins of the elements that are circuit parts with a pad on a net (a drawing frame
 /// or logo far from the board does not count).
-pub fn board_centre(board: &conduit_eagle::Board, circuit: &Circuit) -> [f64; 2] {
-    let mut points: Vec<[f64; 2]> = board
-        .outline
-        .iter()
-        .flat_map(|s| [[s.x1, s.y1], [s.x2, s.y2]])
-        .collect();
+pub fn board_centre(board: &BoardInput, circuit: &Circuit) -> [f64; 2] {
+    let mut points: Vec<[f64; 2]> = board.outline.clone();
     if points.is_empty() {
         points = board
             .elements
@@ -141,10 +222,7 @@ pub fn face_up_rotation(part: &Part, degrees: f64) -> f64 {
 /// The top-side elements whose pads' extent (their package's pad rectangle, turned as the
 /// board turns it) holds the centre of a smaller top-side element's pads: on the board they
 /// stand over that part, which a print can only do with them on a lower plane.
-fn covering_parts(
-    board: &conduit_eagle::Board,
-    circuit: &Circuit,
-) -> std::collections::BTreeSet<String> {
+fn covering_parts(board: &BoardInput, circuit: &Circuit) -> std::collections::BTreeSet<String> {
     struct Extent {
         name: String,
         centre: [f64; 2],
@@ -156,20 +234,20 @@ fn covering_parts(
     let extents: Vec<Extent> = board
         .elements
         .iter()
-        .filter(|e| !e.rotation.mirror)
+        .filter(|e| !e.mirror)
         .filter_map(|e| {
             let part = circuit
                 .part(&e.name)
                 .filter(|p| has_connected_pads(circuit, p))?;
             let [x0, y0, x1, y1] = part.pad_extent()?;
             let (lo, hi) = ([x0, y0], [x1, y1]);
-            let (s, c) = e.rotation.degrees.to_radians().sin_cos();
+            let (s, c) = e.degrees.to_radians().sin_cos();
             let (mx, my) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
             Some(Extent {
                 name: e.name.clone(),
                 centre: [e.x + mx * c - my * s, e.y + mx * s + my * c],
                 at: [e.x, e.y],
-                turn: e.rotation.degrees,
+                turn: e.degrees,
                 lo,
                 hi,
             })
@@ -213,7 +291,7 @@ pub(crate) fn has_connected_pads(circuit: &Circuit, part: &Part) -> bool {
 /// [`BoardLayoutError`] for refused bottom parts, a board without parts, or a scale or body
 /// height that is not a positive number.
 pub fn layout_board(
-    board: &conduit_eagle::Board,
+    board: &BoardInput,
     circuit: &Circuit,
     params: &BoardLayoutParams,
 ) -> Result<BoardLayout, BoardLayoutError> {
@@ -258,16 +336,16 @@ pub fn layout_board(
                 .push(format!("{}: none of its pads is on a net", e.name));
             continue;
         }
-        let (side, z, rotation) = if e.rotation.mirror {
+        let (side, z, rotation) = if e.mirror {
             let Some(z) = params.bottom_z else {
                 refused.push(e.name.clone());
                 continue;
             };
-            (Side::Bottom, z, face_up_rotation(part, e.rotation.degrees))
+            (Side::Bottom, z, face_up_rotation(part, e.degrees))
         } else if let (true, Some(z)) = (covering.contains(&e.name), params.bottom_z) {
-            (Side::Under, z, e.rotation.degrees)
+            (Side::Under, z, e.degrees)
         } else {
-            (Side::Top, params.top_z, e.rotation.degrees)
+            (Side::Top, params.top_z, e.degrees)
         };
         let (dx, dy) = (
             (e.x - centre[0]) * params.scale,
@@ -459,7 +537,7 @@ pub const MAX_SUGGESTED_SCALE: f64 = 10.0;
 /// parts at the same heights `room.parts`, with the board laid out by `params` otherwise;
 /// `None` when even the largest does not do it.
 pub fn suggest_scale(
-    board: &conduit_eagle::Board,
+    board: &BoardInput,
     circuit: &Circuit,
     params: &BoardLayoutParams,
     room: Room,
@@ -551,5 +629,37 @@ mod tests {
         // A two-pad part along x mirrored without a turn: a half turn puts pad 1 where the
         // mirror has it.
         assert_eq!(face_up_rotation(&packages[0], 0.0), 180.0);
+    }
+
+    /// A KiCad bottom footprint turned by θ is EAGLE's `MR(180° − θ)` of its top-side pads:
+    /// the layout's element puts every pad where the KiCad board has it.
+    #[test]
+    fn a_kicad_bottom_footprint_is_eagles_mirrored_element() {
+        let pcb = conduit_kicad::read_pcb(
+            br#"(kicad_pcb (version 20240108)
+              (footprint "X" (layer "B.Cu") (at 10 20 30) (property "Reference" "U1")
+                (pad "1" smd rect (at 1 2 30) (size 1 1) (layers "B.Cu"))
+                (pad "2" smd rect (at -1.5 0.5 30) (size 1 1) (layers "B.Cu")))
+              (gr_line (start 0 0) (end 40 -10) (layer "Edge.Cuts")))"#,
+        )
+        .expect("board");
+        let input = BoardInput::from_kicad(&pcb);
+        let e = &input.elements[0];
+        assert_eq!((e.x, e.y, e.degrees, e.mirror), (10.0, -20.0, 150.0, true));
+        assert_eq!(input.outline, [[0.0, 0.0], [40.0, 10.0]]);
+        let part = &Circuit::from_kicad_pcb(&pcb).parts[0];
+        let f = &pcb.footprints[0];
+        let (s, c) = e.degrees.to_radians().sin_cos();
+        for (pad, kicad) in part.pads.iter().zip(&f.pads) {
+            // EAGLE's MR<degrees>: turned, then x negated; y up.
+            let (x, y) = (pad.x, pad.y);
+            let eagle = [e.x - (x * c - y * s), e.y + x * s + y * c];
+            let (bx, by) = f.board_position(kicad);
+            assert!(
+                (eagle[0] - bx).abs() < 1e-9 && (eagle[1] + by).abs() < 1e-9,
+                "{}: {eagle:?} vs ({bx}, {by})",
+                pad.name
+            );
+        }
     }
 }

@@ -1,7 +1,7 @@
 //! Circuits, part placement and rubberbands: the inputs of the route stage.
 //!
 //! ```text
-//! .sch/.brd ──Circuit::load──► Circuit (parts, pads, nets)
+//! .sch/.brd, .kicad_pcb/.kicad_sch/.net ──Circuit::load──► Circuit (parts, pads, nets)
 //! .toml/.3de ──Placement::load──► Placement (poses, waypoints, wires)   ──validate(&Circuit)
 //!                 place(circuit, placement, object bboxes) ──► PlacedPart (pads in model frame)
 //!                 rubberbands(circuit, placement, placed) ──► Rubberband (connections to route)
@@ -10,10 +10,12 @@
 //! This module only describes *what* must be connected and *where* the parts sit; it never
 //! reads a mesh and never routes. The EAGLE files are read by the `conduit-eagle` crate; this
 //! module turns its [`conduit_eagle::Schematic`] or [`conduit_eagle::Board`] into a
-//! [`Circuit`] the pipeline uses.
+//! [`Circuit`] the pipeline uses. KiCad files are read by `conduit-kicad` and converted in
+//! [`kicad`].
 
 pub mod board_layout;
 pub mod fit;
+pub mod kicad;
 mod placed;
 mod placement;
 pub mod placement_toml;
@@ -325,8 +327,11 @@ pub struct Circuit {
 /// Why a circuit could not be loaded.
 ///
 /// # How to fix
-/// Pass an EAGLE 6+ XML schematic (`.sch`) or board (`.brd`); re-save older binary files in
-/// EAGLE. The wrapped [`conduit_eagle::EagleError`] says what is wrong inside the file.
+/// Pass an EAGLE 6+ XML schematic (`.sch`) or board (`.brd`), or a KiCad 6+ board
+/// (`.kicad_pcb`), schematic (`.kicad_sch`) or netlist export (`.net`); re-save older files in
+/// their program. The wrapped [`conduit_eagle::EagleError`] or [`conduit_kicad::KicadError`]
+/// says what is wrong inside the file. A KiCad schematic or netlist needs its board beside it
+/// for the pads.
 ///
 /// A variant that wraps another error shows it in its own message rather than chaining it as
 /// a source, so an error printed with its chain names the cause once.
@@ -347,6 +352,35 @@ pub enum CircuitError {
         path: PathBuf,
         /// What the EAGLE reader found.
         error: Box<conduit_eagle::EagleError>,
+    },
+    /// The file is not a readable KiCad board, schematic or netlist export.
+    #[error("{path}: KiCad: {error}")]
+    Kicad {
+        /// The file.
+        path: PathBuf,
+        /// What the KiCad reader found.
+        error: Box<conduit_kicad::KicadError>,
+    },
+    /// A KiCad schematic or netlist export whose parts have no pads: their footprints are only
+    /// named, and the board beside it is missing or lacks them.
+    #[error(
+        "{path}: no pad geometry for {} part(s) ({}): {}",
+        parts.len(),
+        parts.join(", "),
+        match board {
+            Some(b) => format!("{} has no footprint with their references; update the board from the schematic in KiCad", b.display()),
+            None => format!("put the KiCad board {} beside it (the schematic only names footprints)", expected.display()),
+        }
+    )]
+    KicadPadsMissing {
+        /// The schematic or netlist export.
+        path: PathBuf,
+        /// The board read beside it, if there is one.
+        board: Option<PathBuf>,
+        /// The board looked for.
+        expected: PathBuf,
+        /// The references of the parts without pads, sorted.
+        parts: Vec<String>,
     },
     /// A pad whose position, size or rotation is not finite or beyond its bound
     /// ([`MAX_PAD_MM`], [`MAX_PAD_ROTATION_DEG`]).
@@ -421,7 +455,9 @@ impl Circuit {
         }
     }
 
-    /// Reads an EAGLE `.sch` or `.brd`; which one is decided by the content, not the name.
+    /// Reads an EAGLE `.sch` or `.brd`, or a KiCad `.kicad_pcb`, `.kicad_sch` or `.net`
+    /// (with its board beside it, see [`kicad`]); which one is decided by the content, not the
+    /// name.
     ///
     /// # Errors
     /// [`CircuitError`] naming the file.
@@ -430,6 +466,11 @@ impl Circuit {
             path: path.to_path_buf(),
             error,
         })?;
+        if conduit_kicad::sniff(&bytes).is_some() {
+            let circuit = Self::from_kicad(&kicad::read(&bytes, path)?, path)?;
+            circuit.check_pads(path)?;
+            return Ok(circuit);
+        }
         let circuit = match conduit_eagle::read(&bytes) {
             Ok(conduit_eagle::Document::Schematic(s)) => Self::from_schematic(&s),
             Ok(conduit_eagle::Document::Board(b)) => Self::from_board(&b),

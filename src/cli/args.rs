@@ -37,7 +37,7 @@ pub struct Cli {
 /// The commands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Show what is in files: meshes, 3MF builds, EAGLE designs, G-code, point clouds, SVG designs.
+    /// Show what is in files: meshes, 3MF builds, EAGLE and KiCad designs, G-code, point clouds, SVG designs.
     Info(InfoArgs),
     /// Convert meshes between STL, 3MF and OBJ (reads STL, 3MF, OBJ, OFF, PLY), in parallel.
     Convert(ConvertArgs),
@@ -59,9 +59,9 @@ pub enum Command {
     /// Place a circuit's parts by hand in a 3D view in the browser, served on 127.0.0.1: drag
     /// parts, see the checks and rubberbands follow, route, save the placement TOML.
     Studio(StudioArgs),
-    /// Write a placement (TOML to edit) for a circuit in a model: an EAGLE board's layout moved
-    /// into the object (`--from-brd`), or the parts packed inside its solid (`--auto`); every
-    /// part is checked against the solid and the others.
+    /// Write a placement (TOML to edit) for a circuit in a model: an EAGLE or KiCad board's
+    /// layout moved into the object (`--from-brd`, `--from-pcb`), or the parts packed inside its
+    /// solid (`--auto`); every part is checked against the solid and the others.
     Place(PlaceArgs),
     /// Slicer plugin mode: read another slicer's G-code (PrusaSlicer, SuperSlicer, OrcaSlicer,
     /// Cura, Slic3r...) with its settings (unless `-c` is given) and edit it in place; without a
@@ -118,7 +118,8 @@ pub struct ConfigSource {
 
 /// Arguments of `conduit place`.
 #[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("how").required(true).args(["from_brd", "auto"])))]
+#[command(group(clap::ArgGroup::new("how").required(true).args(["from_brd", "from_pcb", "auto"])))]
+#[command(group(clap::ArgGroup::new("board").args(["from_brd", "from_pcb"])))]
 pub struct PlaceArgs {
     /// The model the parts go into (STL, 3MF, OBJ, OFF, PLY; its first object).
     #[arg(long, value_name = "MODEL")]
@@ -126,11 +127,19 @@ pub struct PlaceArgs {
     /// Lay the parts out as this EAGLE board has them.
     #[arg(long, value_name = "X.brd")]
     pub from_brd: Option<PathBuf>,
+    /// Lay the parts out as this KiCad board has them (as --from-brd does).
+    #[arg(long, value_name = "X.kicad_pcb")]
+    pub from_pcb: Option<PathBuf>,
     /// Pack the parts inside the model's solid, keeping nets short.
     #[arg(long)]
     pub auto: bool,
-    /// The circuit (.sch or .brd) the placement is for; with --from-brd, the board by default.
-    #[arg(long, value_name = "X.sch|X.brd", required_unless_present = "from_brd")]
+    /// The circuit (.sch, .brd, .kicad_sch, .kicad_pcb or .net) the placement is for; with
+    /// --from-brd or --from-pcb, the board by default.
+    #[arg(
+        long,
+        value_name = "X.sch|X.brd|X.kicad_sch|X.kicad_pcb|X.net",
+        required_unless_present_any = ["from_brd", "from_pcb"]
+    )]
     pub circuit: Option<PathBuf>,
     /// Settings (`route.wall_clearance`, `route.cavity_offset`, the trace width, the layers).
     #[command(flatten)]
@@ -153,36 +162,36 @@ pub struct PlaceArgs {
         allow_hyphen_values = true
     )]
     pub z_from_top: Option<f64>,
-    /// With --from-brd: where the board's centre goes, `X,Y` in model mm (default: the middle
+    /// With --from-brd or --from-pcb: where the board's centre goes, `X,Y` in model mm (default: the middle
     /// of the model's bounding box).
-    #[arg(long, value_name = "X,Y", value_parser = parse_xy, requires = "from_brd", allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y", value_parser = parse_xy, requires = "board", allow_hyphen_values = true)]
     pub at: Option<[f64; 2]>,
-    /// With --from-brd: turn the layout about the board's centre, degrees counter-clockwise.
+    /// With --from-brd or --from-pcb: turn the layout about the board's centre, degrees counter-clockwise.
     #[arg(
         long,
         value_name = "DEG",
         default_value_t = 0.0,
-        requires = "from_brd",
+        requires = "board",
         allow_hyphen_values = true
     )]
     pub rotate: f64,
-    /// With --from-brd: spread the layout (distances between parts times S; parts keep their
+    /// With --from-brd or --from-pcb: spread the layout (distances between parts times S; parts keep their
     /// size). The summary suggests the smallest scale that leaves traces room between pads.
-    #[arg(long, value_name = "S", default_value_t = 1.0, requires = "from_brd")]
+    #[arg(long, value_name = "S", default_value_t = 1.0, requires = "board")]
     pub scale: f64,
-    /// With --from-brd: seating plane of the bottom-side parts (face up); by default under
+    /// With --from-brd or --from-pcb: seating plane of the bottom-side parts (face up); by default under
     /// the top plane by the body height and `route.wall_clearance`.
     #[arg(
         long,
         value_name = "Z",
-        requires = "from_brd",
+        requires = "board",
         conflicts_with = "bottom",
         allow_hyphen_values = true
     )]
     pub bottom_z: Option<f64>,
-    /// With --from-brd: `refuse` fails on a board with bottom-side parts instead of placing
+    /// With --from-brd or --from-pcb: `refuse` fails on a board with bottom-side parts instead of placing
     /// them face up below the top parts.
-    #[arg(long, value_name = "below|refuse", value_parser = ["below", "refuse"], requires = "from_brd")]
+    #[arg(long, value_name = "below|refuse", value_parser = ["below", "refuse"], requires = "board")]
     pub bottom: Option<String>,
     /// Body height written for every part, mm (board files have none: measure your parts).
     #[arg(long, value_name = "H", default_value_t = 1.0)]
@@ -246,10 +255,15 @@ pub struct SliceArgs {
     /// also parts and, per wire, routed/length/lower bound/layer changes/perimeter crossings).
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
-    /// Circuit to build into the object: an EAGLE schematic or board (.sch, .brd). Needs
+    /// Circuit to build into the object: an EAGLE schematic or board (.sch, .brd) or a KiCad
+    /// schematic, board or netlist (.kicad_sch, .kicad_pcb, .net). Needs
     /// `--placement`. Also writes the pick-and-place files OUT.pos (KiCad's ASCII table, as
     /// OpenPnP imports it), OUT-pos.csv (KiCad's CSV) and OUT.board.xml (an OpenPnP board).
-    #[arg(long, value_name = "X.sch|X.brd", requires = "placement")]
+    #[arg(
+        long,
+        value_name = "X.sch|X.brd|X.kicad_sch|X.kicad_pcb|X.net",
+        requires = "placement"
+    )]
     pub circuit: Option<PathBuf>,
     /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.
     #[arg(long, value_name = "P.toml|P.3de", requires = "circuit")]
@@ -285,8 +299,9 @@ pub struct RouteArgs {
     /// Settings.
     #[command(flatten)]
     pub config: ConfigSource,
-    /// The circuit: an EAGLE schematic or board (.sch, .brd).
-    #[arg(long, value_name = "X.sch|X.brd")]
+    /// The circuit: an EAGLE schematic or board (.sch, .brd) or a KiCad
+    /// schematic, board or netlist (.kicad_sch, .kicad_pcb, .net).
+    #[arg(long, value_name = "X.sch|X.brd|X.kicad_sch|X.kicad_pcb|X.net")]
     pub circuit: PathBuf,
     /// Where the parts go: a placement TOML or an Electronic Slic3r .3de file.
     #[arg(long, value_name = "P.toml|P.3de")]
@@ -320,12 +335,17 @@ pub struct PostprocessArgs {
     /// settings written into the G-code).
     #[command(flatten)]
     pub config: ConfigSource,
-    /// Circuit to build into the print: an EAGLE schematic or board (.sch, .brd). Needs
+    /// Circuit to build into the print: an EAGLE schematic or board (.sch, .brd) or a KiCad
+    /// schematic, board or netlist (.kicad_sch, .kicad_pcb, .net). Needs
     /// `--placement`. Its parts get cavities cut from the host's extrusion, its wires are routed
     /// in channels and printed on the conductive tool at layer ends, with part events; the
     /// placement is in the host's bed coordinates (`origin = "model"`) or relative to the
     /// printed object's centre (`origin = "bbox_center"`).
-    #[arg(long, value_name = "X.sch|X.brd", requires = "placement")]
+    #[arg(
+        long,
+        value_name = "X.sch|X.brd|X.kicad_sch|X.kicad_pcb|X.net",
+        requires = "placement"
+    )]
     pub circuit: Option<PathBuf>,
     /// Where the circuit's parts go: a placement TOML or an Electronic Slic3r .3de file.
     #[arg(long, value_name = "P.toml|P.3de", requires = "circuit")]
@@ -522,7 +542,7 @@ pub struct CheckArgs {
     #[arg(long)]
     pub json: bool,
     /// Check the circuit in the G-code too: nets connected, no shorts, no conductive material
-    /// outside the solid, part events after their cavity (EAGLE `.sch` or `.brd`).
+    /// outside the solid, part events after their cavity (EAGLE `.sch`, `.brd`, or KiCad `.kicad_sch`, `.kicad_pcb`, `.net`).
     #[arg(long, value_name = "FILE", requires = "placement")]
     pub circuit: Option<PathBuf>,
     /// Where the circuit's parts sit (`.toml` or `.3de`), as given to slice or postprocess.
@@ -628,7 +648,7 @@ pub struct ViewArgs {
     /// places it with the same config.
     #[arg(long, value_name = "MODEL")]
     pub model: Option<PathBuf>,
-    /// Show the circuit (EAGLE `.sch`/`.brd`): parts as labelled boxes, cavities, and the
+    /// Show the circuit (EAGLE `.sch`/`.brd`, KiCad `.kicad_sch`/`.kicad_pcb`/`.net`): parts as labelled boxes, cavities, and the
     /// wires the first file's traces do not connect.
     #[arg(long, value_name = "FILE", requires = "placement")]
     pub circuit: Option<PathBuf>,
@@ -649,7 +669,7 @@ pub struct StudioArgs {
     /// The model the parts go into (STL, 3MF, OBJ, OFF, PLY).
     #[arg(value_name = "MODEL")]
     pub model: PathBuf,
-    /// The circuit (EAGLE `.sch` or `.brd`).
+    /// The circuit (EAGLE `.sch`, `.brd`, or KiCad `.kicad_sch`, `.kicad_pcb`, `.net`).
     #[arg(long, value_name = "FILE")]
     pub circuit: PathBuf,
     /// The placement to start from (`.toml` or `.3de`); without it the parts are laid out as

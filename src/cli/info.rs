@@ -104,6 +104,7 @@ fn describe(file: &LoadedFile, trial_repair: bool) -> Value {
             })
         }
         Content::Eagle(doc) => describe_eagle(doc),
+        Content::Kicad(doc) => describe_kicad(doc, &file.path),
         Content::Gcode(summary) => json!({ "gcode": summary }),
         Content::Design(design) => json!({
             "width_mm": design.width_mm,
@@ -243,6 +244,49 @@ fn describe_eagle(doc: &conduit_eagle::Document) -> Value {
         }
         Document::Library => json!({ "eagle": "library" }),
     }
+}
+
+/// A KiCad file: what it holds, and the circuit conduit makes of it (a schematic's or netlist
+/// export's with the pads of the board beside it, or why it has none).
+fn describe_kicad(doc: &conduit_kicad::Document, path: &std::path::Path) -> Value {
+    use conduit_kicad::Document;
+    let mut v = match doc {
+        Document::Pcb(b) => {
+            let footprints: std::collections::BTreeSet<&str> =
+                b.footprints.iter().map(|f| f.name.as_str()).collect();
+            json!({
+                "kicad": "board",
+                "version": b.version,
+                "footprints": b.footprints.len(),
+                "bottom_footprints": b.footprints.iter().filter(|f| f.bottom).count(),
+                "footprint_kinds": footprints.len(),
+                "pads": b.footprints.iter().map(|f| f.pads.len()).sum::<usize>(),
+                "outline_shapes": b.outline.len(),
+            })
+        }
+        Document::Schematic(s) => json!({
+            "kicad": "schematic",
+            "version": s.version,
+            "sheet_instances": s.sheet_instances,
+            "symbols_on_board": s.parts.len(),
+            "pins": s.parts.iter().map(|p| p.pins.len()).sum::<usize>(),
+            "nets_with_pins": s.nets.len(),
+        }),
+        Document::NetFile(n) => json!({
+            "kicad": "netlist",
+            "components": n.components.len(),
+            "nets": n.nets.len(),
+        }),
+    };
+    match conduit::circuit::Circuit::from_kicad(doc, path) {
+        Ok(circuit) => {
+            v["parts"] = json!(circuit.parts.len());
+            v["nets"] = json!(circuit.nets.len());
+            v["circuit"] = describe_circuit(&circuit);
+        }
+        Err(e) => v["circuit_error"] = json!(e.to_string()),
+    }
+    v
 }
 
 /// What a circuit holds, as conduit places and routes it: per part its value, package, pads

@@ -1,5 +1,5 @@
-//! `conduit place`: a placement TOML for a circuit in a model, from an EAGLE board's layout or
-//! packed automatically, checked against the model's solid before it is written.
+//! `conduit place`: a placement TOML for a circuit in a model, from an EAGLE or KiCad board's
+//! layout or packed automatically, checked against the model's solid before it is written.
 
 use anyhow::Context;
 
@@ -12,9 +12,14 @@ use conduit::scene::OutputSet;
 
 pub(crate) fn run(args: PlaceArgs) -> Result<(), Failure> {
     let mut outputs = OutputSet::new(std::slice::from_ref(&args.model));
-    for p in [&args.from_brd, &args.circuit, &args.config.config]
-        .into_iter()
-        .flatten()
+    for p in [
+        &args.from_brd,
+        &args.from_pcb,
+        &args.circuit,
+        &args.config.config,
+    ]
+    .into_iter()
+    .flatten()
     {
         outputs.input(p);
     }
@@ -25,6 +30,7 @@ pub(crate) fn run(args: PlaceArgs) -> Result<(), Failure> {
         .circuit
         .clone()
         .or_else(|| args.from_brd.clone())
+        .or_else(|| args.from_pcb.clone())
         .context("--circuit is needed with --auto")?;
     let circuit = Circuit::load(&circuit_path).map_err(anyhow::Error::from)?;
     let source = Some(relative_to(&circuit_path, &args.output));
@@ -33,10 +39,8 @@ pub(crate) fn run(args: PlaceArgs) -> Result<(), Failure> {
         (None, Some(d)) => PlaneChoice::FromTop(d),
         (None, None) => PlaneChoice::UnderTop,
     };
-    let (outcome, from) = if let Some(brd) = &args.from_brd {
-        let bytes =
-            std::fs::read(brd).with_context(|| format!("{}: cannot read", brd.display()))?;
-        let board = conduit_eagle::read_board(&bytes).with_context(|| brd.display().to_string())?;
+    let (outcome, from) = if let Some(brd) = args.from_brd.as_ref().or(args.from_pcb.as_ref()) {
+        let board = read_board(brd, args.from_pcb.is_some())?;
         let how = FromBoard {
             at: args.at,
             rotate_deg: args.rotate,
@@ -164,7 +168,7 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
         };
         outln!("closest pads of different nets: {gap:.2} mm ({a}, {b}), {verdict} ({need:.2} mm)")?;
     }
-    if args.from_brd.is_some() {
+    if args.from_brd.is_some() || args.from_pcb.is_some() {
         let scale = match o.suggested_scale {
             Some(s) if (s - args.scale).abs() < 1e-9 => format!("--scale {s:.2} is the smallest"),
             Some(s) => format!("try --scale {s:.2}, the smallest"),
@@ -194,4 +198,22 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
         outln!("left out: {}", groups.join("; "))?;
     }
     Ok(())
+}
+
+/// The layout of an EAGLE board, or of a KiCad board when `kicad`.
+pub(crate) fn read_board(
+    path: &std::path::Path,
+    kicad: bool,
+) -> anyhow::Result<conduit::circuit::board_layout::BoardInput> {
+    use conduit::circuit::board_layout::BoardInput;
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    Ok(if kicad {
+        BoardInput::from_kicad(
+            &conduit_kicad::read_pcb(&bytes).with_context(|| path.display().to_string())?,
+        )
+    } else {
+        BoardInput::from_eagle(
+            &conduit_eagle::read_board(&bytes).with_context(|| path.display().to_string())?,
+        )
+    })
 }

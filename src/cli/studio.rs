@@ -158,15 +158,16 @@ fn start_placement(
         return Ok(Placement::load(p).map_err(anyhow::Error::from)?);
     }
     let source = Some(args.circuit.display().to_string());
-    if args
+    let ext = args
         .circuit
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("brd"))
-    {
-        let bytes = std::fs::read(&args.circuit)
-            .with_context(|| format!("{}: cannot read", args.circuit.display()))?;
-        let board = conduit_eagle::read_board(&bytes)
-            .with_context(|| args.circuit.display().to_string())?;
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if let Some(kicad) = match ext.as_deref() {
+        Some("brd") => Some(false),
+        Some("kicad_pcb") => Some(true),
+        _ => None,
+    } {
+        let board = super::place::read_board(&args.circuit, kicad)?;
         let how = FromBoard {
             at: None,
             rotate_deg: 0.0,

@@ -9,8 +9,8 @@
 //! [`crate::circuit::fit::placement_problems`].
 
 use crate::circuit::board_layout::{
-    BoardLayoutError, BoardLayoutParams, Room, Side, closest_foreign_pads, layout_board,
-    suggest_scale,
+    BoardInput, BoardLayoutError, BoardLayoutParams, Room, Side, closest_foreign_pads,
+    layout_board, suggest_scale,
 };
 use crate::circuit::fit::{FitParams, placement_problems};
 use crate::circuit::placement_toml::placement_toml;
@@ -366,7 +366,7 @@ pub fn place_from_board(
     scene: &Scene,
     cfg: &Config,
     circuit: &Circuit,
-    board: &conduit_eagle::Board,
+    board: &BoardInput,
     how: &FromBoard,
     source: Option<String>,
 ) -> Result<PlaceOutcome, PlaceError> {

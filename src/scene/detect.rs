@@ -21,6 +21,8 @@ pub enum FileKind {
     Xyz,
     /// EAGLE schematic or board.
     Eagle,
+    /// KiCad board, schematic or netlist export.
+    Kicad,
     /// G-code (text, or binary which is refused).
     Gcode,
     /// SVG 2D design.
@@ -39,6 +41,7 @@ impl FileKind {
             "ply" => FileKind::Ply,
             "xyz" | "pts" => FileKind::Xyz,
             "sch" | "brd" | "lbr" => FileKind::Eagle,
+            "kicad_pcb" | "kicad_sch" | "net" => FileKind::Kicad,
             "gcode" | "gco" | "g" | "nc" | "bgcode" => FileKind::Gcode,
             "svg" => FileKind::Svg,
             _ => return None,
@@ -55,6 +58,8 @@ impl FileKind {
             Some(FileKind::ThreeMf)
         } else if head.starts_with(b"GCDE") {
             Some(FileKind::Gcode)
+        } else if conduit_kicad::sniff(head).is_some() {
+            Some(FileKind::Kicad)
         } else if text.contains("<eagle") {
             Some(FileKind::Eagle)
         } else if text.contains("<svg") {

@@ -58,7 +58,7 @@ pub enum LoadErrorKind {
     },
     /// Neither the extension nor the content names a format conduit reads.
     #[error(
-        "unrecognised file format (supported: STL, 3MF, OBJ, OFF, PLY, XYZ, EAGLE .sch/.brd, G-code, SVG)"
+        "unrecognised file format (supported: STL, 3MF, OBJ, OFF, PLY, XYZ, EAGLE .sch/.brd, KiCad .kicad_pcb/.kicad_sch/.net, G-code, SVG)"
     )]
     Unrecognised,
     /// STL error.
@@ -82,6 +82,9 @@ pub enum LoadErrorKind {
     /// EAGLE error.
     #[error("EAGLE: {0}")]
     Eagle(#[from] conduit_eagle::EagleError),
+    /// KiCad error.
+    #[error("KiCad: {0}")]
+    Kicad(#[from] conduit_kicad::KicadError),
     /// G-code error.
     #[error("G-code: {0}")]
     Gcode(#[from] conduit_gcode::GcodeError),
@@ -149,6 +152,8 @@ pub enum Content {
     PointCloud(conduit_pointcloud::PointCloud),
     /// An EAGLE schematic, board or library.
     Eagle(conduit_eagle::Document),
+    /// A KiCad board, schematic (its sheets read from beside it) or netlist export.
+    Kicad(conduit_kicad::Document),
     /// A G-code program (summarised).
     Gcode(conduit_gcode::Summary),
     /// A 2D design.
@@ -264,6 +269,9 @@ fn parse(
         }
         FileKind::Xyz => Content::PointCloud(conduit_pointcloud::read_xyz(bytes)?),
         FileKind::Eagle => Content::Eagle(conduit_eagle::read(bytes)?),
+        FileKind::Kicad => {
+            Content::Kicad(conduit_kicad::read(bytes, path, &mut |p| std::fs::read(p))?)
+        }
         FileKind::Gcode => Content::Gcode(conduit_gcode::summarize(&conduit_gcode::parse(bytes)?)),
         FileKind::Svg => Content::Design(conduit_svg::read(bytes, opts.svg_tolerance_mm)?),
     };

@@ -171,6 +171,49 @@ pub fn all() -> Vec<Target> {
             ci_execs: CI,
         },
         Target {
+            name: "kicad",
+            about: "conduit_kicad::read (.kicad_pcb, .kicad_sch, .net) and the netlists",
+            accepts: |s| ext_in(s, &["kicad_pcb", "kicad_sch", "net"]),
+            dict: &[
+                "(pad \"1\" smd roundrect (at 0 0 90) (size 1 1) (layers \"F.Cu\") (net 1 \"A\"))",
+                "(pad \"2\" smd custom (at 0 0) (size 1 1) (primitives (gr_poly (pts (xy 0 0) (xy 1e308 1)))))",
+                "(wire (pts (xy 0 0) (xy 10 0)))",
+                "(label \"D[0..7]\" (at 0 0 0))",
+                "(hierarchical_label \"X\" (at 0 0 0))",
+                "(global_label \"G\" (at 10 0 0))",
+                "(junction (at 0 0))",
+                "(at 1e308 -1e308 90)",
+                "(mirror x)",
+                "(hide yes)",
+                "(",
+                ")",
+                "\"",
+            ],
+            run: |i| {
+                let doc = conduit_kicad::read(
+                    i.bytes,
+                    std::path::Path::new("fuzz.kicad_sch"),
+                    &mut |_| Err(std::io::ErrorKind::NotFound.into()),
+                );
+                match doc {
+                    Ok(conduit_kicad::Document::Pcb(p)) => {
+                        let _ = p.netlist();
+                        true
+                    }
+                    Ok(conduit_kicad::Document::Schematic(s)) => {
+                        let _ = s.netlist();
+                        true
+                    }
+                    Ok(conduit_kicad::Document::NetFile(n)) => {
+                        let _ = n.netlist();
+                        true
+                    }
+                    Err(_) => false,
+                }
+            },
+            ci_execs: CI,
+        },
+        Target {
             name: "gcode",
             about: "conduit_gcode::parse (byte-for-byte round trip), summarize and moves",
             accepts: |s| ext_in(s, &["gcode", "g", "gco", "nc"]),
@@ -329,12 +372,24 @@ pub fn all() -> Vec<Target> {
         // The library's readers.
         Target {
             name: "scene",
-            about: "conduit::scene::load of a file by its extension (every mesh, cloud, EAGLE, G-code and SVG format)",
+            about: "conduit::scene::load of a file by its extension (every mesh, cloud, EAGLE, KiCad, G-code and SVG format)",
             accepts: |s| {
                 ext_in(
                     s,
                     &[
-                        "stl", "3mf", "obj", "off", "ply", "xyz", "sch", "brd", "gcode", "svg",
+                        "stl",
+                        "3mf",
+                        "obj",
+                        "off",
+                        "ply",
+                        "xyz",
+                        "sch",
+                        "brd",
+                        "kicad_pcb",
+                        "kicad_sch",
+                        "net",
+                        "gcode",
+                        "svg",
                     ],
                 )
             },
@@ -443,8 +498,8 @@ pub fn all() -> Vec<Target> {
         },
         Target {
             name: "circuit",
-            about: "conduit::circuit::Circuit::load (EAGLE into the circuit model, pads checked)",
-            accepts: |s| ext_in(s, &["sch", "brd"]),
+            about: "conduit::circuit::Circuit::load (EAGLE and KiCad into the circuit model, pads checked)",
+            accepts: |s| ext_in(s, &["sch", "brd", "kicad_pcb", "kicad_sch", "net"]),
             dict: &[
                 "<smd name=\"1\" x=\"0\" y=\"0\" dx=\"1e308\" dy=\"1\" layer=\"1\"/>",
                 "<pad name=\"1\" x=\"0\" y=\"0\" drill=\"-1\"/>",
