@@ -7,20 +7,10 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use crate::support::{conduit, sample, stderr, stdout, temp_dir};
+use crate::support::{conduit, placement_parts, sample, stderr, stdout, temp_dir};
 
 fn demo(f: &str) -> PathBuf {
     sample(&format!("circuit_demo/{f}"))
-}
-
-/// The parts of a placement TOML: (name, x, y, z, rotation), in file order.
-fn parts(path: &Path) -> Vec<(String, [f64; 4])> {
-    let text = std::fs::read_to_string(path).expect("placement written");
-    let p = conduit::circuit::Placement::from_toml(&text).expect("placement reads back");
-    p.parts
-        .iter()
-        .map(|q| (q.name.clone(), [q.x, q.y, q.z, q.rotation]))
-        .collect()
 }
 
 fn place(board_flag: &str, board: &Path, out: &Path) {
@@ -45,8 +35,8 @@ fn a_kicad_board_is_placed_sliced_and_checked_clean() {
     let (kicad, eagle) = (d.join("kicad.toml"), d.join("eagle.toml"));
     place("--from-pcb", &demo("led_coin.kicad_pcb"), &kicad);
     place("--from-brd", &demo("led_coin.brd"), &eagle);
-    let k = parts(&kicad);
-    assert_eq!(k, parts(&eagle));
+    let k = placement_parts(&kicad);
+    assert_eq!(k, placement_parts(&eagle));
     assert_eq!(
         k,
         [

@@ -9,7 +9,7 @@ use conduit::mesh::Mesh;
 use conduit::scene::{MeshFormat, Scene, SceneObject, save};
 use serde_json::Value;
 
-use crate::support::{conduit, corpus, eagle_file, stderr, stdout, temp_dir};
+use crate::support::{conduit, corpus, eagle_file, placement_parts, stderr, stdout, temp_dir};
 
 /// A block `size` mm with its bottom centre at the origin, written as STL.
 fn block(dir: &Path, name: &str, size: [f64; 3]) -> PathBuf {
@@ -54,12 +54,7 @@ fn place_into(model: &Path, out: &Path, rest: &[&std::ffi::OsStr]) -> (Option<i3
 
 /// The parts of a placement TOML by name: (x, y, z, rotation).
 fn parts(toml_path: &Path) -> BTreeMap<String, [f64; 4]> {
-    let text = std::fs::read_to_string(toml_path).expect("placement written");
-    let p = conduit::circuit::Placement::from_toml(&text).expect("placement reads back");
-    p.parts
-        .iter()
-        .map(|q| (q.name.clone(), [q.x, q.y, q.z, q.rotation]))
-        .collect()
+    placement_parts(toml_path).into_iter().collect()
 }
 
 /// Every corpus board with a readable `.brd`: laid out at the scale the first run suggests in

@@ -214,3 +214,13 @@ pub fn eagle_file(corpus: &Path, name: &str, ext: &str) -> PathBuf {
     assert_eq!(found.len(), 1, "one .{ext} under eagle/{name}");
     found.remove(0)
 }
+
+/// The parts of a placement TOML: (name, [x, y, z, rotation]), in file order.
+pub fn placement_parts(path: &Path) -> Vec<(String, [f64; 4])> {
+    let text = std::fs::read_to_string(path).expect("placement written");
+    let p = conduit::circuit::Placement::from_toml(&text).expect("placement reads back");
+    p.parts
+        .iter()
+        .map(|q| (q.name.clone(), [q.x, q.y, q.z, q.rotation]))
+        .collect()
+}

@@ -239,37 +239,34 @@ type PadUnions = HashMap<(usize, String), Arc<Grown>>;
 /// layers alike.
 type Geometries = HashMap<(usize, String, BBox), Arc<LayerGeometry>>;
 
-/// A wire's search and what of the board it looked at: the traces of other nets on `layers`
-/// (and the layers next to them) within `frame`. Placing a wire there elsewhere leaves the
-/// search as it was.
-#[derive(Debug)]
-struct Searched {
-    route: WireRoute,
-    frame: BBox,
-    /// `None` for a search that looked at no layer.
-    layers: Option<std::ops::RangeInclusive<usize>>,
-}
-
-impl Searched {
-    /// A search that looked at no trace (no layer for it, or no time).
-    fn unlooked(route: WireRoute) -> Self {
-        Self {
-            route,
-            frame: bbox(&[]),
-            layers: None,
-        }
-    }
-}
-
-/// Where a wire is expected to look and place its channels: a box on a range of layers.
+/// A part of the board: a box on a range of layers. What a search looks at (other nets'
+/// traces within its window, on its layers and the layers next to them, whose traces touch
+/// its own), or where a wire is expected to look and place its channels.
 #[derive(Debug, Clone)]
 struct Reach {
     frame: BBox,
-    /// `None` for a wire that has no layer to be routed on.
+    /// `None` for nowhere (a wire with no layer to be routed on, a search that looked at no
+    /// trace).
     layers: Option<std::ops::RangeInclusive<usize>>,
 }
 
 impl Reach {
+    /// No part of the board.
+    fn nowhere() -> Self {
+        Self {
+            frame: bbox(&[]),
+            layers: None,
+        }
+    }
+
+    /// `frame` on the layers of `range` and the layers next to them.
+    fn around(range: &std::ops::RangeInclusive<usize>, frame: BBox) -> Self {
+        Self {
+            frame,
+            layers: Some(range.start().saturating_sub(1)..=range.end().saturating_add(1)),
+        }
+    }
+
     /// Whether the two share a layer and a point.
     fn meets(&self, other: &Reach) -> bool {
         match (&self.layers, &other.layers) {
@@ -279,6 +276,31 @@ impl Reach {
                     && boxes_meet(&self.frame, &other.frame)
             }
             _ => false,
+        }
+    }
+
+    /// Whether a box `b` on layer `l` lies (partly) within.
+    fn holds(&self, l: usize, b: &BBox) -> bool {
+        self.layers
+            .as_ref()
+            .is_some_and(|layers| layers.contains(&l) && boxes_meet(b, &self.frame))
+    }
+}
+
+/// A wire's search and what of the board it looked at: placing a wire elsewhere leaves the
+/// search as it was.
+#[derive(Debug)]
+struct Searched {
+    route: WireRoute,
+    looked: Reach,
+}
+
+impl Searched {
+    /// A search that looked at no trace (no layer for it, or no time).
+    fn unlooked(route: WireRoute) -> Self {
+        Self {
+            route,
+            looked: Reach::nowhere(),
         }
     }
 }
@@ -537,17 +559,14 @@ impl<'a> Board<'a> {
     fn reach(&self, i: usize) -> Reach {
         let wire = &self.wires[i];
         let Some(range) = layer_range(self.layers, wire, self.params) else {
-            return Reach {
-                frame: bbox(&[]),
-                layers: None,
-            };
+            return Reach::nowhere();
         };
         let frame = bbox(&self.window(wire, &Traces::Obstacles, Some(tight_grow(wire))));
         let d = scaled(channels::keep_out_radius(self.params));
-        Reach {
-            frame: [frame[0] - d, frame[1] - d, frame[2] + d, frame[3] + d],
-            layers: Some(range.start().saturating_sub(1)..=range.end() + 1),
-        }
+        Reach::around(
+            &range,
+            [frame[0] - d, frame[1] - d, frame[2] + d, frame[3] + d],
+        )
     }
 
     /// Whether wire `j`'s search `searched`, made before wire `i` was placed, is still the one
@@ -559,16 +578,11 @@ impl<'a> Board<'a> {
         {
             return false;
         }
-        let Some(layers) = &searched.layers else {
-            return true;
-        };
-        let near = layers.start().saturating_sub(1)..=layers.end().saturating_add(1);
-        !self.placed[..]
-            .iter()
-            .enumerate()
-            .filter(|(l, _)| near.contains(l))
-            .flat_map(|(_, placed)| placed)
-            .any(|p| p.wire == i && boxes_meet(&p.bbox, &searched.frame))
+        !self.placed.iter().enumerate().any(|(l, placed)| {
+            placed
+                .iter()
+                .any(|p| p.wire == i && searched.looked.holds(l, &p.bbox))
+        })
     }
 
     /// Whether the deadline has passed; if so, routing stops (and says so).
@@ -987,8 +1001,7 @@ impl<'a> Board<'a> {
         let window = self.window(wire, traces, None);
         let seen = |route: WireRoute, window: &[ExPolygon]| Searched {
             route,
-            frame: bbox(window),
-            layers: Some(range.clone()),
+            looked: Reach::around(&range, bbox(window)),
         };
         if matches!(traces, Traces::Obstacles) {
             let tight = self.window(wire, traces, Some(tight_grow(wire)));
