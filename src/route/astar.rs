@@ -23,9 +23,9 @@
 //!   total float order; vertex ids follow creation order, which depends only on the input; hash
 //!   maps are only looked up, never iterated.
 
-use super::graph::{self, Ends, Graph, LayerInput, PreparedLayer, VertexId, Zone};
+use super::graph::{self, Ends, Graph, IntSet, LayerInput, PreparedLayer, VertexId, Zone};
 use super::index::{dist, lerp};
-use super::interlayer::{Parent, piece_fits, polyline_length, walk_back};
+use super::interlayer::{FitMemo, Parent, piece_fits, polyline_length, walk_back};
 use super::{RouteLayer, RouteParams, Unrouted, Wire, WireRoute, layer_of, trace};
 use crate::geom::{Point2, scaled, segment_distance, segment_param, unscaled};
 use std::cmp::Ordering;
@@ -190,8 +190,15 @@ pub struct Search {
     min_weight: f64,
     /// Least cost of one layer change.
     change_cost: f64,
+    /// Least cost of one layer change counting its whole printed piece: `layer_change_penalty`
+    /// plus `interlayer_overlap + grid_step` at `base_weight`.
+    step_cost: f64,
     /// Routes costing more than this are not searched for (see [`RouteParams::max_detour`]).
     cost_limit: f64,
+    /// Grid pairs (from, to) [`Search::grid_weight`] refused an edge.
+    refused: IntSet<(VertexId, VertexId)>,
+    /// Region tests of staircase pieces on neighbour layers.
+    fit_memo: FitMemo,
 }
 
 impl Search {
@@ -267,7 +274,12 @@ impl Search {
             expansions: 0,
             min_weight,
             change_cost,
+            step_cost: (params.layer_change_penalty
+                + (params.interlayer_overlap + params.grid_step) * params.base_weight)
+                .max(0.0),
             cost_limit: f64::INFINITY,
+            refused: IntSet::default(),
+            fit_memo: FitMemo::default(),
         };
         if search.state == SearchState::Running {
             search.taps = taps
@@ -454,10 +466,19 @@ impl Search {
 
     /// The least cost from a point on layer `la` to one `dxy` scaled units away (in xy) on
     /// layer `lb`.
+    ///
+    /// Two bounds, the larger taken: every change costs at least `change_cost` plus its rise
+    /// at the least weight (so the 3D distance bounds the rest), and every change prints a
+    /// piece longer than `interlayer_overlap + grid_step` (see `explore_layers`), so it costs
+    /// at least [`Search::step_cost`] while the planar moves still cover the xy distance. Both
+    /// fall by at most an edge's cost along an edge, so their maximum stays consistent.
     fn bound(&self, la: usize, lb: usize, dxy: f64) -> f64 {
         let dz = self.layer(la).z - self.layer(lb).z;
         let dxy = unscaled(1) * dxy;
-        self.min_weight * (dxy * dxy + dz * dz).sqrt() + self.change_cost * la.abs_diff(lb) as f64
+        let changes = la.abs_diff(lb) as f64;
+        let through = self.min_weight * (dxy * dxy + dz * dz).sqrt() + self.change_cost * changes;
+        let stepped = self.min_weight * dxy + self.step_cost * changes;
+        through.max(stepped)
     }
 
     fn heuristic(&mut self, v: VertexId) -> f64 {
@@ -616,11 +637,7 @@ impl Search {
                 continue;
             }
             if let Some(v) = self.graph.nearest(l, q, reuse) {
-                let zv = self.zone(v, tol);
-                let pv = self.graph.pos(v);
-                if let Some(w) = self.grid_weight(self.layer(l), (p, zu), (pv, zv), tol) {
-                    self.graph.link(u, v, w);
-                }
+                self.grid_link(u, v, zu, tol);
                 continue;
             }
             let layer = self.layer(l);
@@ -640,13 +657,23 @@ impl Search {
             }
         }
         for v in self.graph.within(l, p, step) {
-            if v == u {
-                continue;
-            }
-            let zv = self.zone(v, tol);
-            let pv = self.graph.pos(v);
-            if let Some(w) = self.grid_weight(self.layer(l), (p, zu), (pv, zv), tol) {
-                self.graph.link(u, v, w);
+            self.grid_link(u, v, zu, tol);
+        }
+    }
+
+    /// Links `u` (of zone `zu`) to `v` on their layer if [`Search::grid_weight`] accepts the
+    /// edge. A pair already linked, or already refused, is not weighed again: the weight is a
+    /// function of the two points and their zones, which never change.
+    fn grid_link(&mut self, u: VertexId, v: VertexId, zu: Zone, tol: i64) {
+        if u == v || self.graph.linked(u, v) || self.refused.contains(&(u, v)) {
+            return;
+        }
+        let zv = self.zone(v, tol);
+        let (l, p, pv) = (self.graph.layer(u), self.graph.pos(u), self.graph.pos(v));
+        match self.grid_weight(self.layer(l), (p, zu), (pv, zv), tol) {
+            Some(w) => self.graph.link(u, v, w),
+            None => {
+                self.refused.insert((u, v));
             }
         }
     }
@@ -684,7 +711,15 @@ impl Search {
         let tol = scaled(self.params.align_tolerance).max(1);
         let p = self.graph.pos(u);
         for other in [l.checked_sub(1), Some(l + 1)].into_iter().flatten() {
-            if !self.in_range(other) || !piece_fits(&piece, &self.graph, self.layer(other), tol) {
+            if !self.in_range(other)
+                || !piece_fits(
+                    &piece,
+                    &self.graph,
+                    &self.layers[other - self.layers[0].index],
+                    tol,
+                    &mut self.fit_memo,
+                )
+            {
                 continue;
             }
             let (v, created) = self.graph.add_vertex(other, p);
@@ -734,4 +769,21 @@ pub fn route_wire(layers: &[RouteLayer], wire: &Wire, params: &RouteParams) -> W
     let mut search = Search::new(layers, wire, params);
     while search.step() == SearchState::Running {}
     search.result()
+}
+
+#[cfg(test)]
+impl Search {
+    /// Along the route found, the least of (cost still to go − heuristic), negative where the
+    /// heuristic promised more than the route costs; and the route's cost.
+    pub(crate) fn heuristic_slack(&mut self) -> (f64, f64) {
+        let to_go = self.g[self.target as usize];
+        let mut slack = f64::INFINITY;
+        let mut at = Some(self.target);
+        while let Some(v) = at {
+            let h = self.heuristic(v);
+            slack = slack.min(to_go - self.g[v as usize] - h);
+            at = self.parents[v as usize].map(|(p, _)| p);
+        }
+        (slack, to_go)
+    }
 }

@@ -71,6 +71,10 @@ impl Hasher for IntHasher {
         self.write_u64(v as u64);
     }
 
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+
     fn write_usize(&mut self, v: usize) {
         self.write_u64(v as u64);
     }
@@ -78,6 +82,9 @@ impl Hasher for IntHasher {
 
 /// A hash map with [`IntHasher`].
 pub(crate) type IntMap<K, V> = HashMap<K, V, BuildHasherDefault<IntHasher>>;
+
+/// A hash set with [`IntHasher`].
+pub(crate) type IntSet<K> = std::collections::HashSet<K, BuildHasherDefault<IntHasher>>;
 
 /// Vertex number within one wire's graph.
 pub(crate) type VertexId = u32;
@@ -697,14 +704,9 @@ impl Graph {
         }
     }
 
-    /// Vertices of `layer` within `radius` of `p`, each with its squared distance to `p`, in no
-    /// particular order.
-    fn near(
-        &self,
-        layer: usize,
-        p: Point2,
-        radius: i64,
-    ) -> impl Iterator<Item = (VertexId, i128)> + '_ {
+    /// Calls `visit` with every vertex of `layer` within `radius` of `p` and its squared
+    /// distance to `p`, in no particular order.
+    fn near(&self, layer: usize, p: Point2, radius: i64, mut visit: impl FnMut(VertexId, i128)) {
         let (x0, x1) = (
             (p.x - radius).div_euclid(self.cell),
             (p.x + radius).div_euclid(self.cell),
@@ -714,16 +716,25 @@ impl Graph {
             (p.y + radius).div_euclid(self.cell),
         );
         let r2 = (radius as i128) * (radius as i128);
-        (x0..=x1)
-            .flat_map(move |cx| (y0..=y1).map(move |cy| (cx, cy)))
-            .flat_map(move |(cx, cy)| self.cells.get(&(layer, cx, cy)).into_iter().flatten())
-            .map(move |&v| (v, self.verts[v as usize].p.distance_squared(p)))
-            .filter(move |&(_, d)| d <= r2)
+        for cx in x0..=x1 {
+            for cy in y0..=y1 {
+                let Some(list) = self.cells.get(&(layer, cx, cy)) else {
+                    continue;
+                };
+                for &v in list {
+                    let d = self.verts[v as usize].p.distance_squared(p);
+                    if d <= r2 {
+                        visit(v, d);
+                    }
+                }
+            }
+        }
     }
 
     /// Vertices of `layer` within `radius` of `p`, by increasing id.
     pub(crate) fn within(&self, layer: usize, p: Point2, radius: i64) -> Vec<VertexId> {
-        let mut out: Vec<VertexId> = self.near(layer, p, radius).map(|(v, _)| v).collect();
+        let mut out: Vec<VertexId> = Vec::new();
+        self.near(layer, p, radius, |v, _| out.push(v));
         out.sort_unstable();
         out
     }
@@ -733,9 +744,13 @@ impl Graph {
         if let Some(&v) = self.by_pos.get(&(layer, p.x, p.y)) {
             return Some(v);
         }
-        self.near(layer, p, radius)
-            .min_by_key(|&(v, d)| (d, v))
-            .map(|(v, _)| v)
+        let mut best: Option<(i128, VertexId)> = None;
+        self.near(layer, p, radius, |v, d| {
+            if best.is_none_or(|b| (d, v) < b) {
+                best = Some((d, v));
+            }
+        });
+        best.map(|(_, v)| v)
     }
 
     /// The vertex at `p` on `layer`: an existing one within [`MERGE_NM`], else a new one, snapped
@@ -782,6 +797,11 @@ impl Graph {
         let cost = unscaled(1) * dist(self.verts[a as usize].p, self.verts[b as usize].p) * weight;
         self.adj[a as usize].push(Edge { to: b, cost });
         self.adj[b as usize].push(Edge { to: a, cost });
+    }
+
+    /// Whether `a` and `b` are linked.
+    pub(crate) fn linked(&self, a: VertexId, b: VertexId) -> bool {
+        self.adj[a as usize].iter().any(|e| e.to == b)
     }
 
     /// Position of vertex `v`.

@@ -20,7 +20,7 @@
 //! consecutive layers meet) is a vertex of both layers at the same xy, so it is one such
 //! candidate; a plain edge there would join two traces with no overlap, which does not conduct.
 
-use super::graph::{Graph, PreparedLayer, VertexId};
+use super::graph::{Graph, IntMap, PreparedLayer, VertexId};
 use super::index::dist;
 use crate::geom::Point2;
 
@@ -75,17 +75,50 @@ pub(crate) fn walk_back(
     }
 }
 
+/// What a search has learnt about printing points and piece edges on a neighbour layer: the
+/// region tests of [`piece_fits`] depend only on the layer and the points, and consecutive
+/// expansions along a path ask about mostly the same piece, so each is made once per search.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct FitMemo {
+    /// Per (layer, x, y): inside the material, and inside the first deflated area clear of
+    /// keep-outs.
+    points: IntMap<(usize, i64, i64), (bool, bool)>,
+    /// Per (layer, a, b): whether the edge crosses a keep-out.
+    edges: IntMap<(usize, i64, i64, i64, i64), bool>,
+}
+
 /// Whether every point of `piece` can be printed on `layer` (see the module docs).
-pub(crate) fn piece_fits(piece: &[Point2], graph: &Graph, layer: &PreparedLayer, tol: i64) -> bool {
+pub(crate) fn piece_fits(
+    piece: &[Point2],
+    graph: &Graph,
+    layer: &PreparedLayer,
+    tol: i64,
+    memo: &mut FitMemo,
+) -> bool {
     // A vertex of the neighbour layer at the same xy is a match only inside its material:
     // direct connections also run across holes and cavities, where no trace may be printed.
-    let fits = |p: Point2| {
-        (graph.nearest(layer.index, p, tol).is_some() && layer.material.inside_or_on(p, tol))
-            || (layer.clearance.inside_or_on(p, tol) && !layer.blocked.contains(p))
+    let mut fits = |p: Point2| {
+        let (material, clear) = *memo
+            .points
+            .entry((layer.index, p.x, p.y))
+            .or_insert_with(|| {
+                (
+                    layer.material.inside_or_on(p, tol),
+                    layer.clearance.inside_or_on(p, tol) && !layer.blocked.contains(p),
+                )
+            });
+        clear || (material && graph.nearest(layer.index, p, tol).is_some())
     };
-    piece.iter().all(|&p| fits(p))
-        && (layer.blocked.is_empty()
-            || piece.windows(2).all(|w| !layer.blocked.crosses(w[0], w[1])))
+    if !piece.iter().all(|&p| fits(p)) {
+        return false;
+    }
+    layer.blocked.is_empty()
+        || piece.windows(2).all(|w| {
+            !*memo
+                .edges
+                .entry((layer.index, w[0].x, w[0].y, w[1].x, w[1].y))
+                .or_insert_with(|| layer.blocked.crosses(w[0], w[1]))
+        })
 }
 
 /// Length of a polyline, scaled units.

@@ -765,3 +765,29 @@ fn routes_are_the_same_on_any_number_of_threads() {
     assert_eq!(on(2), one);
     assert_eq!(on(3), one);
 }
+
+#[test]
+fn the_heuristic_never_promises_more_than_a_climb_costs() {
+    // Steep climbs (8 layers over 4 mm) and shallow ones (8 layers over 30 mm): every layer
+    // change prints a piece longer than overlap + grid step, which the heuristic counts.
+    let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 10);
+    let params = RouteParams::default();
+    let step_cost = params.layer_change_penalty
+        + (params.interlayer_overlap + params.grid_step) * params.base_weight;
+    for (to_x, to_layer) in [(9.0, 8), (35.0, 8), (30.0, 3)] {
+        let w = wire(
+            "up",
+            (5.0, 20.0, layers[0].z),
+            (to_x, 20.0, layers[to_layer].z),
+        );
+        let mut search = Search::new(&layers, &w, &params);
+        while search.step() == SearchState::Running {}
+        let r = search.result();
+        assert!(r.routed, "{r:?}");
+        assert_eq!(r.layer_changes, to_layer, "{r:?}");
+        let (slack, cost) = search.heuristic_slack();
+        assert!(slack >= -1e-9, "to x {to_x}: heuristic over by {}", -slack);
+        // The bound it rests on: the xy distance plus a whole step per layer.
+        assert!(cost >= (to_x - 5.0) + step_cost * to_layer as f64 - 1e-9);
+    }
+}
