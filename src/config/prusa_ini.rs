@@ -1329,6 +1329,24 @@ mod tests {
     }
 
     #[test]
+    fn overhang_keys_map_with_prusaslicers_defaults_when_missing() -> Result<(), ConfigError> {
+        let (missing, _) = from_ini_str("layer_height = 0.2\n")?;
+        assert!(missing.slice.overhangs && !missing.slice.dynamic_overhang_speeds);
+        assert_eq!(missing.overhang_params().speeds, None);
+        let (set, _) = from_ini_str(
+            "external_perimeter_speed = 30\noverhangs = 0\nenable_dynamic_overhang_speeds = 1\n\
+             overhang_speed_0 = 50%\noverhang_speed_1 = 0\noverhang_speed_3 = 28\n\
+             bridge_fan_speed = 80,80\nenable_dynamic_fan_speeds = 1\noverhang_fan_speed_2 = 40\n",
+        )?;
+        let o = set.overhang_params();
+        assert!(!o.bridging);
+        assert_eq!(o.speeds, Some([15.0, 30.0, 20.0, 28.0]));
+        assert_eq!(o.fans, Some([0.0, 0.0, 40.0, 0.0]));
+        assert_eq!(o.bridge_fan, 80.0);
+        Ok(())
+    }
+
+    #[test]
     fn seam_gap_is_read_in_mm_or_percent_of_the_nozzle() -> Result<(), ConfigError> {
         let (missing, _) = from_ini_str("layer_height = 0.2\n")?;
         assert_eq!(missing.slice.seam_gap, 0.15);

@@ -763,12 +763,25 @@ mod tests {
                 .paths()
                 .any(|p| p.role == Role::TopSolidInfill && p.speed == 30.0)
         );
-        assert!(
-            program
-                .layers
-                .iter()
-                .all(|l| l.items.iter().all(|i| matches!(i, LayerItem::Path(_))))
-        );
+        // Besides paths, only the bridge fan around the internal bridges under the top.
+        for l in &program.layers {
+            let mut fan = None;
+            for item in &l.items {
+                match item {
+                    LayerItem::Path(p) => {
+                        assert_eq!(
+                            fan.is_some(),
+                            p.role == Role::BridgeInfill,
+                            "layer {}",
+                            l.index
+                        );
+                    }
+                    LayerItem::Event(Event::PartFan { at_least }) => fan = *at_least,
+                    LayerItem::Event(e) => panic!("unexpected {e:?}"),
+                }
+            }
+            assert_eq!(fan, None);
+        }
     }
 
     #[test]
