@@ -124,8 +124,9 @@ fn the_overhang_probe_prints_with_removable_support_and_nothing_over_air() {
     assert!(ends().any(|p| p[0] < -t30 - 1.0 && p[1] < 4.0));
     assert!(ends().all(|p| p[1] <= 9.6 + 1e-6));
     // The arm's lowest layer lies over the interface, one layer up.
-    let arm_plastic = role_moves(&gcode, shift, "External perimeter")
-        .into_iter()
+    let arm_plastic = ["External perimeter", "Overhang perimeter"]
+        .iter()
+        .flat_map(|r| role_moves(&gcode, shift, r))
         .flat_map(|(a, b)| [a, b])
         .filter(|p| p[0] > 12.0)
         .map(|p| p[1])
@@ -160,5 +161,136 @@ fn a_brim_surrounds_the_first_layer_only() {
     assert!(
         (lo - left + reach).abs() < 0.01 && (hi - 10.0 - reach).abs() < 0.01,
         "{lo} {hi}"
+    );
+}
+
+/// Extruding moves with their role, feed (mm/s), model X and Y of both ends and layer z.
+struct Stroke {
+    role: String,
+    speed: f64,
+    from: [f64; 2],
+    to: [f64; 2],
+    z: f64,
+}
+
+fn strokes(gcode: &str, shift: f64) -> Vec<Stroke> {
+    let parsed = parse(gcode.as_bytes()).expect("G-code parses");
+    moves(&parsed, Firmware::Marlin)
+        .moves
+        .into_iter()
+        .filter(|m| m.extruding)
+        .filter_map(|m| {
+            Some(Stroke {
+                role: m.role.as_deref()?.to_owned(),
+                speed: m.feed,
+                from: [m.from[0]? - shift, m.from[1]?],
+                to: [m.to[0]? - shift, m.to[1]?],
+                z: m.to[2]?,
+            })
+        })
+        .collect()
+}
+
+impl Stroke {
+    fn length(&self) -> f64 {
+        (self.to[0] - self.from[0]).hypot(self.to[1] - self.from[1])
+    }
+    /// A move along Y (a side of the probe) longer than `min` mm.
+    fn along_y(&self, min: f64) -> bool {
+        (self.to[0] - self.from[0]).abs() < 1e-3 && (self.to[1] - self.from[1]).abs() > min
+    }
+}
+
+#[test]
+fn overhanging_walls_slow_down_by_degree_and_the_arm_prints_as_overhang_perimeter() {
+    let dir = temp_dir();
+    let stl = dir.path().join("probe.stl");
+    write_stl(&stl, &probe());
+    let no_slowdown = ["--set", "printer.slowdown_below_layer_time=0"];
+    let (gcode, shift) = slice(dir.path(), &stl, &no_slowdown);
+    let all = strokes(&gcode, shift);
+    // The arm's first layer (8.0–8.2 mm) is the only one with perimeters over air: the
+    // stretches more than half a nozzle (0.2 mm) beyond the post's wall at x = 10. External
+    // loop (centre 0.225 in): the arm's end, 20 − 2 · 0.225 long, and its two sides from
+    // x = 10.2 to 19.775; inner loop (centre 0.225 + spacing in): the same at its depth.
+    let over: Vec<&Stroke> = all
+        .iter()
+        .filter(|s| s.role == "Overhang perimeter")
+        .collect();
+    let odd: Vec<(f64, f64)> = over
+        .iter()
+        .filter(|s| (s.z - 8.2).abs() > 1e-6 || s.speed != 15.0)
+        .map(|s| (s.z, s.speed))
+        .collect();
+    assert!(!over.is_empty() && odd.is_empty(), "{odd:?}");
+    let d1 = 0.225 + conduit::region::spacing(0.45, 0.2);
+    let want = (20.0 - 0.45) + 2.0 * (19.775 - 10.2) + (20.0 - 2.0 * d1) + 2.0 * (20.0 - d1 - 10.2);
+    let found: f64 = over.iter().map(|s| s.length()).sum();
+    assert!((found - want).abs() < 0.1, "{found} mm vs {want} mm");
+    // The bridge fan runs around them, and the layer's fan comes back after.
+    let lines: Vec<&str> = gcode.lines().collect();
+    for (i, l) in lines.iter().enumerate() {
+        if *l == ";TYPE:Overhang perimeter" && !lines[i - 1].starts_with(";WIDTH") {
+            assert!(lines[..i].iter().rev().find(|l| l.starts_with("M106")) == Some(&"M106 S255"));
+        }
+    }
+    let last_over = lines
+        .iter()
+        .rposition(|l| *l == ";TYPE:Overhang perimeter")
+        .expect("overhang perimeters");
+    let after = lines[last_over..]
+        .iter()
+        .find(|l| l.starts_with("M106"))
+        .expect("the fan back to the layer's");
+    assert_ne!(*after, "M106 S255");
+    // The 60° side leans out 0.2 · tan 60° = 0.346 mm a layer: its external bead rests on
+    // 23 % of its width (the 0–25 % band, 15 mm/s); the 30° side leans 0.115 mm, 26 % of the
+    // width out (the 50–75 % band, 20 mm/s); the vertical wall at x = 10 keeps the external
+    // perimeter's 25 mm/s. Inner perimeters rest on the layer below (45 mm/s).
+    let sides = |z0: f64, z1: f64, pick: &dyn Fn(&Stroke) -> bool| -> Vec<f64> {
+        all.iter()
+            .filter(|s| s.z > z0 && s.z < z1 && s.along_y(15.0) && pick(s))
+            .map(|s| s.speed)
+            .collect()
+    };
+    let external = |s: &Stroke| s.role == "External perimeter";
+    let left = |s: &Stroke| external(s) && s.from[0] < 0.0;
+    let wall = |s: &Stroke| external(s) && (s.from[0] - 9.775).abs() < 1e-3;
+    for (z0, z1, speed) in [(4.3, 7.9, 15.0), (0.3, 3.9, 20.0)] {
+        let v = sides(z0, z1, &left);
+        assert!(
+            v.len() > 10 && v.iter().all(|s| *s == speed),
+            "{z0}–{z1}: {v:?}"
+        );
+    }
+    let v = sides(0.3, 7.9, &wall);
+    assert!(v.len() > 30 && v.iter().all(|s| *s == 25.0), "{v:?}");
+    let inner = sides(0.3, 9.9, &|s: &Stroke| s.role == "Perimeter");
+    assert!(
+        inner.len() > 40 && inner.iter().all(|s| *s == 45.0),
+        "{inner:?}"
+    );
+
+    // PrusaSlicer 2.5's behaviour (no dynamic speeds): the overhang at the bridge speed, the
+    // sides at their own (past the first layer's 20 mm/s).
+    let (plain, _) = slice(
+        dir.path(),
+        &stl,
+        &[
+            &no_slowdown[..],
+            &["--set", "slice.dynamic_overhang_speeds=false"],
+        ]
+        .concat(),
+    );
+    let all = strokes(&plain, shift);
+    assert!(
+        all.iter()
+            .filter(|s| s.role == "Overhang perimeter")
+            .all(|s| s.speed == 60.0)
+    );
+    assert!(
+        all.iter()
+            .filter(|s| s.role == "External perimeter" && s.z > 0.3)
+            .all(|s| s.speed == 25.0)
     );
 }

@@ -73,7 +73,10 @@ use crate::region::{
     BrimParams, BrimType, InfillPatternKind, MIN_LAYER_HEIGHT, NOZZLE_RANGE, PerimeterGenerator,
     RegionParams, SupportParams,
 };
-use crate::toolpaths::{OrderParams, ProgramParams, RoleSpeeds, SeamRule, ToolPathParams};
+use crate::toolpaths::overhang::DEFAULT_OVERHANG_SPEEDS;
+use crate::toolpaths::{
+    OrderParams, OverhangParams, ProgramParams, RoleSpeeds, SeamRule, ToolPathParams,
+};
 
 /// Fastest speed of any move, mm/s: the fastest FFF printers travel at about 1000 mm/s; a
 /// larger number is a typo, and would make every time estimate meaningless.
@@ -260,6 +263,26 @@ pub struct SliceSettings {
     pub support_interface_speed: f64,
     /// Speed of conductive traces (paste tools), mm/s. Default 10.
     pub conductive_speed: f64,
+    /// Print the stretches of a perimeter whose bead lies more than half a nozzle beyond the
+    /// layer below as overhang perimeters (`;TYPE:Overhang perimeter`): round threads of the
+    /// nozzle's diameter at `bridge_speed` (`overhang_speed_0` with
+    /// `dynamic_overhang_speeds`), with `printer.bridge_fan_speed` (PrusaSlicer's `overhangs`).
+    /// Default true.
+    pub overhangs: bool,
+    /// Slow perimeters down by how much of their bead's width hangs out over the layer below
+    /// (PrusaSlicer's `enable_dynamic_overhang_speeds`): each stretch resting on less than
+    /// 95 %, 75 %, 50 %, 25 % of its width prints at `overhang_speed_3`, `_2`, `_1`, `_0`
+    /// (never faster than its own speed). Default true.
+    pub dynamic_overhang_speeds: bool,
+    /// Speed of perimeters resting on 0 % of their width (in the air) up to 25 %, mm/s.
+    /// Default 15 (PrusaSlicer's).
+    pub overhang_speed_0: f64,
+    /// Speed of perimeters resting on 25 % to 50 % of their width, mm/s. Default 15.
+    pub overhang_speed_1: f64,
+    /// Speed of perimeters resting on 50 % to 75 % of their width, mm/s. Default 20.
+    pub overhang_speed_2: f64,
+    /// Speed of perimeters resting on 75 % to 95 % of their width, mm/s. Default 25.
+    pub overhang_speed_3: f64,
     /// Tool of each scene object: object `i` prints with tool `object_tools[i]`; objects past the
     /// end of the list use tool 0. Default [] (everything with tool 0).
     pub object_tools: Vec<usize>,
@@ -330,6 +353,12 @@ impl Default for SliceSettings {
                     support_speed: 50.0,
                     support_interface_speed: 40.0,
                     conductive_speed: 10.0,
+                    overhangs: true,
+                    dynamic_overhang_speeds: true,
+                    overhang_speed_0: DEFAULT_OVERHANG_SPEEDS[0],
+                    overhang_speed_1: DEFAULT_OVERHANG_SPEEDS[1],
+                    overhang_speed_2: DEFAULT_OVERHANG_SPEEDS[2],
+                    overhang_speed_3: DEFAULT_OVERHANG_SPEEDS[3],
                     object_tools: Vec::new(),
                 }
             };
@@ -685,7 +714,7 @@ impl Config {
 
     /// The speeds every print move or travel uses, with their keys: each must be positive
     /// and at most [`MAX_SPEED`].
-    fn speed_keys(&self) -> [(&'static str, f64); 14] {
+    fn speed_keys(&self) -> [(&'static str, f64); 18] {
         let s = &self.slice;
         let p = &self.printer;
         [
@@ -701,6 +730,10 @@ impl Config {
             ("slice.support_speed", s.support_speed),
             ("slice.support_interface_speed", s.support_interface_speed),
             ("slice.conductive_speed", s.conductive_speed),
+            ("slice.overhang_speed_0", s.overhang_speed_0),
+            ("slice.overhang_speed_1", s.overhang_speed_1),
+            ("slice.overhang_speed_2", s.overhang_speed_2),
+            ("slice.overhang_speed_3", s.overhang_speed_3),
             ("printer.travel_speed", p.travel_speed),
             ("printer.retract_speed", p.retract_speed),
         ]
@@ -800,6 +833,17 @@ impl Config {
         ] {
             if !v.is_finite() {
                 problems.push(format!("{key} must be a finite number, got {v}"));
+            }
+        }
+        for (key, v) in [
+            ("printer.bridge_fan_speed", p.bridge_fan_speed),
+            ("printer.overhang_fan_speed_0", p.overhang_fan_speed_0),
+            ("printer.overhang_fan_speed_1", p.overhang_fan_speed_1),
+            ("printer.overhang_fan_speed_2", p.overhang_fan_speed_2),
+            ("printer.overhang_fan_speed_3", p.overhang_fan_speed_3),
+        ] {
+            if !(0.0..=100.0).contains(&v) {
+                problems.push(format!("{key} must be between 0 and 100 %, got {v}"));
             }
         }
         for (key, v) in [
@@ -914,6 +958,9 @@ impl Config {
                         enabled: s.support_material,
                         ..self.support.clone()
                     },
+                    overhangs: s.overhangs
+                        || s.dynamic_overhang_speeds
+                        || self.printer.dynamic_fan_speeds,
                 }
             };
         }
@@ -980,7 +1027,36 @@ impl Config {
                 ..OrderParams::default()
             },
             seam_gap: s.seam_gap * s.nozzle_diameter,
+            overhang: self.overhang_params(),
             ..ProgramParams::default()
+        }
+    }
+
+    /// How perimeters over air and bridges print: `slice.overhangs`, the dynamic overhang
+    /// speeds (limited to `printer.max_print_speed`) and the bridge and overhang fans.
+    pub fn overhang_params(&self) -> OverhangParams {
+        let s = &self.slice;
+        let p = &self.printer;
+        let max = p.max_print_speed;
+        OverhangParams {
+            bridging: s.overhangs,
+            speeds: s.dynamic_overhang_speeds.then(|| {
+                [
+                    s.overhang_speed_0,
+                    s.overhang_speed_1,
+                    s.overhang_speed_2,
+                    s.overhang_speed_3,
+                ]
+                .map(|v| v.min(max))
+            }),
+            fans: p.dynamic_fan_speeds.then_some([
+                p.overhang_fan_speed_0,
+                p.overhang_fan_speed_1,
+                p.overhang_fan_speed_2,
+                p.overhang_fan_speed_3,
+            ]),
+            bridge_fan: p.bridge_fan_speed,
+            bridge_width: s.nozzle_diameter,
         }
     }
 

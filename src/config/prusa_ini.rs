@@ -38,7 +38,10 @@
 //!   solid infill, first layer → perimeter, support → perimeter), `support_material_speed` (→
 //!   `support_speed` and `skirt_speed`, as PrusaSlicer prints skirts at support speed),
 //!   `support_material_interface_speed` (`%` of the support speed), `brim_separation`,
-//!   `brim_type` (`no_brim` clears `brim_width`; OrcaSlicer's `brim_ears` → `ears`);
+//!   `brim_type` (`no_brim` clears `brim_width`; OrcaSlicer's `brim_ears` → `ears`),
+//!   `overhangs`, `enable_dynamic_overhang_speeds` (off when missing, as in PrusaSlicer) with
+//!   `overhang_speed_0..3` (mm/s or `%` of the external perimeter speed), `bridge_fan_speed`,
+//!   `enable_dynamic_fan_speeds` and `overhang_fan_speed_0..3` (the first extruder's);
 //! - support (`[support]`): `support_material_threshold` (from the horizontal there, from the
 //!   vertical here: `90 − t`; 0, automatic, keeps 45°), `support_material_contact_distance` →
 //!   `z_gap`, `support_material_xy_spacing` (mm or `%` of the external perimeter width) →
@@ -500,6 +503,36 @@ const RULES: &[(&str, Rule)] = &[
         ),
     ),
     ("support_material_speed", Rule::Custom(support_speed)),
+    // Overhangs (after the external perimeter speed: overhang speeds may be a % of it).
+    ("overhangs", Rule::Flag(|c| &mut c.slice.overhangs)),
+    (
+        "enable_dynamic_overhang_speeds",
+        Rule::Custom(dynamic_overhang_speeds),
+    ),
+    (
+        "bridge_fan_speed",
+        Rule::Num(|c| &mut c.printer.bridge_fan_speed),
+    ),
+    (
+        "enable_dynamic_fan_speeds",
+        Rule::Flag(|c| &mut c.printer.dynamic_fan_speeds),
+    ),
+    (
+        "overhang_fan_speed_0",
+        Rule::Num(|c| &mut c.printer.overhang_fan_speed_0),
+    ),
+    (
+        "overhang_fan_speed_1",
+        Rule::Num(|c| &mut c.printer.overhang_fan_speed_1),
+    ),
+    (
+        "overhang_fan_speed_2",
+        Rule::Num(|c| &mut c.printer.overhang_fan_speed_2),
+    ),
+    (
+        "overhang_fan_speed_3",
+        Rule::Num(|c| &mut c.printer.overhang_fan_speed_3),
+    ),
     (
         "support_material_interface_speed",
         Rule::Percent(
@@ -923,6 +956,36 @@ fn seam_gap(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     Ok(())
 }
 
+/// `enable_dynamic_overhang_speeds` (off when missing, PrusaSlicer's default) with
+/// `overhang_speed_0..3`: mm/s, or `%` of the external perimeter speed; 0 is the external
+/// perimeter speed, as in PrusaSlicer.
+fn dynamic_overhang_speeds(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    imp.cfg.slice.dynamic_overhang_speeds = imp.p.flag(key)?.unwrap_or(false);
+    let base = imp.cfg.slice.external_perimeter_speed;
+    for (i, name) in [
+        "overhang_speed_0",
+        "overhang_speed_1",
+        "overhang_speed_2",
+        "overhang_speed_3",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        if let Some(v) = imp.p.abs_or_percent(name, base)? {
+            let v = if v > 0.0 { v } else { base };
+            let s = &mut imp.cfg.slice;
+            let field = match i {
+                0 => &mut s.overhang_speed_0,
+                1 => &mut s.overhang_speed_1,
+                2 => &mut s.overhang_speed_2,
+                _ => &mut s.overhang_speed_3,
+            };
+            *field = v;
+        }
+    }
+    Ok(())
+}
+
 /// `brim_type`: PrusaSlicer's `no_brim` (no brim whatever `brim_width` says), `outer_only`,
 /// `inner_only`, `outer_and_inner`, and OrcaSlicer's `brim_ears` (`auto_brim` is read as
 /// `outer_only`).
@@ -1060,7 +1123,6 @@ const CHANGES_THE_PRINT: &[(&str, Option<&[&str]>)] = &[
     ("interface_shells", Some(&["0"])),
     ("ironing", Some(&["0"])),
     ("max_volumetric_speed", Some(&["0"])),
-    ("overhangs", Some(&["0"])),
     ("raft_layers", Some(&["0"])),
     ("solid_infill_every_layers", Some(&["0"])),
     ("spiral_vase", Some(&["0"])),
@@ -1263,6 +1325,24 @@ mod tests {
         );
         let (thin, _) = from_ini_str("perimeter_generator = classic\nthin_walls = 1\n")?;
         assert!(thin.slice.thin_walls);
+        Ok(())
+    }
+
+    #[test]
+    fn overhang_keys_map_with_prusaslicers_defaults_when_missing() -> Result<(), ConfigError> {
+        let (missing, _) = from_ini_str("layer_height = 0.2\n")?;
+        assert!(missing.slice.overhangs && !missing.slice.dynamic_overhang_speeds);
+        assert_eq!(missing.overhang_params().speeds, None);
+        let (set, _) = from_ini_str(
+            "external_perimeter_speed = 30\noverhangs = 0\nenable_dynamic_overhang_speeds = 1\n\
+             overhang_speed_0 = 50%\noverhang_speed_1 = 0\noverhang_speed_3 = 28\n\
+             bridge_fan_speed = 80,80\nenable_dynamic_fan_speeds = 1\noverhang_fan_speed_2 = 40\n",
+        )?;
+        let o = set.overhang_params();
+        assert!(!o.bridging);
+        assert_eq!(o.speeds, Some([15.0, 30.0, 20.0, 28.0]));
+        assert_eq!(o.fans, Some([0.0, 0.0, 40.0, 0.0]));
+        assert_eq!(o.bridge_fan, 80.0);
         Ok(())
     }
 

@@ -304,6 +304,47 @@ pub fn clip_polylines(lines: &[Polyline], region: &[ExPolygon]) -> Vec<Polyline>
     out
 }
 
+/// The stretches of the polyline `line` inside `region` (its boundary counts as inside), as
+/// intervals of arc length along it, mm from its start, in order. `line` may return to its
+/// start (a loop opened at its seam): a stretch through that point is given as two intervals,
+/// one at each end.
+pub fn clip_intervals(line: &[Point2], region: &[ExPolygon]) -> Vec<(f64, f64)> {
+    let length = |p: &[Point2]| -> f64 {
+        p.windows(2)
+            .map(|w| (w[0].distance_squared(w[1]) as f64).sqrt())
+            .sum()
+    };
+    let total = length(line);
+    // Cut points are rounded to the nanometre grid: a few nm off the line at most.
+    let tol = 1e3;
+    let (Some(&start), Some(&end)) = (line.first(), line.last()) else {
+        return Vec::new();
+    };
+    let pieces = clip_polylines(
+        &[Polyline {
+            points: line.to_vec(),
+        }],
+        region,
+    );
+    let mut out: Vec<(f64, f64)> = pieces
+        .iter()
+        .map(|piece| {
+            let len = length(&piece.points);
+            let (first, last) = (piece.points[0], piece.points[piece.points.len() - 1]);
+            let (a, b) = (position_along(line, first), position_along(line, last));
+            // The positions of a loop's start and end are ambiguous (both 0 by projection):
+            // the piece's own length says which end it reaches.
+            let forward = (b - (a + len)).abs() <= tol
+                || (last == end && last == start && (a + len - total).abs() <= tol);
+            // A reversed piece's last point is its earliest along the line.
+            let from = if forward { a } else { b };
+            (from / 1e6, ((from + len).min(total)) / 1e6)
+        })
+        .collect();
+    out.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
+    out
+}
+
 /// How [`stroke`] closes the two ends of each polyline.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Cap {

@@ -14,8 +14,8 @@ mod tool_frame;
 mod transform;
 
 pub use clip::{
-    Cap, FillRule, Join, clip_polylines, difference, intersection, offset, polygons_to_expolygons,
-    stroke, union,
+    Cap, FillRule, Join, clip_intervals, clip_polylines, difference, intersection, offset,
+    polygons_to_expolygons, stroke, union,
 };
 pub use point::{Coord, Point2, Point3, Vector3, scaled, unscaled};
 pub use polygon::{ExPolygon, Polygon, Polyline};

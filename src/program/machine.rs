@@ -102,6 +102,24 @@ pub struct Printer {
     /// `slowdown_below_layer_time` the fan runs in proportion (PrusaSlicer's
     /// `fan_below_layer_time`). Default 60.
     pub fan_below_layer_time: f64,
+    /// Fan speed during bridge infill and overhang perimeters, percent, when it is above the
+    /// layer's (PrusaSlicer's `bridge_fan_speed`); 0: the layer's. Default 100.
+    pub bridge_fan_speed: f64,
+    /// Give overhanging perimeters a fan of their own by how far they hang out
+    /// (`overhang_fan_speed_0..3`; PrusaSlicer's `enable_dynamic_fan_speeds`). Default false.
+    pub dynamic_fan_speeds: bool,
+    /// With `dynamic_fan_speeds`: fan speed for perimeters resting on 0 % of their width on the
+    /// layer below (in the air), percent, or the layer's when higher. Default 0.
+    pub overhang_fan_speed_0: f64,
+    /// Fan speed for perimeters with 25 % of their width on the layer below (or less, down to
+    /// 0 %), percent. Default 0.
+    pub overhang_fan_speed_1: f64,
+    /// Fan speed for perimeters with 50 % of their width on the layer below (down to 25 %),
+    /// percent. Default 0.
+    pub overhang_fan_speed_2: f64,
+    /// Fan speed for perimeters with 75 % of their width on the layer below (down to 50 %),
+    /// and those hanging out by more than 5 % of it, percent. Default 0.
+    pub overhang_fan_speed_3: f64,
     /// Retract with the firmware's `G10`/`G11` instead of E moves. Default false.
     pub use_firmware_retraction: bool,
 }
@@ -211,6 +229,12 @@ impl Default for Printer {
             slowdown_below_layer_time: 5.0,
             min_print_speed: 10.0,
             fan_below_layer_time: 60.0,
+            bridge_fan_speed: 100.0,
+            dynamic_fan_speeds: false,
+            overhang_fan_speed_0: 0.0,
+            overhang_fan_speed_1: 0.0,
+            overhang_fan_speed_2: 0.0,
+            overhang_fan_speed_3: 0.0,
             use_firmware_retraction: false,
         }
     }

@@ -14,6 +14,9 @@ pub enum Role {
     ExternalPerimeter,
     /// An inner perimeter loop.
     Perimeter,
+    /// A stretch of a perimeter loop whose bead lies over air (its centre more than half a
+    /// nozzle beyond the layer below): printed as a round thread, like a bridge.
+    OverhangPerimeter,
     /// Internal solid infill (solid layers between a surface and sparse infill).
     SolidInfill,
     /// Solid infill of an upward-facing (visible) surface.
@@ -50,9 +53,10 @@ pub enum Role {
 
 impl Role {
     /// Every role, in declaration order.
-    pub const ALL: [Role; 18] = [
+    pub const ALL: [Role; 19] = [
         Role::ExternalPerimeter,
         Role::Perimeter,
+        Role::OverhangPerimeter,
         Role::SolidInfill,
         Role::TopSolidInfill,
         Role::BottomSolidInfill,
@@ -82,6 +86,7 @@ impl Role {
         match self {
             Role::ExternalPerimeter => "External perimeter",
             Role::Perimeter => "Perimeter",
+            Role::OverhangPerimeter => "Overhang perimeter",
             Role::SolidInfill | Role::BottomSolidInfill => "Solid infill",
             Role::TopSolidInfill => "Top solid infill",
             Role::BridgeInfill => "Bridge infill",
@@ -113,7 +118,7 @@ impl Role {
     /// else is pressed onto the layer below (see [`super::extrusion`]).
     pub fn bead_shape(self) -> super::extrusion::BeadShape {
         match self {
-            Role::BridgeInfill => super::extrusion::BeadShape::Round,
+            Role::BridgeInfill | Role::OverhangPerimeter => super::extrusion::BeadShape::Round,
             _ => super::extrusion::BeadShape::RoundedRectangle,
         }
     }
@@ -337,6 +342,13 @@ pub enum Event {
     Dwell {
         /// Duration, seconds.
         seconds: f64,
+    },
+    /// The part-cooling fan from here on: `Some(p)` runs it at `p` percent or at the layer's
+    /// own speed, whichever is higher (bridges and overhanging perimeters); `None` returns it
+    /// to the layer's speed. Layers printed with the fan off keep it off.
+    PartFan {
+        /// The lowest fan speed wanted, percent; `None`: the layer's.
+        at_least: Option<f64>,
     },
     /// Switch the active tool's output on or off (an aerosol jet's shutter). An `on` switch
     /// before a path takes effect where the path starts, an `off` switch after a path where it

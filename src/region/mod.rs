@@ -28,6 +28,7 @@ pub mod brim;
 pub mod cavity;
 pub mod gapfill;
 pub mod infill;
+pub mod overhang;
 pub mod params;
 pub mod perimeters;
 pub mod simplify;
@@ -35,9 +36,10 @@ pub mod skins;
 pub mod skirt;
 pub mod support;
 #[cfg(test)]
-mod test_util;
+pub(crate) mod test_util;
 
 pub use brim::{Brim, BrimParams, BrimType, make_brim};
+pub use overhang::{OverhangZones, overhang_zones};
 pub use params::{
     InfillPatternKind, MAX_PERIMETERS, MAX_SKIRT_LOOPS, MAX_SOLID_INFILL_MARGIN, MAX_SOLID_LAYERS,
     MAX_WIDTH, MAX_WIDTH_NOZZLES, MIN_LAYER_HEIGHT, NOZZLE_RANGE, ParamError, PerimeterGenerator,
@@ -97,6 +99,10 @@ pub struct LayerRegions {
     pub infill_area: Vec<ExPolygon>,
     /// The infill area split by role.
     pub skins: SkinAreas,
+    /// Where the perimeter beads hang out over the layer below, one entry per loop width that
+    /// does ([`overhang`]); empty on the first layer, when nothing overhangs, and without
+    /// [`RegionParams::overhangs`].
+    pub overhangs: Vec<OverhangZones>,
 }
 
 /// What [`make_regions_with_heights`] cannot work with.
@@ -214,6 +220,11 @@ fn regions(layers: &[Vec<ExPolygon>], heights: &[f64], params: &RegionParams) ->
                 .checked_sub(1)
                 .map_or(&[][..], |i| layers[i].as_slice());
             let gap_fill = thick_lines(&per, &lp, height);
+            let overhangs = if params.overhangs && index > 0 {
+                layer_overhangs(&layers[index], below, &per.loops, params.nozzle_diameter)
+            } else {
+                Vec::new()
+            };
             LayerRegions {
                 index,
                 height,
@@ -236,8 +247,26 @@ fn regions(layers: &[Vec<ExPolygon>], heights: &[f64], params: &RegionParams) ->
                 skirt_width: lp.perimeter_width,
                 infill_area: per.infill_area,
                 skins,
+                overhangs,
             }
         })
+        .collect()
+}
+
+/// The overhang zones of a layer's `loops` over the layer `below`, one per loop width that
+/// overhangs, in order of width.
+fn layer_overhangs(
+    islands: &[ExPolygon],
+    below: &[ExPolygon],
+    loops: &[PerimeterLoop],
+    nozzle: f64,
+) -> Vec<OverhangZones> {
+    let mut widths: Vec<f64> = loops.iter().map(|l| l.width).collect();
+    widths.sort_by(f64::total_cmp);
+    widths.dedup();
+    widths
+        .into_iter()
+        .filter_map(|w| overhang_zones(islands, below, w, nozzle))
         .collect()
 }
 

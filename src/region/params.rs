@@ -111,6 +111,9 @@ pub struct RegionParams {
     pub nozzle_diameter: f64,
     /// Layer height, mm, used in the spacing formula when no per-layer heights are given.
     pub layer_height: f64,
+    /// Find where perimeter beads hang out over the layer below
+    /// ([`LayerRegions::overhangs`](super::LayerRegions::overhangs)).
+    pub overhangs: bool,
 }
 
 impl Default for RegionParams {
@@ -141,6 +144,7 @@ impl Default for RegionParams {
             support: SupportParams::default(),
             nozzle_diameter: 0.4,
             layer_height: 0.2,
+            overhangs: true,
         }
     }
 }

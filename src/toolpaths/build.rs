@@ -27,6 +27,9 @@
 //!   `slice.seam_position` picks [`SeamRule::Aligned`](super::order::SeamRule::Aligned).
 //! - **Seam gap.** Perimeter loops (not the skirt, not a paste tool's traces) end
 //!   [`ProgramParams::seam_gap`] short of their start.
+//! - **Overhangs.** Perimeter paths are cut where their bead hangs out over the layer below
+//!   by another degree, each piece at its degree's speed and role, and runs of bridges and
+//!   overhangs get the bridge fan ([`super::overhang`]).
 //! - **Speeds and widths.** Per tool ([`ToolPathParams`]): perimeters keep the width the
 //!   regions stage gave each loop; infill and skirt take the tool's widths; every path on the
 //!   program's first layer is printed at `first_layer_speed`.
@@ -37,6 +40,7 @@
 use std::collections::BTreeMap;
 
 use super::order::{Group, OrderParams, order_groups};
+use super::overhang::{OverhangParams, split_paths, with_fan_events};
 use crate::geom::{Point2, Point3, Polygon, scaled, segment_distance2, unscaled};
 use crate::program::extrusion::BeadShape;
 use crate::program::{Event, Layer, LayerExtras, LayerInsert, LayerItem, Program, Role, Toolpath};
@@ -106,7 +110,7 @@ impl RoleSpeeds {
             Role::ExternalPerimeter => self.external_perimeter,
             Role::Perimeter | Role::Custom => self.perimeter,
             Role::SolidInfill | Role::BottomSolidInfill => self.solid_infill,
-            Role::BridgeInfill => self.bridge,
+            Role::BridgeInfill | Role::OverhangPerimeter => self.bridge,
             Role::GapFill => self.gap_fill,
             Role::TopSolidInfill => self.top_solid_infill,
             Role::SparseInfill | Role::Scaffold | Role::Buffer => self.sparse_infill,
@@ -175,6 +179,8 @@ pub struct ProgramParams {
     /// How far short of its start each perimeter loop ends, mm
     /// ([`Toolpath::clip_loop_end`]). Default 0: loops close.
     pub seam_gap: f64,
+    /// Perimeters over air and the bridge fan ([`super::overhang`]).
+    pub overhang: OverhangParams,
 }
 
 impl Default for ProgramParams {
@@ -185,6 +191,7 @@ impl Default for ProgramParams {
             start: Point3::origin(),
             resolution: DEFAULT_RESOLUTION_MM,
             seam_gap: 0.0,
+            overhang: OverhangParams::default(),
         }
     }
 }
@@ -590,12 +597,18 @@ pub fn build_program_with(
                     path.clip_loop_end(params.seam_gap);
                 }
             }
+            let zones: Vec<_> = entries
+                .iter()
+                .filter(|e| e.tool == tool)
+                .flat_map(|e| &e.regions.overhangs)
+                .collect();
+            let paths = split_paths(paths, &zones, &params.overhang, tp.speeds.bridge);
             if current_tool.is_some_and(|c| c != tool) {
                 items.push(LayerItem::Event(Event::ToolChange { tool }));
             }
             current_tool = Some(tool);
             pos = end;
-            items.extend(paths.into_iter().map(LayerItem::Path));
+            items.extend(with_fan_events(paths));
         }
         if let Some(extra) = extras.paths_after.get(&z_key) {
             let mut extra_tools: Vec<usize> = extra.iter().map(|p| p.tool).collect();
@@ -750,12 +763,25 @@ mod tests {
                 .paths()
                 .any(|p| p.role == Role::TopSolidInfill && p.speed == 30.0)
         );
-        assert!(
-            program
-                .layers
-                .iter()
-                .all(|l| l.items.iter().all(|i| matches!(i, LayerItem::Path(_))))
-        );
+        // Besides paths, only the bridge fan around the internal bridges under the top.
+        for l in &program.layers {
+            let mut fan = None;
+            for item in &l.items {
+                match item {
+                    LayerItem::Path(p) => {
+                        assert_eq!(
+                            fan.is_some(),
+                            p.role == Role::BridgeInfill,
+                            "layer {}",
+                            l.index
+                        );
+                    }
+                    LayerItem::Event(Event::PartFan { at_least }) => fan = *at_least,
+                    LayerItem::Event(e) => panic!("unexpected {e:?}"),
+                }
+            }
+            assert_eq!(fan, None);
+        }
     }
 
     #[test]

@@ -28,7 +28,9 @@
 //!   after-first-layer values. The fan is off for the first `disable_fan_first_layers` layers,
 //!   then follows the layer's extrusion time as PrusaSlicer's cooling does with its default
 //!   thresholds: `fan_max_speed` under 5 s, `fan_min_speed` over 60 s, linear in between
-//!   (`M106 S0-255`, written only when it changes).
+//!   (`M106 S0-255`, written only when it changes). An [`crate::program::Event::PartFan`]
+//!   raises it for the paths after it (bridges and overhangs) to its speed if that is higher,
+//!   and returns it to the layer's; not on the layers with the fan off.
 //! - Per path: a travel (`G1 X Y F<travel>`; longer than `retract_before_travel`: retract
 //!   first, and with `retract_lift > 0` a z-hop up before and back down after), un-retract,
 //!   `;TYPE:<role>` and `;WIDTH:<w>` when they change (`;HEIGHT:` too, within a layer), `G1 F`

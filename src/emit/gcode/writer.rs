@@ -122,6 +122,8 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     used: Vec<usize>,
     /// Fan command written last.
     fan: Option<String>,
+    /// The current layer's own fan speed, percent (what [`Event::PartFan`] returns to).
+    layer_fan: f64,
     /// Position, carried `E` and totals of a switched-tool job.
     switch: switched::SwitchState,
 }
@@ -195,6 +197,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             speed_factor: 1.0,
             used: Vec::new(),
             fan: None,
+            layer_fan: 0.0,
             switch: switched::SwitchState::default(),
         })
     }
@@ -900,7 +903,8 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         self.take_planned_times();
         let (factor, time) = self.slowdown(layer);
         self.speed_factor = factor;
-        let fan_line = fan(self.fan_speed(layer, time));
+        self.layer_fan = self.fan_speed(layer, time);
+        let fan_line = fan(self.layer_fan);
         if self.fan.as_deref() != Some(fan_line.as_str()) {
             self.line(&fan_line);
             self.fan = Some(fan_line);
@@ -1088,6 +1092,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                 }
             }
             Event::Switch { on, .. } => self.switch_snippet(*on),
+            Event::PartFan { at_least } => self.part_fan(*at_least),
             Event::Dwell { seconds } => {
                 if seconds.is_finite() && *seconds > 0.0 {
                     // Its time counts as the line is written (see `plan_command`).
@@ -1096,6 +1101,20 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             }
         }
         Ok(())
+    }
+
+    /// The fan at `at_least` percent or the layer's speed, whichever is higher (`None`: the
+    /// layer's), written when it changes; nothing on the layers printed with the fan off.
+    fn part_fan(&mut self, at_least: Option<f64>) {
+        if self.layer_index < self.cfg.printer.disable_fan_first_layers {
+            return;
+        }
+        let speed = at_least.map_or(self.layer_fan, |p| p.min(100.0).max(self.layer_fan));
+        let l = fan(speed);
+        if self.fan.as_deref() != Some(l.as_str()) {
+            self.line(&l);
+            self.fan = Some(l);
+        }
     }
 
     /// The active tool's output switched on or off outside a switched-tool job: the paste
