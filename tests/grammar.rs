@@ -31,9 +31,9 @@ fn json_of(o: &std::process::Output, what: &str) -> Value {
 }
 
 /// A PrusaSlicer profile with settings conduit reads, three it ignores that change the print
-/// only when not off (`overhangs = 1` and `ironing = 1` do, `spiral_vase = 0` does not) and two
+/// only when not off (`raft_layers = 2` and `ironing = 1` do, `spiral_vase = 0` does not) and two
 /// that do not change it.
-const PROFILE: &str = "layer_height = 0.2\noverhangs = 1\nironing = 1\nspiral_vase = 0\n\
+const PROFILE: &str = "layer_height = 0.2\nraft_layers = 2\nironing = 1\nspiral_vase = 0\n\
                        gcode_comments = 0\nwipe = 1\n";
 
 #[test]
@@ -565,7 +565,7 @@ fn ignored_prusaslicer_keys_are_one_short_warning_and_all_of_them_with_verbose()
         stderr(&o),
         format!(
             "warning: {}: 5 PrusaSlicer keys ignored (2 that change the print: ironing, \
-             overhangs); full list with --verbose\n",
+             raft_layers); full list with --verbose\n",
             ini.display()
         )
     );
@@ -574,7 +574,7 @@ fn ignored_prusaslicer_keys_are_one_short_warning_and_all_of_them_with_verbose()
     let err = stderr(&o);
     assert!(
         err.contains(
-            "ignored PrusaSlicer keys: gcode_comments, ironing, overhangs, spiral_vase, wipe\n"
+            "ignored PrusaSlicer keys: gcode_comments, ironing, raft_layers, spiral_vase, wipe\n"
         ),
         "{err}"
     );
@@ -614,7 +614,7 @@ fn ignored_prusaslicer_keys_are_one_short_warning_and_all_of_them_with_verbose()
         .unwrap_or_else(|| panic!("{err}"));
     assert!(line.len() < 600, "{} characters: {line}", line.len());
     assert!(
-        line.contains("overhangs") && !line.contains("gcode_comments"),
+        line.contains("thick_bridges") && !line.contains("gcode_comments"),
         "{line}"
     );
     assert!(line.ends_with("; full list with --verbose"), "{line}");

@@ -190,9 +190,6 @@ pub struct Search {
     min_weight: f64,
     /// Least cost of one layer change.
     change_cost: f64,
-    /// Least cost of one layer change counting its whole printed piece: `layer_change_penalty`
-    /// plus `interlayer_overlap + grid_step` at `base_weight`.
-    step_cost: f64,
     /// Routes costing more than this are not searched for (see [`RouteParams::max_detour`]).
     cost_limit: f64,
     /// Grid pairs (from, to) [`Search::grid_weight`] refused an edge.
@@ -274,9 +271,6 @@ impl Search {
             expansions: 0,
             min_weight,
             change_cost,
-            step_cost: (params.layer_change_penalty
-                + (params.interlayer_overlap + params.grid_step) * params.base_weight)
-                .max(0.0),
             cost_limit: f64::INFINITY,
             refused: IntSet::default(),
             fit_memo: FitMemo::default(),
@@ -466,19 +460,10 @@ impl Search {
 
     /// The least cost from a point on layer `la` to one `dxy` scaled units away (in xy) on
     /// layer `lb`.
-    ///
-    /// Two bounds, the larger taken: every change costs at least `change_cost` plus its rise
-    /// at the least weight (so the 3D distance bounds the rest), and every change prints a
-    /// piece longer than `interlayer_overlap + grid_step` (see `explore_layers`), so it costs
-    /// at least [`Search::step_cost`] while the planar moves still cover the xy distance. Both
-    /// fall by at most an edge's cost along an edge, so their maximum stays consistent.
     fn bound(&self, la: usize, lb: usize, dxy: f64) -> f64 {
         let dz = self.layer(la).z - self.layer(lb).z;
         let dxy = unscaled(1) * dxy;
-        let changes = la.abs_diff(lb) as f64;
-        let through = self.min_weight * (dxy * dxy + dz * dz).sqrt() + self.change_cost * changes;
-        let stepped = self.min_weight * dxy + self.step_cost * changes;
-        through.max(stepped)
+        self.min_weight * (dxy * dxy + dz * dz).sqrt() + self.change_cost * la.abs_diff(lb) as f64
     }
 
     fn heuristic(&mut self, v: VertexId) -> f64 {

@@ -769,7 +769,8 @@ fn routes_are_the_same_on_any_number_of_threads() {
 #[test]
 fn the_heuristic_never_promises_more_than_a_climb_costs() {
     // Steep climbs (8 layers over 4 mm) and shallow ones (8 layers over 30 mm): every layer
-    // change prints a piece longer than overlap + grid step, which the heuristic counts.
+    // change prints a piece longer than overlap + grid step, so a climb costs at least that
+    // per layer on top of its xy distance, more than the heuristic's bound.
     let layers = stack(vec![solid(rect(0.0, 0.0, 40.0, 40.0))], 10);
     let params = RouteParams::default();
     let step_cost = params.layer_change_penalty
