@@ -24,7 +24,7 @@
 //! G-code built from them is byte-identical across runs.
 
 use super::point::{Point2, scaled};
-use super::polygon::{ExPolygon, Polygon, Polyline};
+use super::polygon::{ExPolygon, Polygon, Polyline, polyline_length};
 use i_overlay::core::fill_rule::FillRule as IFillRule;
 use i_overlay::core::overlay::{Overlay, ShapeType};
 use i_overlay::core::overlay_rule::OverlayRule;
@@ -309,12 +309,7 @@ pub fn clip_polylines(lines: &[Polyline], region: &[ExPolygon]) -> Vec<Polyline>
 /// start (a loop opened at its seam): a stretch through that point is given as two intervals,
 /// one at each end.
 pub fn clip_intervals(line: &[Point2], region: &[ExPolygon]) -> Vec<(f64, f64)> {
-    let length = |p: &[Point2]| -> f64 {
-        p.windows(2)
-            .map(|w| (w[0].distance_squared(w[1]) as f64).sqrt())
-            .sum()
-    };
-    let total = length(line);
+    let total = polyline_length(line);
     // Cut points are rounded to the nanometre grid: a few nm off the line at most.
     let tol = 1e3;
     let (Some(&start), Some(&end)) = (line.first(), line.last()) else {
@@ -329,7 +324,7 @@ pub fn clip_intervals(line: &[Point2], region: &[ExPolygon]) -> Vec<(f64, f64)> 
     let mut out: Vec<(f64, f64)> = pieces
         .iter()
         .map(|piece| {
-            let len = length(&piece.points);
+            let len = polyline_length(&piece.points);
             let (first, last) = (piece.points[0], piece.points[piece.points.len() - 1]);
             let (a, b) = (position_along(line, first), position_along(line, last));
             // The positions of a loop's start and end are ambiguous (both 0 by projection):

@@ -18,7 +18,7 @@ pub use clip::{
     polygons_to_expolygons, stroke, union,
 };
 pub use point::{Coord, Point2, Point3, Vector3, scaled, unscaled};
-pub use polygon::{ExPolygon, Polygon, Polyline};
+pub use polygon::{ExPolygon, Polygon, Polyline, polyline_length};
 pub use segment::{segment_distance, segment_distance2, segment_param};
 pub use tolerances::{Tolerance, Tolerances};
 pub use tool_frame::tool_frame;

@@ -2,6 +2,14 @@
 
 use super::point::Point2;
 
+/// Length of the open polyline through `points`, scaled units.
+pub fn polyline_length(points: &[Point2]) -> f64 {
+    points
+        .windows(2)
+        .map(|w| (w[0].distance_squared(w[1]) as f64).sqrt())
+        .sum()
+}
+
 /// A closed polygon; the last point connects back to the first (it is not repeated).
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Polygon {

@@ -25,9 +25,9 @@
 
 use super::graph::{self, Ends, Graph, IntSet, LayerInput, PreparedLayer, VertexId, Zone};
 use super::index::{dist, lerp};
-use super::interlayer::{FitMemo, Parent, piece_fits, polyline_length, walk_back};
+use super::interlayer::{FitMemo, Parent, piece_fits, walk_back};
 use super::{RouteLayer, RouteParams, Unrouted, Wire, WireRoute, layer_of, trace};
-use crate::geom::{Point2, scaled, segment_distance, segment_param, unscaled};
+use crate::geom::{Point2, polyline_length, scaled, segment_distance, segment_param, unscaled};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::ops::RangeInclusive;
@@ -700,6 +700,7 @@ impl Search {
                 || !piece_fits(
                     &piece,
                     &self.graph,
+                    // The field, not `self.layer(other)`, so the memo can be borrowed beside it.
                     &self.layers[other - self.layers[0].index],
                     tol,
                     &mut self.fit_memo,

@@ -791,7 +791,7 @@ impl Graph {
 
     /// Joins `a` and `b` both ways at `weight` per mm of their distance (once).
     pub(crate) fn link(&mut self, a: VertexId, b: VertexId, weight: f64) {
-        if a == b || self.adj[a as usize].iter().any(|e| e.to == b) {
+        if a == b || self.linked(a, b) {
             return;
         }
         let cost = unscaled(1) * dist(self.verts[a as usize].p, self.verts[b as usize].p) * weight;

@@ -120,8 +120,3 @@ pub(crate) fn piece_fits(
                 .or_insert_with(|| layer.blocked.crosses(w[0], w[1]))
         })
 }
-
-/// Length of a polyline, scaled units.
-pub(crate) fn polyline_length(points: &[Point2]) -> f64 {
-    points.windows(2).map(|w| dist(w[0], w[1])).sum()
-}

@@ -27,7 +27,7 @@
 //!   wrapped in [`Event::PartFan`] events: the writer runs the fan at that speed or the layer's,
 //!   whichever is higher, and returns to the layer's after.
 
-use crate::geom::{ExPolygon, Point2, clip_intervals, scaled};
+use crate::geom::{ExPolygon, Point2, clip_intervals, polyline_length, scaled};
 use crate::program::{Event, LayerItem, Role, Toolpath};
 use crate::region::OverhangZones;
 use crate::region::overhang::ZONES;
@@ -173,10 +173,7 @@ fn gather(zones: &[&OverhangZones]) -> Vec<WidthZones> {
 /// The degree of each stretch of `line` against `zones`: `(from, to, degree)` in arc length
 /// (mm), covering the line, neighbours of equal degree merged.
 fn degrees(line: &[Point2], zones: &[Vec<ExPolygon>]) -> Vec<(f64, f64, usize)> {
-    let total: f64 = line
-        .windows(2)
-        .map(|w| (w[0].distance_squared(w[1]) as f64).sqrt() / 1e6)
-        .sum();
+    let total = polyline_length(line) / 1e6;
     let mut inside: Vec<Vec<(f64, f64)>> = Vec::new();
     for zone in zones {
         if zone.is_empty() {
