@@ -19,7 +19,10 @@
 //! Routing stops at the deadline: no search starts once it has passed, a running search looks
 //! at the clock every `CLOCK_EVERY` steps and gives up, and no rip-up round or attempt starts.
 //! The wires this leaves without a route are reported [`Unrouted::TimeLimit`]; an attempt cut
-//! short is undone like any other that routes no more wires.
+//! short is undone like any other that routes no more wires. Routing itself stops
+//! [`EXPLAIN_SHARE`] of the time before the deadline: the rest is kept for looking at what
+//! blocks the wires that failed ([`Board::diagnose`]), so a run that uses all its time still
+//! says why, within the limit.
 //!
 //! Each ordered search runs first in a tight window round its pads (a third of their distance
 //! plus a few mm), accepting only a route cheaper than any that leaves it (its length out and
@@ -57,6 +60,18 @@ mod negotiate;
 
 /// Steps of one A* search between two looks at the clock.
 const CLOCK_EVERY: usize = 256;
+
+/// The share of the time left to the deadline that routing leaves to [`Board::diagnose`]: on
+/// the corpus RedBot board at the default 180 s, 9 s, enough to probe a handful of failed wires.
+const EXPLAIN_SHARE: f64 = 0.05;
+
+/// When routing stops, given the `deadline` it has from `now`: [`EXPLAIN_SHARE`] of the time
+/// between them earlier.
+fn routing_deadline(deadline: Instant, now: Instant) -> Instant {
+    now + deadline
+        .saturating_duration_since(now)
+        .mul_f64(1.0 - EXPLAIN_SHARE)
+}
 
 /// A channel area (mm²) below which two channels count as not touching: polygon noise.
 const TOUCH_MM2: f64 = 1e-6;
@@ -395,8 +410,11 @@ pub(crate) struct Board<'a> {
     /// Layer geometry of negotiation rounds (see [`Geometries`]): the material less other
     /// nets' pads, the same in every round.
     geometry: Geometries,
-    /// When routing must stop.
+    /// When routing must stop (see [`routing_deadline`]); once routing is over, when looking at
+    /// what blocks the failed wires must stop.
     deadline: Option<Instant>,
+    /// The deadline the board was given: the end of [`Board::diagnose`].
+    explain_until: Option<Instant>,
     /// Whether the deadline stopped any work.
     stopped: bool,
 }
@@ -447,7 +465,8 @@ impl<'a> Board<'a> {
             eroded: (0..layers.len()).map(|_| OnceLock::new()).collect(),
             routes: vec![None; wires.len()],
             geometry: Geometries::new(),
-            deadline,
+            deadline: deadline.map(|d| routing_deadline(d, Instant::now())),
+            explain_until: deadline,
             stopped: false,
         }
     }
@@ -640,10 +659,12 @@ impl<'a> Board<'a> {
     }
 
     /// Looks at what stands in the way of every wire left without a route (not for lack of a
-    /// layer or time), until the deadline: see [`Blockage`]. Whether the deadline stopped
+    /// layer or time), until the board's deadline (routing stopped a little before it, see
+    /// [`routing_deadline`]): see [`Blockage`]. Whether the deadline stopped
     /// routing is left as it was: this only explains the result.
     pub(crate) fn diagnose(&mut self) {
         let stopped = self.stopped;
+        self.deadline = self.explain_until;
         for i in 0..self.wires.len() {
             let explain = self.routes[i].as_ref().is_none_or(|r| {
                 !r.routed && !matches!(r.reason, Some(Unrouted::TimeLimit(_) | Unrouted::NoLayer))
@@ -1323,6 +1344,21 @@ impl<'a> Board<'a> {
 #[cfg(test)]
 mod window_tests {
     use super::*;
+
+    #[test]
+    fn routing_leaves_the_last_twentieth_of_its_time_to_the_diagnosis() {
+        let now = Instant::now();
+        let d = now + std::time::Duration::from_secs(180);
+        assert_eq!(
+            routing_deadline(d, now),
+            now + std::time::Duration::from_secs(171)
+        );
+        // A deadline already past stays past.
+        assert_eq!(
+            routing_deadline(now, now + std::time::Duration::from_secs(1)),
+            now + std::time::Duration::from_secs(1)
+        );
+    }
 
     fn wire(from: [f64; 2], to: [f64; 2]) -> Wire {
         Wire {
