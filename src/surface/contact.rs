@@ -25,7 +25,7 @@
 
 use super::mesh::Surface;
 use super::replay::{Obstacle, Sample, Stretch};
-use super::tool::{Piece, PieceShape, ToolSolid};
+use super::tool::{PieceShape, ToolSolid};
 use crate::geom::{Point3, Vector3};
 
 /// Points on the rim of a tip disc standing on edge.
