@@ -67,9 +67,12 @@
 //! - never goes backwards: not behind its own design point, not behind the tip before it.
 //!   Tips held at one place (at a corner, at the end) are one tip, the last.
 //!
-//! The escape's share across the path stays an offset. So the printed path is the design on
-//! the surface (without the first shift at each path's start), and its length is the surface
-//! path's within the G-code's rounding.
+//! The escape's share across the path stays an offset. So the printed path, seen from above
+//! and laid on the surface, is the design on the surface (without the first shift at each
+//! path's start), its length the surface path's. The tip's own travel is longer where its
+//! height over the surface changes: the deposit modes' shift (d_o/2 ahead going down, d/2 going
+//! up) changes at every turn between downhill, level and uphill stretches, and the nozzle climbs
+//! or sinks relative to the surface there (on 2 mm Hilbert stretches on 30° slopes, 0.6–0.8 %).
 
 use super::Corrections;
 use super::nozzle::Nozzle;
