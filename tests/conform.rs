@@ -1105,11 +1105,14 @@ fn accuracy_the_fold_is_printed_without_contact_by_the_exact_query_and_dense_sam
 }
 
 /// The Hilbert loop and the spiral on generated surfaces: the written dispensing moves pass
-/// through every corner of the design on the surface to 1 µm, and are as long as the design on
-/// the surface to 0.1 % — the spiral everywhere, the Hilbert loop on a gentle swell. Where a
-/// Hilbert loop turns on a slope the deposit model's shift changes (d_o/2 ahead going down,
-/// none across, d/2 going up) and with it the tip's height over the surface, which adds
-/// 0.6–0.8 % on the ramp, the bump and the wrinkled film: measured and printed.
+/// through every corner of the design on the surface to 1 µm, and the printed path laid on the
+/// surface is as long as the design on the surface to 0.1 % — everywhere: no correction carries
+/// a tip backwards or past a corner. The tip's own path is as long to 0.1 % where its height
+/// over the surface holds (the spiral everywhere, the Hilbert loop on a gentle swell, and every
+/// run without corrections); where a Hilbert loop turns on a slope the deposit model's shift
+/// changes (d_o/2 ahead going down, none across, d/2 going up) and with it the tip's height over
+/// the ground, which adds 0.6–0.8 % of nozzle travel on the ramp, the bump and the wrinkled
+/// film: measured and printed.
 #[test]
 fn accuracy_printed_paths_keep_the_designs_length_and_corners() {
     let mut surfaces = generated_surfaces();
@@ -1149,11 +1152,33 @@ fn accuracy_printed_paths_keep_the_designs_length_and_corners() {
                 &planned.corners,
                 planned.report.geometry.length_3d,
             );
+            // The same without corrections: the tip d over its design point.
+            let none = params(Corrections::None, Mapping::Projection);
+            let bare = match plan(s, d, &placement_on(s, d), &none, |_| {}) {
+                Ok(x) => x,
+                Err(e) => panic!("{sn}, {dn}: {e}"),
+            };
+            let bare_written = match write_and_replay(&bare.paths, &cfg, s, &none) {
+                Ok(x) => x,
+                Err(e) => panic!("{sn}, {dn}: {e}"),
+            };
+            let bare_ratio = conduit::conform::replay::accuracy(
+                &bare_written.parsed,
+                &bare_written.machine,
+                s,
+                &none.nozzle,
+                &bare.corners,
+                bare.report.geometry.length_3d,
+            )
+            .length_ratio;
             println!(
-                "{sn:18} {dn:12} printed {:9.3} mm on the surface {:9.3} mm ratio {:.5} corners {} deviation {:.2e} mm tip above {:.4}/{:.4}/{:.4}",
+                "{sn:18} {dn:12} printed {:9.3} mm laid {:9.3} mm on the surface {:9.3} mm ratio {:.5} laid {:.5} (none {:.5}) corners {} deviation {:.2e} mm tip above {:.4}/{:.4}/{:.4}",
                 a.printed_length,
+                a.laid_length,
                 a.surface_length,
                 a.length_ratio,
+                a.laid_ratio,
+                bare_ratio,
                 a.corners,
                 a.corner_deviation_max,
                 a.tip_above_surface.min,
@@ -1169,16 +1194,29 @@ fn accuracy_printed_paths_keep_the_designs_length_and_corners() {
                 .sum::<f64>()
                 * placement_on(s, d).scale;
             assert!((planar - drawn).abs() < 1e-9 * drawn, "{planar} {drawn}");
-            results.push((gentle.contains(&sn.as_str()), format!("{sn}, {dn}"), a));
+            results.push((
+                gentle.contains(&sn.as_str()),
+                format!("{sn}, {dn}"),
+                a,
+                bare_ratio,
+            ));
         }
     }
     assert_eq!(results.len(), 8);
-    for (is_gentle, name, a) in &results {
+    for (is_gentle, name, a, bare_ratio) in &results {
         assert!(a.corners > 50, "{name}: {a:?}");
         assert!(a.corner_deviation_max <= 0.001, "{name}: {a:?}");
         assert!(a.tip_above_surface.min > 0.0, "{name}: {a:?}");
+        assert!((a.laid_ratio - 1.0).abs() < 0.001, "{name}: {a:?}");
+        assert!(
+            (bare_ratio - 1.0).abs() < 0.001,
+            "{name}: none {bare_ratio}"
+        );
         if *is_gentle || name.ends_with("spiral") {
             assert!((a.length_ratio - 1.0).abs() < 0.001, "{name}: {a:?}");
+        } else {
+            // The tip's height changes at the turns: more travel, never less than the path.
+            assert!(a.length_ratio > a.laid_ratio, "{name}: {a:?}");
         }
     }
 }

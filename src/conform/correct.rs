@@ -8,8 +8,11 @@
 //! For each point Tᵢ of the zero-standoff path, the tip goes to Tᵢ + d·ẑ. Then, with d_o the
 //! outer diameter, Vᵢ the horizontal direction of travel and κᵢ the signed curvature:
 //!
-//! - Contact: the tip disk meets the surface around the centroid pᵢ of the contact; the point
-//!   moves by Lᵢ = d_o/2 − |Tᵢpᵢ| + tolerance along Qᵢ = pᵢ→Tᵢ (horizontal).
+//! - Contact: the tip disk meets the surface around the centroid pᵢ of the contact (exactly:
+//!   the contact is found where the surface's highest point over the disc reaches the tip, pᵢ
+//!   is the centroid of the part of the disc under the surface,
+//!   [`crate::surface::clearance::DiscContact`]); the point moves by
+//!   Lᵢ = d_o/2 − |Tᵢpᵢ| + tolerance along Qᵢ = pᵢ→Tᵢ (horizontal).
 //! - Downhill (t_z < 0): Mᵢ = 0.5·d·(1 + d·κᵢ) for κᵢ ≤ 1/d, Mᵢ = d beyond (never below 0).
 //! - Contact and uphill → L·Q; contact and downhill → L·Q + M·V; no contact and downhill →
 //!   M'ᵢ·Vᵢ with M'ᵢ = d_o/2 − |Tᵢqᵢ| + Mᵢ, where qᵢ is the first point of the segment
@@ -64,9 +67,12 @@
 //! - never goes backwards: not behind its own design point, not behind the tip before it.
 //!   Tips held at one place (at a corner, at the end) are one tip, the last.
 //!
-//! The escape's share across the path stays an offset. So the printed path is the design on
-//! the surface (without the first shift at each path's start), and its length is the surface
-//! path's within the G-code's rounding.
+//! The escape's share across the path stays an offset. So the printed path, seen from above
+//! and laid on the surface, is the design on the surface (without the first shift at each
+//! path's start), its length the surface path's. The tip's own travel is longer where its
+//! height over the surface changes: the deposit modes' shift (d_o/2 ahead going down, d/2 going
+//! up) changes at every turn between downhill, level and uphill stretches, and the nozzle climbs
+//! or sinks relative to the surface there (on 2 mm Hilbert stretches on 30° slopes, 0.6–0.8 %).
 
 use super::Corrections;
 use super::nozzle::Nozzle;
@@ -556,9 +562,13 @@ fn snap(p: Point3) -> Point3 {
     )
 }
 
-/// Lifts points until no sample of the whole nozzle, at the points and along the segments
-/// between them (every quarter of the inner diameter, as [`super::replay`] samples), meets the
-/// surface; returns how many points were lifted. `margin` is the clearance kept, mm.
+/// Lifts points until the whole nozzle clears the surface by `margin` (mm) at the points and
+/// along the segments between them; returns how many points were lifted. Each tip position is
+/// checked by the exact query ([`crate::surface::ToolSolid::shortfall`]: the highest point of
+/// the surface over every footprint of the solid, per triangle), at the points and every
+/// quarter of the inner diameter along the segments — the positions the report and
+/// [`super::replay`] check with the same query, so a path this pass leaves clear replays with
+/// no contact.
 ///
 /// Points are first put on the G-code's 1 µm grid and every lift is rounded up to it, so the
 /// path checked is the path written: on a steep flank half a micrometre sideways is several

@@ -30,6 +30,15 @@
 //!
 //! Sampling the rim (4 rings × 16 angles, 0.1 mm apart on a 0.5 mm disc) misses a crease
 //! between two samples by micrometres; this does not.
+//!
+//! # Where a disc meets the surface
+//!
+//! The corrections' escape wants a place, not a depth: the centroid of the part of the disc
+//! where the surface reaches a level ([`HeightField::contact_in_disc`]). Over one triangle that
+//! part is the triangle cut by the line where its plane crosses the level (a convex polygon)
+//! and then by the circle; its area and first moment are exact sums over the polygon's edges
+//! (Green's theorem): a piece of an edge inside the circle adds the triangle it spans with the
+//! centre, a piece outside adds the circular sector between its ends' directions.
 
 use super::height_field::HeightField;
 use crate::geom::{Point3, Vector3};
@@ -214,7 +223,141 @@ pub fn max_over_cone(p: [[f64; 2]; 3], vals: [f64; 3], r0: f64, r1: f64, k: f64)
     (best > f64::NEG_INFINITY).then_some(best)
 }
 
+/// The part of the convex polygon `poly` (xy) where the affine function taking `vals` at its
+/// corners is at least 0: a convex polygon (empty when the function is negative throughout).
+fn clip_at_or_above(poly: &[[f64; 2]], vals: &[f64]) -> Vec<[f64; 2]> {
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for k in 0..poly.len() {
+        let j = (k + 1) % poly.len();
+        let (a, b, va, vb) = (poly[k], poly[j], vals[k], vals[j]);
+        if va >= 0.0 {
+            out.push(a);
+        }
+        if (va >= 0.0) != (vb >= 0.0) {
+            let t = va / (va - vb);
+            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+        }
+    }
+    out
+}
+
+/// Area and first moment (∫x, ∫y) of the part of the convex polygon `poly` (corners relative
+/// to the disc's centre, either winding) inside the disc of radius `r`, exactly (module docs).
+pub fn polygon_in_disc(poly: &[[f64; 2]], r: f64) -> (f64, [f64; 2]) {
+    let (mut area, mut mx, mut my) = (0.0, 0.0, 0.0);
+    let r2 = r * r;
+    for k in 0..poly.len() {
+        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+        let mut cuts = [0.0, f64::NAN, f64::NAN, 1.0];
+        for (slot, t) in circle_crossings(a, b, r).enumerate() {
+            cuts[1 + slot] = t;
+        }
+        let mut ts: Vec<f64> = cuts.into_iter().filter(|t| !t.is_nan()).collect();
+        ts.sort_by(f64::total_cmp);
+        for w in ts.windows(2) {
+            let at = |t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+            let (p, q) = (at(w[0]), at(w[1]));
+            // Inside when both ends are (crossings are on the circle to rounding); a line
+            // grazing the circle, whose crossings rounding loses, is outside: its chord's
+            // area is as small as its crossings are close.
+            let within = |v: [f64; 2]| dot(v, v) <= r2 * (1.0 + 1e-9);
+            if within(p) && within(q) {
+                // The triangle (centre, p, q).
+                let c = 0.5 * cross(p, q);
+                area += c;
+                mx += c * (p[0] + q[0]) / 3.0;
+                my += c * (p[1] + q[1]) / 3.0;
+            } else {
+                // The sector from p's direction to q's.
+                let t0 = p[1].atan2(p[0]);
+                let t1 = t0 + cross(p, q).atan2(dot(p, q));
+                area += 0.5 * r2 * (t1 - t0);
+                mx += r2 * r / 3.0 * (t1.sin() - t0.sin());
+                my += r2 * r / 3.0 * (t0.cos() - t1.cos());
+            }
+        }
+    }
+    // A clockwise polygon sums to the negative of both.
+    if area < 0.0 {
+        (-area, [-mx, -my])
+    } else {
+        (area, [mx, my])
+    }
+}
+
+/// Where the surface reaches into a disc ([`HeightField::contact_in_disc`]): the part of the
+/// disc under the surface, by its area and centroid, and the highest point of the surface
+/// over the disc.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DiscContact {
+    /// Area of the part of the disc where the surface is at or above the level, mm².
+    pub area: f64,
+    /// Its centroid (x, y), mm; where it has no area (the surface touches the level along a
+    /// ridge or at a peak), the centroid of the part within [`CONTACT_BAND`] of the highest
+    /// point.
+    pub centroid: [f64; 2],
+    /// The highest the surface reaches over the disc, mm.
+    pub highest: f64,
+}
+
+/// Depth below the surface's highest point over a disc that stands for a touch, mm (0.1 µm):
+/// where the surface only touches the level (a ridge or a peak at the level, no area), the
+/// contact's place is the centroid of the part of the disc within this of the highest point.
+pub const CONTACT_BAND: f64 = 1e-7;
+
+/// Areas below this are no area (the clipped polygons' rounding), mm².
+const NO_AREA: f64 = 1e-18;
+
 impl HeightField {
+    /// Area and first moment of the part of the disc of radius `r` about (x, y) where the
+    /// surface is at or above `level`, moments relative to (x, y).
+    fn region_at_or_above(&self, x: f64, y: f64, r: f64, level: f64) -> (f64, [f64; 2]) {
+        let (mut area, mut m) = (0.0, [0.0, 0.0]);
+        for i in self.near(x, y, r) {
+            let t = &self.triangles()[i];
+            let p = t.corners.map(|c| [c.x - x, c.y - y]);
+            let vals = t.corners.map(|c| c.z - level);
+            if vals.iter().all(|&v| v < 0.0) {
+                continue;
+            }
+            let part = clip_at_or_above(&p, &vals);
+            if part.len() < 3 {
+                continue;
+            }
+            let (a, mo) = polygon_in_disc(&part, r);
+            area += a;
+            m[0] += mo[0];
+            m[1] += mo[1];
+        }
+        (area, m)
+    }
+
+    /// Where the surface meets the disc of radius `r` about (x, y) at `level`: `None` when the
+    /// highest point of the surface over the disc is below `level` (exactly, as
+    /// [`HeightField::max_in_disc`]), else the part of the disc under the surface by its area
+    /// and centroid (module docs). Overlapping triangles (a scan folded over itself) each add
+    /// their part.
+    pub fn contact_in_disc(&self, x: f64, y: f64, r: f64, level: f64) -> Option<DiscContact> {
+        let highest = self.max_in_disc(x, y, r).filter(|&h| h >= level)?;
+        let (area, m) = self.region_at_or_above(x, y, r, level);
+        let (band, mb) = if area > NO_AREA {
+            (area, m)
+        } else {
+            self.region_at_or_above(x, y, r, highest - CONTACT_BAND)
+        };
+        let centroid = if band > NO_AREA {
+            [x + mb[0] / band, y + mb[1] / band]
+        } else {
+            // Nothing measurable even within the band (a vertical sliver): the centre.
+            [x, y]
+        };
+        Some(DiscContact {
+            area: if area > NO_AREA { area } else { 0.0 },
+            centroid,
+            highest,
+        })
+    }
+
     /// The highest the surface reaches over the disc of radius `r` about (x, y), exactly (see
     /// the module docs); `None` when no triangle meets the disc.
     pub fn max_in_disc(&self, x: f64, y: f64, r: f64) -> Option<f64> {
@@ -437,6 +580,105 @@ mod tests {
                 assert!(exact >= dense - 1e-12, "({x}, {y}): {exact} < {dense}");
                 assert!(exact - dense < 0.005, "({x}, {y}): {exact} ≫ {dense}");
             }
+        }
+    }
+
+    #[test]
+    fn a_plane_cuts_the_disc_in_a_segment_of_exact_area_and_centroid() {
+        // z = x over a triangle holding the disc, level c: the part x ≥ c of the disc of
+        // radius r is a circular segment of half-angle α = acos(c/r), area r²(α − sin α cos α),
+        // centroid at 2r sin³α / (3(α − sin α cos α)) along x.
+        let p = [[-5.0, -5.0], [5.0, -5.0], [0.0, 5.0]];
+        let r = 0.25;
+        for c in [-0.2, -0.05, 0.0, 0.1, 0.24] {
+            let vals = p.map(|q| q[0] - c);
+            let part = clip_at_or_above(&p, &vals);
+            let (area, m) = polygon_in_disc(&part, r);
+            let alpha = (c / r).acos();
+            let (sin, cos) = alpha.sin_cos();
+            let exact = r * r * (alpha - sin * cos);
+            let centroid = 2.0 * r * sin.powi(3) / (3.0 * (alpha - sin * cos));
+            assert!((area - exact).abs() < 1e-14, "{c}: {area} {exact}");
+            assert!((m[0] / area - centroid).abs() < 1e-12, "{c}: {m:?}");
+            assert!((m[1] / area).abs() < 1e-12, "{c}: {m:?}");
+        }
+        // A triangle inside the disc is itself; either winding.
+        let small = [[0.0, 0.0], [0.1, 0.0], [0.0, 0.1]];
+        for poly in [small.to_vec(), small.iter().rev().copied().collect()] {
+            let (area, m) = polygon_in_disc(&poly, r);
+            assert!((area - 0.005).abs() < 1e-15, "{area}");
+            assert!((m[0] / area - 0.1 / 3.0).abs() < 1e-12, "{m:?}");
+        }
+        // The whole disc: πr², centroid at the centre.
+        let (area, m) = polygon_in_disc(&p, r);
+        assert!(
+            (area - std::f64::consts::PI * r * r).abs() < 1e-14,
+            "{area}"
+        );
+        assert!(m[0].abs() < 1e-14 && m[1].abs() < 1e-14, "{m:?}");
+    }
+
+    #[test]
+    fn on_random_meshes_the_contact_region_matches_a_dense_grid_of_the_disc() {
+        // Random height fields as above; the part of a 0.5 mm disc within 20 µm of the
+        // surface's highest point over it, by the exact region and by a grid of 2.5 µm cells
+        // (31 416 points in the disc).
+        let mut rng = Rng(11);
+        let n = 30;
+        let h: Vec<f64> = (0..(n + 1) * (n + 1))
+            .map(|_| rng.range(0.0, 0.1))
+            .collect();
+        let p =
+            |i: usize, j: usize| Point3::new(0.2 * i as f64, 0.2 * j as f64, h[j * (n + 1) + i]);
+        let mut tris = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+                tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+            }
+        }
+        let surface = match crate::surface::Surface::from_triangles(tris) {
+            Ok(s) => s,
+            Err(e) => panic!("{e}"),
+        };
+        let field = surface.height_field();
+        let (r, cell) = (0.25, 0.0025);
+        for _ in 0..20 {
+            let (x, y) = (rng.range(0.5, 5.5), rng.range(0.5, 5.5));
+            let top = field.max_in_disc(x, y, r).unwrap_or(f64::NAN);
+            let level = top - 0.02;
+            let Some(c) = field.contact_in_disc(x, y, r, level) else {
+                panic!("({x}, {y}): no contact 20 µm under the top");
+            };
+            assert_eq!(c.highest, top);
+            assert!(field.contact_in_disc(x, y, r, top + 1e-9).is_none());
+            let k = (r / cell) as i64;
+            let (mut count, mut sx, mut sy) = (0.0, 0.0, 0.0);
+            for i in -k..=k {
+                for j in -k..=k {
+                    let (dx, dy) = (i as f64 * cell, j as f64 * cell);
+                    if dx.hypot(dy) <= r
+                        && surface.height(x + dx, y + dy).is_some_and(|z| z >= level)
+                    {
+                        count += 1.0;
+                        sx += dx;
+                        sy += dy;
+                    }
+                }
+            }
+            let area = count * cell * cell;
+            assert!(
+                (c.area - area).abs() < 0.05 * c.area + 2e-4,
+                "{} {area}",
+                c.area
+            );
+            let (gx, gy) = (x + sx / count, y + sy / count);
+            let off = (c.centroid[0] - gx).hypot(c.centroid[1] - gy);
+            assert!(
+                off < 0.005,
+                "({x}, {y}): centroid {:?} grid ({gx}, {gy})",
+                c.centroid
+            );
         }
     }
 

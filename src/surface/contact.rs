@@ -19,18 +19,17 @@
 //! above the surface's top ends the search), a cone every half millimetre along it. A section
 //! whose lowest point is above a bound of the surface's height around it is skipped.
 //!
-//! The corrections' [`ToolSolid::disc_contact`] wants a place, not a depth: the weighted
-//! centroid of the tip disc's samples (4 rings of 16 points and the centre) under the surface.
+//! The corrections' [`ToolSolid::disc_contact`] wants a place, not a depth: the centroid of
+//! the part of the tip disc under the surface, exact too
+//! ([`super::clearance::DiscContact`]): it finds every contact the depth query finds.
 
 use super::mesh::Surface;
 use super::replay::{Obstacle, Sample, Stretch};
-use super::tool::{Piece, PieceShape, ToolSolid};
+use super::tool::{PieceShape, ToolSolid};
 use crate::geom::{Point3, Vector3};
 
-/// Angles per ring of a disc.
+/// Points on the rim of a tip disc standing on edge.
 const DISC_ANGLES: usize = 16;
-/// Rings of a disc (at ¼, ½, ¾ and 1 of its radius).
-const DISC_RINGS: usize = 4;
 /// Cross-section spacing along a tilted cone, mm.
 const CONE_RING_MM: f64 = 0.5;
 /// Points per rim of a cone's cross-section on an axis standing on edge.
@@ -41,70 +40,16 @@ const CYLINDER_ANGLES: usize = 16;
 /// frame), mm: a nanometre, a thousandth of the G-code's grid.
 const TOUCH: f64 = 1e-9;
 
-/// Unit directions of the disc rings, computed once.
-static DIRECTIONS: std::sync::LazyLock<Vec<[f64; 2]>> = std::sync::LazyLock::new(|| {
-    (0..DISC_ANGLES)
-        .map(|a| {
-            let t = std::f64::consts::TAU * a as f64 / DISC_ANGLES as f64;
-            [t.cos(), t.sin()]
-        })
-        .collect()
-});
-
-/// One sample of the tip disc: offset from the axis and its area weight.
-#[derive(Debug, Clone, Copy)]
-struct RingSample {
-    dx: f64,
-    dy: f64,
-    /// Area weight (the ring's radius) for centroids.
-    weight: f64,
-}
-
-/// A disc piece's samples: the centre and [`DISC_RINGS`] rings.
-fn disc_samples(piece: &Piece) -> Vec<RingSample> {
-    let ro = piece.bottom_radius();
-    let mut s = vec![RingSample {
-        dx: 0.0,
-        dy: 0.0,
-        weight: ro / (2.0 * DISC_RINGS as f64),
-    }];
-    for k in 1..=DISC_RINGS {
-        let r = ro * k as f64 / DISC_RINGS as f64;
-        for u in DIRECTIONS.iter() {
-            s.push(RingSample {
-                dx: r * u[0],
-                dy: r * u[1],
-                weight: r,
-            });
-        }
-    }
-    s
-}
-
 impl ToolSolid {
-    /// The samples of the solid's discs.
-    fn disc_samples(&self) -> Vec<RingSample> {
-        self.pieces()
-            .iter()
-            .filter(|p| matches!(p.shape, PieceShape::Disc { .. }))
-            .flat_map(disc_samples)
-            .collect()
-    }
-
-    /// Where the tip disc at `tip` meets the surface (surface at or above the tip's height):
-    /// the weighted centroid of the touching samples (x, y), or `None` without contact.
+    /// Where the tip disc at `tip` meets the surface (surface at or above the tip's height,
+    /// exactly): the centroid (x, y) of the part of the disc under the surface (where it only
+    /// touches, of the part within [`super::clearance::CONTACT_BAND`] of its highest point),
+    /// or `None` without contact.
     pub fn disc_contact(&self, surface: &Surface, tip: &Point3) -> Option<[f64; 2]> {
-        let (mut sx, mut sy, mut w) = (0.0, 0.0, 0.0);
-        for s in self.disc_samples() {
-            if let Some(h) = surface.height(tip.x + s.dx, tip.y + s.dy)
-                && h >= tip.z
-            {
-                sx += s.weight * (tip.x + s.dx);
-                sy += s.weight * (tip.y + s.dy);
-                w += s.weight;
-            }
-        }
-        (w > 0.0).then(|| [sx / w, sy / w])
+        surface
+            .height_field()
+            .contact_in_disc(tip.x, tip.y, self.tip_radius(), tip.z)
+            .map(|c| c.centroid)
     }
 
     /// How far the surface reaches into the whole solid with its tip at `tip` (vertical axis),
@@ -328,12 +273,44 @@ mod tests {
         assert!((pen - 0.002).abs() < 1e-7, "{pen}");
         let clear = n.tip_clearance(&surface, &tip).unwrap_or(f64::NAN);
         assert!((clear + 0.002).abs() < 1e-7, "{clear}");
-        // The samples the check used to take: every one clear of the surface.
-        let sampled = disc_samples(&n.pieces()[0])
-            .iter()
-            .filter_map(|s| surface.height(tip.x + s.dx, tip.y + s.dy))
+        // The samples the checks used to take (the centre and 4 rings of 16): every one clear
+        // of the surface.
+        let sampled = (1..=4)
+            .flat_map(|ring| {
+                (0..16).map(move |k| {
+                    let t = std::f64::consts::TAU * k as f64 / 16.0;
+                    let rr = 0.25 * ring as f64 / 4.0;
+                    [rr * t.cos(), rr * t.sin()]
+                })
+            })
+            .chain([[0.0, 0.0]])
+            .filter_map(|q| surface.height(tip.x + q[0], tip.y + q[1]))
             .fold(f64::MIN, f64::max);
         assert!(sampled < tip.z - 0.003, "{}", sampled - tip.z);
+        // The corrections' contact finds it too: two caps of the rim, one over each flank,
+        // their centroid over the crease (at the disc's centre, to rounding).
+        let Some(c) = n.disc_contact(&surface, &tip) else {
+            panic!("the contact the samples miss is missed");
+        };
+        assert!(c[0].hypot(c[1]) < 1e-9, "{c:?}");
+        // Off the crease by 0.1 mm across it, one flank's cap: its centroid beyond the crease
+        // on that side, as the circular segment's.
+        let (sin_c, cos_c) = (90f64 + 11.25).to_radians().sin_cos();
+        // Across the crease (the crease runs along (cos, sin) of its angle).
+        let normal = Vector3::new(-sin_c, cos_c, 0.0);
+        let off = tip + normal * 0.1;
+        let Some(c) = n.disc_contact(&surface, &off) else {
+            panic!("no contact 0.1 mm off the crease");
+        };
+        // The flank at distance a from the crease is a·tan 47°: the part of the disc at or
+        // above the tip is where a ≥ rim / tan 47° − 0.002 / tan 47°.
+        let reach = (rim - 0.002) / 47f64.to_radians().tan();
+        let ch = reach - 0.1;
+        let alpha = (ch / 0.25).acos();
+        let (sin, cos) = alpha.sin_cos();
+        let along = 2.0 * 0.25 * sin.powi(3) / (3.0 * (alpha - sin * cos));
+        let got = (c[0] - off.x) * normal.x + (c[1] - off.y) * normal.y;
+        assert!((got - along).abs() < 1e-9, "{got} {along}");
         // A tilted axis 0.1° from the vertical gives the same to rounding of the tilt.
         let axis = Vector3::new(0.0, 0.1f64.to_radians().sin(), 0.1f64.to_radians().cos());
         let along = n.penetration_along(&surface, &tip, &axis, 0.0625);
