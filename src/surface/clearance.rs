@@ -544,6 +544,26 @@ mod tests {
         assert!(met > 100, "{met}");
     }
 
+    /// A height field of random heights in [0, 0.1) mm on an n × n grid of 0.2 mm cells.
+    fn random_surface(rng: &mut Rng, n: usize) -> crate::surface::Surface {
+        let h: Vec<f64> = (0..(n + 1) * (n + 1))
+            .map(|_| rng.range(0.0, 0.1))
+            .collect();
+        let p =
+            |i: usize, j: usize| Point3::new(0.2 * i as f64, 0.2 * j as f64, h[j * (n + 1) + i]);
+        let mut tris = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+                tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+            }
+        }
+        match crate::surface::Surface::from_triangles(tris) {
+            Ok(s) => s,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
     #[test]
     fn on_random_meshes_the_exact_query_matches_dense_sampling_of_the_disc() {
         // Height fields of random heights (slopes up to about 1) on a 0.2 mm grid, discs of
@@ -551,24 +571,7 @@ mod tests {
         // higher than the exact query, and find it as high to within their spacing.
         let mut rng = Rng(7);
         for _ in 0..4 {
-            let n = 30;
-            let h: Vec<f64> = (0..(n + 1) * (n + 1))
-                .map(|_| rng.range(0.0, 0.1))
-                .collect();
-            let p = |i: usize, j: usize| {
-                Point3::new(0.2 * i as f64, 0.2 * j as f64, h[j * (n + 1) + i])
-            };
-            let mut tris = Vec::new();
-            for j in 0..n {
-                for i in 0..n {
-                    tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
-                    tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
-                }
-            }
-            let surface = match crate::surface::Surface::from_triangles(tris) {
-                Ok(s) => s,
-                Err(e) => panic!("{e}"),
-            };
+            let surface = random_surface(&mut rng, 30);
             let field = surface.height_field();
             for _ in 0..25 {
                 let (x, y) = (rng.range(0.5, 5.5), rng.range(0.5, 5.5));
@@ -624,23 +627,7 @@ mod tests {
         // surface's highest point over it, by the exact region and by a grid of 2.5 µm cells
         // (31 416 points in the disc).
         let mut rng = Rng(11);
-        let n = 30;
-        let h: Vec<f64> = (0..(n + 1) * (n + 1))
-            .map(|_| rng.range(0.0, 0.1))
-            .collect();
-        let p =
-            |i: usize, j: usize| Point3::new(0.2 * i as f64, 0.2 * j as f64, h[j * (n + 1) + i]);
-        let mut tris = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
-                tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
-            }
-        }
-        let surface = match crate::surface::Surface::from_triangles(tris) {
-            Ok(s) => s,
-            Err(e) => panic!("{e}"),
-        };
+        let surface = random_surface(&mut rng, 30);
         let field = surface.height_field();
         let (r, cell) = (0.25, 0.0025);
         for _ in 0..20 {
