@@ -17,7 +17,8 @@
 //! `solid_infill_below_area` becomes internal solid (see [`RegionParams`]).
 //!
 //! **Internal bridges.** Internal solid infill directly over the sparse infill of the layer below
-//! spans the gaps between sparse lines (2 mm at 20 %) like a bridge. It becomes
+//! spans the gaps between sparse lines (2 mm at 20 %) like a bridge. Where it is at least six
+//! bridge threads wide (PrusaSlicer's rule too), it becomes
 //! [`SolidRole::InternalBridge`]: round threads at the bridge spacing, as PrusaSlicer's
 //! "bridge over infill", so the first solid layer does not droop between the lines and the top
 //! surface above it comes out flat. Its lines keep the layer's own direction, which crosses the
@@ -31,10 +32,11 @@
 //! the perimeter band, i.e. where the perimeters alone are thinner than `N` layers.
 //!
 //! **Under a step.** Where a smaller part stands on a larger one, its perimeters stand on the
-//! larger part's top layers. Zones are therefore grown by the perimeter band width
-//! ([`super::perimeters::infill_inset`]) plus `solid_infill_margin`, so solid infill reaches under
-//! the whole perimeter band of the part above and is anchored beyond it. Exposed top and bottom
-//! surfaces are grown by `solid_infill_margin` only. Everything is limited to the infill area.
+//! larger part's top layers. Zones are therefore grown by the larger of the perimeter band width
+//! ([`super::perimeters::infill_inset`]) and `solid_infill_margin`, so solid infill reaches under
+//! the whole perimeter band of the part above and, with the default 3 mm margin, 2 mm beyond it
+//! (PrusaSlicer grows its top and bottom surfaces by 3 mm too). Exposed top and bottom surfaces
+//! are grown by `solid_infill_margin`. Everything is limited to the infill area.
 //!
 //! **Slivers.** Each difference is first *opened* by a quarter of the solid infill width, so
 //! slivers narrower than half an extrusion give no solid infill. Layers solid throughout (the
@@ -174,8 +176,13 @@ pub fn detect_skins(
     skins
 }
 
-/// `internal_solid` split into (the part over `sparse_below`, the rest), slivers under a
-/// quarter solid width left solid; `None` when nothing is over sparse infill.
+/// An internal bridge is opened by this many bridge thread widths: parts narrower than twice
+/// that stay internal solid.
+const INTERNAL_BRIDGE_OPENING: f64 = 3.0;
+
+/// `internal_solid` split into (the part over `sparse_below`, the rest), parts narrower than
+/// `2 · INTERNAL_BRIDGE_OPENING` bridge threads left solid; `None` when nothing is over sparse
+/// infill.
 fn internal_bridge(
     internal_solid: &[ExPolygon],
     sparse_below: &[ExPolygon],
@@ -188,7 +195,13 @@ fn internal_bridge(
     if over.is_empty() {
         return None;
     }
-    let bridge = shrink_opened(&over, 0.0, params.solid_infill_width / 4.0);
+    // Threads spanning the sparse lines below need room to span them: a strip narrower than
+    // six bridge threads (the edge of a solid zone creeping over the sparse infill of the layer
+    // below, as on every layer of a sloped top) rests on the solid beside it and gains nothing
+    // but the bridge's slow speed and fan. PrusaSlicer opens its internal bridges by the same
+    // three thread widths.
+    let (bridge_width, _) = params.bridge_flow();
+    let bridge = shrink_opened(&over, 0.0, INTERNAL_BRIDGE_OPENING * bridge_width);
     if bridge.is_empty() {
         return None;
     }
@@ -279,8 +292,12 @@ fn layer_skins(
         }
     };
     let surfaces: Vec<ExPolygon> = [below.as_slice(), top.as_slice()].concat();
+    // The zone reaches under the perimeter band of a part standing on this layer, and the
+    // margin anchors it: both from the same edge (where the part above begins), so the larger
+    // of the two covers both. (Their sum widened the solid ring of every sloped wall by a
+    // band on each of its layers.)
     let mut internal_solid = if zone_whole || !zone.is_empty() {
-        limit(zone, zone_whole, band + margin)
+        limit(zone, zone_whole, band.max(margin))
     } else {
         Vec::new()
     };
@@ -411,7 +428,8 @@ mod tests {
                 "layer {i}"
             );
         }
-        // The solid ring stops a margin past the small part's infill area.
+        // The solid ring stops at the small part's infill area: the band (0.93 mm) is wider
+        // than this margin, and covers it.
         assert!(at(&skins[5].sparse, 7.0, 10.0));
         // The small part's first layers stand on the solid ring: not solid themselves.
         assert!(!solid(&skins[6], 10.0, 10.0));
