@@ -437,6 +437,53 @@ mod tests {
     }
 
     #[test]
+    fn internal_bridges_need_six_threads_of_width() {
+        // A 20 mm square of internal solid over sparse infill that reaches `w` mm into it: the
+        // strip is bridged (exactly, the opening keeps its square corners) when it is at least
+        // six 0.4 mm threads wide, and stays solid when it is narrower.
+        use crate::region::test_util::rect_island;
+        let params = RegionParams::default();
+        assert_eq!(params.bridge_flow().0, 0.4);
+        let solid = vec![square_island(0.0, 0.0, 20.0)];
+        for (w, bridged) in [(2.0, false), (2.3, false), (2.5, true), (6.0, true)] {
+            let sparse = vec![rect_island(20.0 - w, -5.0, 30.0, 25.0)];
+            match internal_bridge(&solid, &sparse, &params) {
+                None => assert!(!bridged, "{w} mm: not bridged"),
+                Some((bridge, rest)) => {
+                    assert!(bridged, "{w} mm: bridged {bridge:?}");
+                    assert!((total_area(&bridge) - 20.0 * w).abs() < 1e-6, "{w} mm");
+                    assert!(
+                        (total_area(&rest) - 20.0 * (20.0 - w)).abs() < 1e-6,
+                        "{w} mm"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn under_a_step_the_solid_reaches_the_margin_past_the_edge_not_margin_plus_band() {
+        // The default 3 mm margin is wider than the perimeter band (0.93 mm): the solid zone
+        // under the small part ends 3 mm inside its edge (x = 5), where PrusaSlicer's 3 mm
+        // growth of the top surface ends too.
+        let params = RegionParams {
+            solid_infill_below_area: 0.0,
+            ..Default::default()
+        };
+        let band = infill_inset(&params, 0.2);
+        assert!(band < params.solid_infill_margin);
+        let mut stack = vec![vec![square_island(0.0, 0.0, 20.0)]; 6];
+        stack.extend(vec![vec![square_island(5.0, 5.0, 10.0)]; 6]);
+        let skins = skins_of(&stack, &params);
+        let at = |a: &[ExPolygon], x: f64| contains(a, Point2::from_mm(x, 10.0));
+        for i in [3, 4] {
+            assert!(at(&skins[i].internal_solid, 7.95), "layer {i}");
+            assert!(at(&skins[i].sparse, 8.05), "layer {i}");
+            assert!(!at(&skins[i].internal_solid, 8.05), "layer {i}");
+        }
+    }
+
+    #[test]
     fn zero_solid_layers_leave_everything_sparse_and_single_layer_is_bottom() {
         let none = RegionParams {
             top_solid_layers: 0,
