@@ -75,7 +75,7 @@ use crate::region::{
 };
 use crate::toolpaths::overhang::DEFAULT_OVERHANG_SPEEDS;
 use crate::toolpaths::{
-    OrderParams, OverhangParams, ProgramParams, RoleSpeeds, SeamRule, ToolPathParams,
+    OrderParams, OverhangParams, ProgramParams, RoleSpeeds, SeamRule, ToolPathParams, TravelParams,
 };
 
 /// Fastest speed of any move, mm/s: the fastest FFF printers travel at about 1000 mm/s; a
@@ -1028,6 +1028,12 @@ impl Config {
             },
             seam_gap: s.seam_gap * s.nozzle_diameter,
             overhang: self.overhang_params(),
+            travel: TravelParams {
+                only_retract_when_crossing_perimeters: self
+                    .printer
+                    .only_retract_when_crossing_perimeters,
+                min_length: self.printer.retract_before_travel,
+            },
             ..ProgramParams::default()
         }
     }

@@ -15,7 +15,9 @@
 //!   `bed_temperature`, `first_layer_bed_temperature`, `retract_length`, `retract_speed`,
 //!   `deretract_speed`, `retract_before_travel`, `retract_lift`, `travel_speed`,
 //!   `machine_max_acceleration_extruding` (or `default_acceleration`),
-//!   `use_relative_e_distances`, `use_firmware_retraction`, `min_fan_speed`, `max_fan_speed`,
+//!   `use_relative_e_distances`, `use_firmware_retraction`,
+//!   `only_retract_when_crossing_perimeters` (when the file states it; conduit's default, on,
+//!   stays otherwise), `min_fan_speed`, `max_fan_speed`,
 //!   `disable_fan_first_layers`, `slowdown_below_layer_time`, `fan_below_layer_time`,
 //!   `min_print_speed`;
 //! - tools: the comma-separated lists give one value per extruder: `nozzle_diameter`,
@@ -400,6 +402,10 @@ const RULES: &[(&str, Rule)] = &[
     (
         "use_firmware_retraction",
         Rule::Flag(|c| &mut c.printer.use_firmware_retraction),
+    ),
+    (
+        "only_retract_when_crossing_perimeters",
+        Rule::Flag(|c| &mut c.printer.only_retract_when_crossing_perimeters),
     ),
     // Slicing.
     ("layer_height", Rule::Num(|c| &mut c.slice.layer_height)),

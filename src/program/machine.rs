@@ -73,6 +73,12 @@ pub struct Printer {
     pub deretract_speed: f64,
     /// Travels shorter than this do not retract, mm. Default 2.
     pub retract_before_travel: f64,
+    /// Retract only for travels that cross a perimeter or leave the internal infill: a travel
+    /// that stays inside an island's sparse or internal solid infill does not retract, however
+    /// long, since what oozes there is covered by the next layers (PrusaSlicer's
+    /// `only_retract_when_crossing_perimeters`, stricter: the travel must not touch a
+    /// perimeter). Travels over top, bottom and bridge surfaces still retract. Default true.
+    pub only_retract_when_crossing_perimeters: bool,
     /// Z lift (z-hop) during retracted travels, mm; 0 = none. Default 0.
     pub retract_lift: f64,
     /// Speed of non-printing moves, mm/s. Default 130.
@@ -218,6 +224,7 @@ impl Default for Printer {
             retract_speed: 35.0,
             deretract_speed: 0.0,
             retract_before_travel: 2.0,
+            only_retract_when_crossing_perimeters: true,
             retract_lift: 0.0,
             travel_speed: 130.0,
             max_acceleration: 1000.0,

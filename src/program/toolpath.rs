@@ -362,6 +362,11 @@ pub enum Event {
         /// path's ends.
         lead_time: f64,
     },
+    /// The travel to the next path stays inside the part's internal infill, clear of every
+    /// perimeter and of top, bottom and bridge surfaces: the writer does not retract for it,
+    /// however long (`printer.only_retract_when_crossing_perimeters`; the toolpaths stage
+    /// decides, see `toolpaths::travel`). Only the next travel is concerned.
+    TravelInsideInfill,
 }
 
 /// One entry of a layer, in print order.

@@ -30,6 +30,8 @@
 //! - **Overhangs.** Perimeter paths are cut where their bead hangs out over the layer below
 //!   by another degree, each piece at its degree's speed and role, and runs of bridges and
 //!   overhangs get the bridge fan ([`super::overhang`]).
+//! - **Travels.** A travel between two paths of an island that stays inside its internal
+//!   infill is marked so that the writer does not retract for it ([`super::travel`]).
 //! - **Speeds and widths.** Per tool ([`ToolPathParams`]): perimeters keep the width the
 //!   regions stage gave each loop; infill and skirt take the tool's widths; every path on the
 //!   program's first layer is printed at `first_layer_speed`.
@@ -41,6 +43,7 @@ use std::collections::BTreeMap;
 
 use super::order::{Group, OrderParams, order_groups};
 use super::overhang::{OverhangParams, split_paths, with_fan_events};
+use super::travel::{InsideArea, TravelParams, mark_inside_travels};
 use crate::geom::{Point2, Point3, Polygon, scaled, segment_distance2, unscaled};
 use crate::program::extrusion::BeadShape;
 use crate::program::{Event, Layer, LayerExtras, LayerInsert, LayerItem, Program, Role, Toolpath};
@@ -181,6 +184,8 @@ pub struct ProgramParams {
     pub seam_gap: f64,
     /// Perimeters over air and the bridge fan ([`super::overhang`]).
     pub overhang: OverhangParams,
+    /// Which travels need no retraction ([`super::travel`]).
+    pub travel: TravelParams,
 }
 
 impl Default for ProgramParams {
@@ -192,6 +197,7 @@ impl Default for ProgramParams {
             resolution: DEFAULT_RESOLUTION_MM,
             seam_gap: 0.0,
             overhang: OverhangParams::default(),
+            travel: TravelParams::default(),
         }
     }
 }
@@ -608,7 +614,16 @@ pub fn build_program_with(
             }
             current_tool = Some(tool);
             pos = end;
-            items.extend(with_fan_events(paths));
+            let inside = if params.travel.only_retract_when_crossing_perimeters {
+                InsideArea::new(entries.iter().filter(|e| e.tool == tool).map(|e| e.regions))
+            } else {
+                InsideArea::default()
+            };
+            items.extend(mark_inside_travels(
+                with_fan_events(paths),
+                &inside,
+                &params.travel,
+            ));
         }
         if let Some(extra) = extras.paths_after.get(&z_key) {
             let mut extra_tools: Vec<usize> = extra.iter().map(|p| p.tool).collect();

@@ -9,13 +9,16 @@
 //! - [`build`]: regions → Program ([`build_program`], [`build_program_with`]).
 //! - [`order`]: travel ordering (nearest neighbour, then 2-opt / or-opt, deterministic).
 //! - [`overhang`]: perimeters cut by overhang degree (speed, role, fan), bridges' fan.
+//! - [`travel`]: the travels inside the internal infill, which need no retraction.
 
 pub mod build;
 pub mod order;
 pub mod overhang;
+pub mod travel;
 
 pub use build::{
     ObjectLayers, ProgramParams, RoleSpeeds, ToolPathParams, build_program, build_program_with,
 };
 pub use order::{Group, OrderParams, SeamRule, order_groups, order_paths, travel_length};
 pub use overhang::OverhangParams;
+pub use travel::TravelParams;

@@ -32,7 +32,9 @@
 //!   raises it for the paths after it (bridges and overhangs) to its speed if that is higher,
 //!   and returns it to the layer's; not on the layers with the fan off.
 //! - Per path: a travel (`G1 X Y F<travel>`; longer than `retract_before_travel`: retract
-//!   first, and with `retract_lift > 0` a z-hop up before and back down after), un-retract,
+//!   first, and with `retract_lift > 0` a z-hop up before and back down after — except after
+//!   an [`crate::program::Event::TravelInsideInfill`], a travel inside the internal infill,
+//!   which never retracts), un-retract,
 //!   `;TYPE:<role>` and `;WIDTH:<w>` when they change (`;HEIGHT:` too, within a layer), `G1 F`
 //!   when the speed changes, then `G1 X Y [Z] E` moves (a closed path returns to its start).
 //!   Filament tools: `E = length × bead area / filament area × extrusion_multiplier`

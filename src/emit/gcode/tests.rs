@@ -213,6 +213,48 @@ fn one_layer_square_header_markers_extrusion_retraction_and_zhop() {
     assert!(retracted);
 }
 
+#[test]
+fn a_travel_marked_inside_the_infill_does_not_retract_or_lift() {
+    let cfg = test_config();
+    let z = 0.2;
+    let line = |y: f64| {
+        LayerItem::Path(path(
+            &[(10.0, y), (30.0, y)],
+            z,
+            false,
+            Role::SparseInfill,
+            0,
+        ))
+    };
+    // Three infill lines 20 mm long, each travel back 20 mm: the second travel is marked.
+    let program = Program {
+        layers: vec![Layer {
+            index: 0,
+            z,
+            height: 0.2,
+            items: vec![
+                line(10.0),
+                line(12.0),
+                LayerItem::Event(Event::TravelInsideInfill),
+                line(14.0),
+            ],
+        }],
+    };
+    let (_, moves) = replay(&write(&program, &cfg).0);
+    let travels: Vec<&Move> = moves
+        .iter()
+        .filter(|m| m.moves_xy() && m.de == 0.0)
+        .skip(1)
+        .collect();
+    assert_eq!(travels.len(), 2);
+    // The unmarked travel was lifted (0.4 mm) after a retraction, the marked one was not.
+    assert!((travels[0].to[2] - 0.6).abs() < 1e-9);
+    assert!((travels[1].to[2] - 0.2).abs() < 1e-9);
+    // One retraction before the end's: the unmarked travel's.
+    let retractions = moves.iter().filter(|m| !m.moves_xy() && m.de < 0.0).count();
+    assert_eq!(retractions, 2);
+}
+
 /// Two filament tools; tool 0 has a standby temperature, tool 1 an offset.
 fn two_tool_config() -> GcodeParams {
     let mut cfg = test_config();

@@ -126,6 +126,9 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     layer_fan: f64,
     /// Position, carried `E` and totals of a switched-tool job.
     switch: switched::SwitchState,
+    /// The next travel stays inside the internal infill ([`Event::TravelInsideInfill`]): no
+    /// retraction for it.
+    travel_inside: bool,
 }
 
 impl<'a, S: GcodeSink> Writer<'a, S> {
@@ -199,6 +202,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             fan: None,
             layer_fan: 0.0,
             switch: switched::SwitchState::default(),
+            travel_inside: false,
         })
     }
 
@@ -520,8 +524,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
     }
 
     /// Travels to `target` (machine coordinates): retract and z-hop when the travel is longer
-    /// than `retract_before_travel`.
+    /// than `retract_before_travel`, unless an [`Event::TravelInsideInfill`] came before it.
     fn travel_to(&mut self, target: Point3) {
+        let inside = std::mem::take(&mut self.travel_inside);
         let speed = self.cfg.printer.travel_speed;
         let Some(cur) = self.pos else {
             // Position unknown (after the start G-code or a part placement). Above the target:
@@ -558,7 +563,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             self.pos = Some(target);
             return;
         }
-        let long = distance > self.cfg.printer.retract_before_travel;
+        let long = distance > self.cfg.printer.retract_before_travel && !inside;
         if long {
             self.retract();
         }
@@ -1093,6 +1098,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             }
             Event::Switch { on, .. } => self.switch_snippet(*on),
             Event::PartFan { at_least } => self.part_fan(*at_least),
+            Event::TravelInsideInfill => self.travel_inside = true,
             Event::Dwell { seconds } => {
                 if seconds.is_finite() && *seconds > 0.0 {
                     // Its time counts as the line is written (see `plan_command`).
