@@ -133,22 +133,24 @@ fn depth_by(x: f64, y: f64, corner: fn(f64, f64) -> f64) -> f64 {
     d
 }
 
+/// Where the slicer put the plate: its outer wall's lower-left corner, less half a bead.
+fn plate_origin(moves: &[Move]) -> (f64, f64) {
+    let half_bead = 0.225;
+    let lo = |k: usize| {
+        moves
+            .iter()
+            .filter(|m| m.extruding && role(m) == "External perimeter")
+            .flat_map(|m| [xyz(m.from)[k], xyz(m.to)[k]])
+            .fold(f64::INFINITY, f64::min)
+    };
+    (lo(0) - half_bead, lo(1) - half_bead)
+}
+
 #[test]
 fn a_plate_with_holes_prints_hole_by_hole_with_joined_infill_and_few_retractions() {
     let dir = temp_dir();
     let all = slice_plate(dir.path(), &[]);
-    // Where the slicer put the plate: its outer wall's lower-left corner, less half a bead.
-    let ext: Vec<&Move> = all
-        .iter()
-        .filter(|m| m.extruding && role(m) == "External perimeter")
-        .collect();
-    let lo = |k: usize| {
-        ext.iter()
-            .flat_map(|m| [xyz(m.from)[k], xyz(m.to)[k]])
-            .fold(f64::INFINITY, f64::min)
-    };
-    let half_bead = 0.225;
-    let (ox, oy) = (lo(0) - half_bead, lo(1) - half_bead);
+    let (ox, oy) = plate_origin(&all);
     let depth = |p: [f64; 3]| depth_in_material(p[0] - ox, p[1] - oy);
 
     // Before infill was joined along the boundary and loops were printed hole by hole, this
@@ -255,16 +257,7 @@ fn xy_length(m: &Move) -> f64 {
 fn travels_inside_the_infill_do_not_retract_and_travels_across_perimeters_do() {
     let dir = temp_dir();
     let on = slice_plate(dir.path(), &[]);
-    let ext: Vec<&Move> = on
-        .iter()
-        .filter(|m| m.extruding && role(m) == "External perimeter")
-        .collect();
-    let lo = |k: usize| {
-        ext.iter()
-            .flat_map(|m| [xyz(m.from)[k], xyz(m.to)[k]])
-            .fold(f64::INFINITY, f64::min)
-    };
-    let (ox, oy) = (lo(0) - 0.225, lo(1) - 0.225);
+    let (ox, oy) = plate_origin(&on);
     // Least depth in the material along a travel by `depth`, sampled every 20 µm.
     let least_depth = |m: &Move, depth: fn(f64, f64) -> f64| {
         let (a, b) = (xyz(m.from), xyz(m.to));

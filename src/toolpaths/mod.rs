@@ -16,6 +16,16 @@ pub mod order;
 pub mod overhang;
 pub mod travel;
 
+use crate::geom::Point2;
+
+/// The box around `points`, nm: `[min_x, min_y, max_x, max_y]` (an empty box, which holds no
+/// point, for none).
+fn bounds<'a>(points: impl Iterator<Item = &'a Point2>) -> [i64; 4] {
+    points.fold([i64::MAX, i64::MAX, i64::MIN, i64::MIN], |b, p| {
+        [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)]
+    })
+}
+
 pub use build::{
     ObjectLayers, ProgramParams, RoleSpeeds, ToolPathParams, build_program, build_program_with,
 };

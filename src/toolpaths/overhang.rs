@@ -135,12 +135,6 @@ struct WidthZones {
     bounds: [i64; 4],
 }
 
-fn bounds<'a>(points: impl Iterator<Item = &'a Point2>) -> [i64; 4] {
-    points.fold([i64::MAX, i64::MAX, i64::MIN, i64::MIN], |b, p| {
-        [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)]
-    })
-}
-
 fn gather(zones: &[&OverhangZones]) -> Vec<WidthZones> {
     let mut out: Vec<WidthZones> = Vec::new();
     for z in zones.iter().filter(|z| !z.is_empty()) {
@@ -159,7 +153,7 @@ fn gather(zones: &[&OverhangZones]) -> Vec<WidthZones> {
         for (k, zone) in z.zones.iter().enumerate().take(ZONES) {
             w.zones[k].extend(zone.iter().cloned());
         }
-        let b = bounds(z.zones[0].iter().flat_map(|ex| ex.contour.points.iter()));
+        let b = super::bounds(z.zones[0].iter().flat_map(|ex| ex.contour.points.iter()));
         w.bounds = [
             w.bounds[0].min(b[0]),
             w.bounds[1].min(b[1]),
@@ -281,7 +275,7 @@ pub fn split_paths(
             .iter()
             .map(|p| Point2::new(scaled(p.x), scaled(p.y)))
             .collect();
-        let b = bounds(line.iter());
+        let b = super::bounds(line.iter());
         if b[2] < w.bounds[0] || b[0] > w.bounds[2] || b[3] < w.bounds[1] || b[1] > w.bounds[3] {
             out.push((path, None));
             continue;

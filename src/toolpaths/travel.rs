@@ -54,7 +54,7 @@ impl Default for TravelParams {
 /// [`EDGE_TOLERANCE_MM`], with each piece's bounding box for a quick first test.
 #[derive(Debug, Clone, Default)]
 pub struct InsideArea {
-    pieces: Vec<(ExPolygon, [Point2; 2])>,
+    pieces: Vec<(ExPolygon, [i64; 4])>,
 }
 
 impl InsideArea {
@@ -76,7 +76,10 @@ impl InsideArea {
         let grown = offset(&union(&parts), EDGE_TOLERANCE_MM, Join::Miter(2.0));
         let pieces = grown
             .into_iter()
-            .filter_map(|e| bounds(&e.contour).map(|b| (e, b)))
+            .map(|e| {
+                let b = super::bounds(e.contour.points.iter());
+                (e, b)
+            })
             .collect();
         Self { pieces }
     }
@@ -90,8 +93,8 @@ impl InsideArea {
     /// piece and the segment touching none of its edges (a segment that grazes an edge counts
     /// as leaving).
     pub fn contains_segment(&self, a: Point2, b: Point2) -> bool {
-        self.pieces.iter().any(|(e, [lo, hi])| {
-            let within = |p: Point2| p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y;
+        self.pieces.iter().any(|(e, bx)| {
+            let within = |p: Point2| p.x >= bx[0] && p.x <= bx[2] && p.y >= bx[1] && p.y <= bx[3];
             within(a)
                 && within(b)
                 && e.contains(a)
@@ -101,17 +104,6 @@ impl InsideArea {
                     .all(|ring| !touches_ring(a, b, ring))
         })
     }
-}
-
-/// Lower-left and upper-right corners of `ring`'s bounding box; `None` for an empty ring.
-fn bounds(ring: &Polygon) -> Option<[Point2; 2]> {
-    let first = *ring.points.first()?;
-    Some(ring.points.iter().fold([first, first], |[lo, hi], p| {
-        [
-            Point2::new(lo.x.min(p.x), lo.y.min(p.y)),
-            Point2::new(hi.x.max(p.x), hi.y.max(p.y)),
-        ]
-    }))
 }
 
 /// Sign of the turn `p → q → r`: 1 left, -1 right, 0 collinear (exact).
@@ -190,15 +182,7 @@ pub fn mark_inside_travels(
 mod tests {
     use super::*;
     use crate::program::{Role, Toolpath};
-
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Polygon {
-        Polygon::new(vec![
-            Point2::from_mm(x0, y0),
-            Point2::from_mm(x1, y0),
-            Point2::from_mm(x1, y1),
-            Point2::from_mm(x0, y1),
-        ])
-    }
+    use crate::region::test_util::rect;
 
     /// A 20 mm square with a 4 mm square hole in the middle, as the area itself (not grown).
     fn holed_square() -> InsideArea {
@@ -208,7 +192,7 @@ mod tests {
             contour: rect(0.0, 0.0, 20.0, 20.0),
             holes: vec![hole],
         };
-        let b = bounds(&e.contour).expect("a ring");
+        let b = crate::toolpaths::bounds(e.contour.points.iter());
         InsideArea {
             pieces: vec![(e, b)],
         }
@@ -250,9 +234,8 @@ mod tests {
         assert_eq!(middle.pieces.len(), 1);
         let sparse = &r[4].skins.sparse[0];
         let grown = middle.pieces[0].0.area_mm2() - sparse.area_mm2();
-        let perimeter = bounds(&sparse.contour).map_or(0.0, |[lo, hi]| {
-            2.0 * crate::geom::unscaled(hi.x - lo.x + hi.y - lo.y)
-        });
+        let b = crate::toolpaths::bounds(sparse.contour.points.iter());
+        let perimeter = 2.0 * crate::geom::unscaled(b[2] - b[0] + b[3] - b[1]);
         // A band EDGE_TOLERANCE_MM wide around the sparse area (its corners add a few µm²).
         assert!(
             (grown - perimeter * EDGE_TOLERANCE_MM).abs() < 0.02,
