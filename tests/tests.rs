@@ -44,3 +44,4 @@ mod support;
 mod thin_walls;
 mod three_de;
 mod view;
+mod wipe_tower;

@@ -76,6 +76,11 @@ const SECTION_DOCS: &[(&str, &str)] = &[
          get columns, the gaps that make them removable, interface layers and patterns. \
          Lengths mm, angles degrees.",
     ),
+    (
+        "wipe_tower",
+        "The wipe tower of multi-tool prints: a block beside the objects where each filament \
+         tool purges after a tool change. Lengths mm, volumes mm³.",
+    ),
 ];
 
 /// The default configuration ([`Config::default`]) as a TOML document with every key, its

@@ -115,6 +115,8 @@ pub struct Config {
     pub compensate: CompensateSettings,
     /// Support material, when `slice.support_material` is on (`[support]`).
     pub support: SupportParams,
+    /// The wipe tower of multi-tool prints (`[wipe_tower]`).
+    pub wipe_tower: crate::toolpaths::TowerParams,
 }
 
 /// Pattern of solid (top and bottom) infill.
@@ -383,6 +385,7 @@ impl Default for Config {
             robot: RobotSettings::default(),
             compensate: CompensateSettings::default(),
             support: SupportParams::default(),
+            wipe_tower: crate::toolpaths::TowerParams::default(),
         }
     }
 }
@@ -808,6 +811,7 @@ impl Config {
             }
         }
         problems.extend(self.support.problems());
+        problems.extend(self.wipe_tower.problems());
         for (key, v) in [
             ("printer.bed_temperature", p.bed_temperature),
             (
@@ -1035,6 +1039,27 @@ impl Config {
                 min_length: self.printer.retract_before_travel,
             },
             ..ProgramParams::default()
+        }
+    }
+
+    /// What the wipe tower pass needs of the machine: the bed, which tools are filament tools,
+    /// their bead width on the tower (`slice.infill_width`) and the first layer's speed.
+    pub fn tower_machine(&self) -> crate::toolpaths::TowerMachine {
+        let p = &self.printer;
+        crate::toolpaths::TowerMachine {
+            bed: [
+                p.bed_origin[0],
+                p.bed_origin[1],
+                p.bed_origin[0] + p.bed_size[0],
+                p.bed_origin[1] + p.bed_size[1],
+            ],
+            filament: self
+                .tools
+                .iter()
+                .map(|t| t.kind == ToolKind::Filament)
+                .collect(),
+            width: vec![self.slice.infill_width; self.tools.len()],
+            first_layer_speed: self.slice.first_layer_speed.min(p.max_print_speed),
         }
     }
 

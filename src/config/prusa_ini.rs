@@ -53,6 +53,9 @@
 //!   warning),
 //!   `support_material_angle`, `support_material_buildplate_only`,
 //!   `support_material_with_sheath`;
+//! - wipe tower (`[wipe_tower]`): `wipe_tower`, `wipe_tower_x`, `wipe_tower_y` (its front-left
+//!   corner), `wipe_tower_width`, `wipe_tower_bridging` → `sparse_spacing`,
+//!   `wiping_volumes_matrix` (its largest entry → `purge_volume`);
 //! - widths: `extrusion_width` and `first_layer_`, `perimeter_`, `external_perimeter_`,
 //!   `infill_`, `solid_infill_`, `top_infill_extrusion_width`. A value is mm or `%` of the first
 //!   nozzle diameter. 0 (or a missing key) falls back to `extrusion_width`, and when that is 0 too to PrusaSlicer's
@@ -587,6 +590,16 @@ const RULES: &[(&str, Rule)] = &[
         "support_material_with_sheath",
         Rule::Flag(|c| &mut c.support.sheath),
     ),
+    // Wipe tower.
+    ("wipe_tower", Rule::Flag(|c| &mut c.wipe_tower.enabled)),
+    ("wipe_tower_x", Rule::Custom(wipe_tower_corner)),
+    ("wipe_tower_y", Rule::Custom(wipe_tower_corner)),
+    ("wipe_tower_width", Rule::Num(|c| &mut c.wipe_tower.width)),
+    (
+        "wipe_tower_bridging",
+        Rule::Num(|c| &mut c.wipe_tower.sparse_spacing),
+    ),
+    ("wiping_volumes_matrix", Rule::Custom(wiping_volumes)),
 ];
 
 /// Role widths: key, automatic width (× nozzle) and field. Read after `extrusion_width`.
@@ -1019,6 +1032,40 @@ fn brim_type(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     Ok(())
 }
 
+/// `wipe_tower_x` / `wipe_tower_y`: the tower's front-left corner (PrusaSlicer's position of
+/// the unrotated tower).
+fn wipe_tower_corner(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    if let Some(v) = imp.p.num(key)? {
+        let tower = &mut imp.cfg.wipe_tower;
+        if key == "wipe_tower_x" {
+            tower.x = Some(v);
+        } else {
+            tower.y = Some(v);
+        }
+    }
+    Ok(())
+}
+
+/// `wiping_volumes_matrix`: mm³ purged from each extruder to each other, row by row. conduit
+/// purges one volume after every change: the largest of the matrix, so that no change purges
+/// less than PrusaSlicer's.
+fn wiping_volumes(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
+    let Some(raw) = imp.p.raw(key).map(str::to_owned) else {
+        return Ok(());
+    };
+    let mut largest: Option<f64> = None;
+    for v in raw.split(',').map(str::trim).filter(|v| !v.is_empty()) {
+        let v: f64 = v
+            .parse()
+            .map_err(|_| imp.p.err(key, "expected numbers separated by commas"))?;
+        largest = Some(largest.map_or(v, |l: f64| l.max(v)));
+    }
+    if let Some(v) = largest {
+        imp.cfg.wipe_tower.purge_volume = v;
+    }
+    Ok(())
+}
+
 /// `support_material_speed`: the support's speed, and the skirt's (PrusaSlicer prints skirt
 /// and brim at the support speed); a `%` is of the perimeter speed.
 fn support_speed(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
@@ -1139,7 +1186,6 @@ const CHANGES_THE_PRINT: &[(&str, Option<&[&str]>)] = &[
     ("support_material_style", Some(&["grid"])),
     ("thick_bridges", Some(&["0"])),
     ("top_solid_min_thickness", Some(&["0"])),
-    ("wipe_tower", Some(&["0"])),
     ("xy_size_compensation", Some(&["0"])),
     ("z_offset", Some(&["0"])),
 ];
@@ -1331,6 +1377,34 @@ mod tests {
         );
         let (thin, _) = from_ini_str("perimeter_generator = classic\nthin_walls = 1\n")?;
         assert!(thin.slice.thin_walls);
+        Ok(())
+    }
+
+    /// The wipe tower's keys as PrusaSlicer 2.5 saves them (`prusa-slicer --wipe-tower
+    /// --wipe-tower-x 170 --wipe-tower-y 40 --wipe-tower-width 50 --wipe-tower-bridging 8
+    /// --wiping-volumes-matrix 0,120,90,0 --save p.ini`).
+    #[test]
+    fn wipe_tower_keys_map() -> Result<(), ConfigError> {
+        let (cfg, warnings) = from_ini_str(
+            "wipe_tower = 1\nwipe_tower_bridging = 8\nwipe_tower_brim_width = 2\n\
+             wipe_tower_no_sparse_layers = 0\nwipe_tower_rotation_angle = 0\n\
+             wipe_tower_width = 50\nwipe_tower_x = 170\nwipe_tower_y = 40\n\
+             wiping_volumes_extruders = 70,70,70,70,70,70,70,70,70,70\n\
+             wiping_volumes_matrix = 0,120,90,0\n",
+        )?;
+        let t = &cfg.wipe_tower;
+        assert!(t.enabled);
+        assert_eq!((t.x, t.y), (Some(170.0), Some(40.0)));
+        assert_eq!(
+            (t.width, t.sparse_spacing, t.purge_volume),
+            (50.0, 8.0, 120.0)
+        );
+        // The keys conduit has no use for are named as ignored; the mapped ones are not.
+        let ignored = warnings.join("\n");
+        assert!(ignored.contains("wipe_tower_brim_width"), "{ignored}");
+        assert!(!ignored.contains("wipe_tower_width"), "{ignored}");
+        let (off, _) = from_ini_str("layer_height = 0.2\n")?;
+        assert_eq!(off.wipe_tower, crate::toolpaths::TowerParams::default());
         Ok(())
     }
 

@@ -121,6 +121,9 @@ pub enum PipelineError {
     /// A curved-layer (clfff) print cannot be planned.
     #[error(transparent)]
     Clfff(#[from] crate::curved::clfff::ClfffError),
+    /// The wipe tower has no place.
+    #[error(transparent)]
+    WipeTower(#[from] crate::toolpaths::TowerError),
     /// Slicing left nothing to print: no layer has an extrusion (a mesh without volume, such
     /// as loose or duplicated triangles, or objects thinner than a line).
     ///
@@ -175,6 +178,9 @@ pub struct SliceSummary {
     /// Curved top regions and rejections, with `curved.mode = "tops"`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub curved: Option<crate::curved::CurvedReport>,
+    /// The wipe tower, when one was built (`[wipe_tower]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wipe_tower: Option<crate::toolpaths::TowerSummary>,
     /// The placed parts (bed coordinates), when a circuit was given: what the pick-and-place
     /// files list.
     #[serde(skip)]
@@ -596,13 +602,15 @@ pub fn slice_scene_watched(
     laps.lap(Stage::Regions);
 
     progress(Stage::Program);
-    let program = build_program_with(&objects, &extras, &cfg.program_params());
+    let mut program = build_program_with(&objects, &extras, &cfg.program_params());
     drop(objects);
     if program.layers.iter().all(|l| l.paths().next().is_none()) {
         return Err(PipelineError::NothingToPrint {
             dropped: summaries.iter().map(|o| o.slice.open_chains_dropped).sum(),
         });
     }
+    let wipe_tower =
+        crate::toolpaths::add_wipe_tower(&mut program, &cfg.wipe_tower, &cfg.tower_machine())?;
     laps.lap(Stage::Program);
 
     progress(Stage::Emit);
@@ -623,6 +631,7 @@ pub fn slice_scene_watched(
         stage_seconds: laps.times,
         electronics: report,
         curved,
+        wipe_tower,
         parts,
     };
     Ok((gcode, program, summary))

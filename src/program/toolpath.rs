@@ -47,13 +47,16 @@ pub enum Role {
     JetWall,
     /// An aerosol-jet line of a fill (contour-parallel loops or a serpentine).
     JetFill,
+    /// The wipe tower: where a tool just selected purges, and the tower's walls and sparse
+    /// layers.
+    WipeTower,
     /// Anything else (custom G-code, imported paths).
     Custom,
 }
 
 impl Role {
     /// Every role, in declaration order.
-    pub const ALL: [Role; 19] = [
+    pub const ALL: [Role; 20] = [
         Role::ExternalPerimeter,
         Role::Perimeter,
         Role::OverhangPerimeter,
@@ -72,6 +75,7 @@ impl Role {
         Role::ConductiveDrop,
         Role::JetWall,
         Role::JetFill,
+        Role::WipeTower,
         Role::Custom,
     ];
 
@@ -101,6 +105,7 @@ impl Role {
             Role::ConductiveDrop => "Conductive drop",
             Role::JetWall => "Jet wall",
             Role::JetFill => "Jet fill",
+            Role::WipeTower => "Wipe tower",
             Role::Custom => "Custom",
         }
     }

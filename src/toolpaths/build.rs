@@ -116,7 +116,9 @@ impl RoleSpeeds {
             Role::BridgeInfill | Role::OverhangPerimeter => self.bridge,
             Role::GapFill => self.gap_fill,
             Role::TopSolidInfill => self.top_solid_infill,
-            Role::SparseInfill | Role::Scaffold | Role::Buffer => self.sparse_infill,
+            Role::SparseInfill | Role::Scaffold | Role::Buffer | Role::WipeTower => {
+                self.sparse_infill
+            }
             Role::Skirt => self.skirt,
             Role::Support => self.support,
             Role::SupportInterface => self.support_interface,

@@ -10,10 +10,13 @@
 //! - [`order`]: travel ordering (nearest neighbour, then 2-opt / or-opt, deterministic).
 //! - [`overhang`]: perimeters cut by overhang degree (speed, role, fan), bridges' fan.
 //! - [`travel`]: the travels inside the internal infill, which need no retraction.
+//! - [`tower`]: the wipe tower, where a tool just selected purges (a pass over the built
+//!   Program).
 
 pub mod build;
 pub mod order;
 pub mod overhang;
+pub mod tower;
 pub mod travel;
 
 use crate::geom::Point2;
@@ -31,4 +34,5 @@ pub use build::{
 };
 pub use order::{Group, OrderParams, SeamRule, order_groups, order_paths, travel_length};
 pub use overhang::OverhangParams;
+pub use tower::{TowerError, TowerMachine, TowerParams, TowerSummary, add_wipe_tower};
 pub use travel::TravelParams;

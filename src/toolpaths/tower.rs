@@ -1,0 +1,833 @@
+//! The wipe tower: a block beside the objects where each filament tool, just selected, purges
+//! the material that oozed or cooled in its nozzle while it stood by, before it prints on the
+//! part.
+//!
+//! Place in the pipeline: a pass over the built [`Program`] (after [`super::build`], before the
+//! writer), run when `[wipe_tower]` is enabled and the program changes tools. It adds paths of
+//! [`Role::WipeTower`] and changes nothing else.
+//!
+//! # The tower
+//!
+//! A rectangle `width` (along X) by `depth` (along Y), standing on the bed from the first layer
+//! to the last layer with a tool change (PrusaSlicer's wipe tower, with its keys and defaults).
+//! Its depth is the largest purge any layer needs: the sum of that layer's bands (below) over
+//! the width, never less than [`MIN_DEPTH_MM`].
+//!
+//! On every layer of the tower:
+//! - **Purge bands.** Right after each change to a filament tool, the new tool fills a band of
+//!   the rectangle with lines along X, one bead apart, until it has laid `purge_volume` mm³
+//!   (rounded up to whole lines). The bands of one layer lie one after the other from the front.
+//! - **The loop.** The first tool to print on the tower on a layer first lays one loop round
+//!   the whole rectangle: it anchors the line ends and walls the tower in.
+//! - **The rest.** What the bands leave of the rectangle gets lines along Y every
+//!   `sparse_spacing` mm, by the last tool that purged (or, on a layer without a change, by the
+//!   active tool at the layer's start): the next layer's purge lines, along X, bridge them. The
+//!   rest's lines stand at the same X on every layer, so they stack into walls.
+//! - **The first layer** is solid: the rest is filled one bead apart too, for adhesion.
+//!
+//! Paste tools are not purged (their flow is switched, not oozing plastic); a change to one adds
+//! nothing to the tower. A layer whose only tool is a paste tool gets no tower layer either
+//! (the tower's lines above it then bridge one more layer height), and the count of such layers
+//! is reported.
+//!
+//! # Where it stands
+//!
+//! At `x`, `y` (its front-left corner) when both are given, else beside the objects: right of
+//! them, behind, left or in front, the first of those that fits on the bed [`GAP_MM`] clear of
+//! every path of the program. A tower that overlaps the objects' paths (within [`MIN_GAP_MM`])
+//! or leaves the bed is an error.
+
+use serde::{Deserialize, Serialize};
+
+use crate::geom::Point3;
+use crate::program::{Event, LayerItem, Program, Role, Toolpath};
+
+/// Smallest depth of the tower, mm: a narrow tower tips over.
+pub const MIN_DEPTH_MM: f64 = 5.0;
+/// Clear gap between the objects' paths and a tower placed automatically, mm.
+pub const GAP_MM: f64 = 5.0;
+/// Smallest clear gap between the objects' paths and a tower placed at `x`, `y`, mm.
+pub const MIN_GAP_MM: f64 = 1.0;
+
+/// How the wipe tower is built (`[wipe_tower]` in the config, whose keys these are). Lengths
+/// in mm.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+pub struct TowerParams {
+    /// Build a wipe tower when the print changes tools. Default false.
+    pub enabled: bool,
+    /// X of the tower's front-left corner on the bed. Default absent: the tower is placed
+    /// beside the objects (set `x` and `y` together).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(example = 180.0)]
+    pub x: Option<f64>,
+    /// Y of the tower's front-left corner on the bed. Default absent (see `x`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(example = 140.0)]
+    pub y: Option<f64>,
+    /// Size along X, 5 to 300. Default 60 (PrusaSlicer's `wipe_tower_width`).
+    pub width: f64,
+    /// Plastic purged on the tower after each change to a filament tool, mm³, 0 to 10000.
+    /// Default 140 (PrusaSlicer's default wiping volume).
+    pub purge_volume: f64,
+    /// Gap between the lines of the tower's sparse part, 1 to 50. Default 10 (PrusaSlicer's
+    /// `wipe_tower_bridging`).
+    pub sparse_spacing: f64,
+    /// Print speed on the tower, mm/s (the first layer at `slice.first_layer_speed`).
+    /// Default 40.
+    pub speed: f64,
+}
+
+impl Default for TowerParams {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            x: None,
+            y: None,
+            width: 60.0,
+            purge_volume: 140.0,
+            sparse_spacing: 10.0,
+            speed: 40.0,
+        }
+    }
+}
+
+impl TowerParams {
+    /// What is wrong with the settings, one message each (empty when they are usable).
+    pub fn problems(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (name, v, lo, hi) in [
+            ("width", self.width, 5.0, 300.0),
+            ("purge_volume", self.purge_volume, 0.0, 10_000.0),
+            ("sparse_spacing", self.sparse_spacing, 1.0, 50.0),
+            ("speed", self.speed, 1.0, 1000.0),
+        ] {
+            if !(v.is_finite() && (lo..=hi).contains(&v)) {
+                out.push(format!(
+                    "wipe_tower.{name} must be between {lo} and {hi}, got {v}"
+                ));
+            }
+        }
+        for (name, v) in [("x", self.x), ("y", self.y)] {
+            if v.is_some_and(|v| !v.is_finite()) {
+                out.push(format!("wipe_tower.{name} must be a finite number"));
+            }
+        }
+        if self.x.is_some() != self.y.is_some() {
+            out.push("wipe_tower.x and wipe_tower.y are set together or not at all".to_owned());
+        }
+        out
+    }
+}
+
+/// What the pass needs besides the [`TowerParams`]: the machine and the tools.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TowerMachine {
+    /// The bed: `[min x, min y, max x, max y]`, mm.
+    pub bed: [f64; 4],
+    /// Per tool: whether it is a filament tool (purged on the tower).
+    pub filament: Vec<bool>,
+    /// Per tool: the bead width on the tower, mm.
+    pub width: Vec<f64>,
+    /// Speed of the tower's first layer, mm/s.
+    pub first_layer_speed: f64,
+}
+
+impl TowerMachine {
+    fn is_filament(&self, tool: usize) -> bool {
+        self.filament.get(tool).copied().unwrap_or(false)
+    }
+
+    fn bead(&self, tool: usize) -> f64 {
+        self.width.get(tool).copied().unwrap_or(0.45)
+    }
+}
+
+/// The tower as built, for the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TowerSummary {
+    /// Front-left corner, mm.
+    pub x: f64,
+    /// Front-left corner, mm.
+    pub y: f64,
+    /// Size along X, mm.
+    pub width: f64,
+    /// Size along Y, mm.
+    pub depth: f64,
+    /// Layers of the tower (from the first).
+    pub layers: usize,
+    /// Purges made (changes to a filament tool).
+    pub purges: usize,
+    /// Plastic purged, mm³ (the bands' lines, width × height × length).
+    pub purged_volume: f64,
+    /// Layers up to the tower's top that got no tower layer (their only tool pastes).
+    pub skipped_layers: usize,
+}
+
+/// Why no tower could be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TowerError {
+    /// No place beside the objects holds the tower on the bed.
+    #[error(
+        "no room for the {width:.1} × {depth:.1} mm wipe tower on the bed beside the objects \
+         (set wipe_tower.x and wipe_tower.y, or a smaller wipe_tower.width)"
+    )]
+    NoRoom {
+        /// Tower width, mm.
+        width: f64,
+        /// Tower depth, mm.
+        depth: f64,
+    },
+    /// The tower set at `x`, `y` overlaps the objects or leaves the bed.
+    #[error("the wipe tower at x {x}, y {y} ({width:.1} × {depth:.1} mm) {why}")]
+    BadPlace {
+        /// Corner, mm.
+        x: f64,
+        /// Corner, mm.
+        y: f64,
+        /// Tower width, mm.
+        width: f64,
+        /// Tower depth, mm.
+        depth: f64,
+        /// What is wrong.
+        why: String,
+    },
+}
+
+/// One layer's plan: the changes to a filament tool (item index of the event, tool).
+struct LayerPlan {
+    purges: Vec<(usize, usize)>,
+    /// The active tool at the layer's start.
+    first_tool: Option<usize>,
+}
+
+/// Adds the wipe tower to `program` (see the module docs); `None` when the program never
+/// changes tools (nothing to purge) or the tower is off.
+pub fn add_wipe_tower(
+    program: &mut Program,
+    params: &TowerParams,
+    machine: &TowerMachine,
+) -> Result<Option<TowerSummary>, TowerError> {
+    if !params.enabled {
+        return Ok(None);
+    }
+    let mut plans = plan(program);
+    keep_filament(&mut plans, machine);
+    let Some(top) = plans.iter().rposition(|p| !p.purges.is_empty()) else {
+        return Ok(None);
+    };
+    // The deepest layer's bands, each rounded up to whole lines.
+    let depth_needed = plans[..=top]
+        .iter()
+        .zip(&program.layers)
+        .map(|(plan, layer)| {
+            plan.purges
+                .iter()
+                .map(|&(_, tool)| band_depth(params, machine.bead(tool), layer.height))
+                .sum::<f64>()
+        })
+        .fold(0.0, f64::max);
+    let loop_bead = machine.width.iter().copied().fold(0.0, f64::max);
+    let depth = (depth_needed + 2.0 * loop_bead).max(MIN_DEPTH_MM);
+    let (x, y) = place(program, params, machine, depth)?;
+    let tower = Rect {
+        x0: x,
+        y0: y,
+        x1: x + params.width,
+        y1: y + depth,
+    };
+    let mut summary = TowerSummary {
+        x,
+        y,
+        width: params.width,
+        depth,
+        layers: top + 1,
+        purges: 0,
+        purged_volume: 0.0,
+        skipped_layers: 0,
+    };
+    for (k, plan) in plans.iter().enumerate().take(top + 1) {
+        let layer = &mut program.layers[k];
+        let speed = if k == 0 {
+            machine.first_layer_speed.min(params.speed)
+        } else {
+            params.speed
+        };
+        let mut builder = LayerBuilder {
+            tower,
+            z: layer.z,
+            height: layer.height,
+            speed,
+            solid: k == 0,
+            next_y: tower.y0,
+            looped: false,
+        };
+        // Inserted from the back so that earlier item indices stay valid.
+        let mut inserts: Vec<(usize, Vec<Toolpath>)> = Vec::new();
+        let last_purge = plan.purges.len().checked_sub(1);
+        for (n, &(at, tool)) in plan.purges.iter().enumerate() {
+            let bead = machine.bead(tool);
+            let mut paths = builder.ring(tool, bead);
+            let band = builder.band(tool, bead, params.purge_volume);
+            summary.purges += 1;
+            summary.purged_volume += band.iter().map(volume).sum::<f64>();
+            paths.extend(band);
+            if Some(n) == last_purge {
+                paths.extend(builder.rest(tool, bead, params.sparse_spacing));
+            }
+            inserts.push((at + 1, paths));
+        }
+        if plan.purges.is_empty() {
+            match plan.first_tool.filter(|&t| machine.is_filament(t)) {
+                Some(tool) => {
+                    let bead = machine.bead(tool);
+                    let mut paths = builder.ring(tool, bead);
+                    paths.extend(builder.rest(tool, bead, params.sparse_spacing));
+                    inserts.push((0, paths));
+                }
+                None => summary.skipped_layers += 1,
+            }
+        }
+        for (at, paths) in inserts.into_iter().rev() {
+            let at = at.min(layer.items.len());
+            layer
+                .items
+                .splice(at..at, paths.into_iter().map(LayerItem::Path));
+        }
+    }
+    Ok(Some(summary))
+}
+
+/// Each layer's changes to a filament tool and its first tool. A layer's first tool is the one
+/// active when it starts: the previous layer's last, or the program's first tool.
+fn plan(program: &Program) -> Vec<LayerPlan> {
+    let mut active = program.first_tool();
+    let mut plans = Vec::with_capacity(program.layers.len());
+    for layer in &program.layers {
+        let first_tool = active.or_else(|| layer.paths().next().map(|p| p.tool));
+        let mut purges = Vec::new();
+        for (i, item) in layer.items.iter().enumerate() {
+            match item {
+                LayerItem::Event(Event::ToolChange { tool }) => {
+                    active = Some(*tool);
+                    purges.push((i, *tool));
+                }
+                LayerItem::Path(p) if active.is_none() => active = Some(p.tool),
+                _ => {}
+            }
+        }
+        plans.push(LayerPlan { purges, first_tool });
+    }
+    plans
+}
+
+/// Filament tools only: the caller's tool kinds decide which changes purge.
+fn keep_filament(plans: &mut [LayerPlan], machine: &TowerMachine) {
+    for plan in plans {
+        plan.purges.retain(|&(_, tool)| machine.is_filament(tool));
+    }
+}
+
+/// Depth along Y of a band of `purge_volume` in lines of `bead` at `height`, mm: whole lines.
+fn band_depth(params: &TowerParams, bead: f64, height: f64) -> f64 {
+    let line_area = bead * height;
+    if line_area <= 0.0 || params.purge_volume <= 0.0 {
+        return 0.0;
+    }
+    let length = params.width - 3.0 * bead;
+    if length <= 0.0 {
+        return 0.0;
+    }
+    (params.purge_volume / (line_area * length)).ceil() * bead
+}
+
+/// Plastic in a path, mm³.
+fn volume(p: &Toolpath) -> f64 {
+    p.length() * p.width * p.height
+}
+
+/// An axis-aligned rectangle, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Rect {
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+}
+
+impl Rect {
+    /// Whether the two come closer than `gap`.
+    fn near(&self, other: &Rect, gap: f64) -> bool {
+        self.x0 < other.x1 + gap
+            && other.x0 < self.x1 + gap
+            && self.y0 < other.y1 + gap
+            && other.y0 < self.y1 + gap
+    }
+
+    /// Whether `self` lies within `outer`.
+    fn within(&self, outer: &Rect) -> bool {
+        outer.x0 <= self.x0 && outer.y0 <= self.y0 && self.x1 <= outer.x1 && self.y1 <= outer.y1
+    }
+}
+
+/// The box of every path of `program` (and its beads), if any.
+fn footprint(program: &Program) -> Option<Rect> {
+    let mut b: Option<Rect> = None;
+    for p in program.paths() {
+        let r = p.width / 2.0;
+        for q in &p.points {
+            let e = b.get_or_insert(Rect {
+                x0: q.x,
+                y0: q.y,
+                x1: q.x,
+                y1: q.y,
+            });
+            e.x0 = e.x0.min(q.x - r);
+            e.y0 = e.y0.min(q.y - r);
+            e.x1 = e.x1.max(q.x + r);
+            e.y1 = e.y1.max(q.y + r);
+        }
+    }
+    b
+}
+
+/// Where the tower's front-left corner goes (see the module docs).
+fn place(
+    program: &Program,
+    params: &TowerParams,
+    machine: &TowerMachine,
+    depth: f64,
+) -> Result<(f64, f64), TowerError> {
+    let bed = Rect {
+        x0: machine.bed[0],
+        y0: machine.bed[1],
+        x1: machine.bed[2],
+        y1: machine.bed[3],
+    };
+    let width = params.width;
+    let at = |x: f64, y: f64| Rect {
+        x0: x,
+        y0: y,
+        x1: x + width,
+        y1: y + depth,
+    };
+    let objects = footprint(program);
+    if let (Some(x), Some(y)) = (params.x, params.y) {
+        let tower = at(x, y);
+        let bad = |why: &str| TowerError::BadPlace {
+            x,
+            y,
+            width,
+            depth,
+            why: why.to_owned(),
+        };
+        if !tower.within(&bed) {
+            return Err(bad("does not fit on the bed"));
+        }
+        if objects.is_some_and(|o| tower.near(&o, MIN_GAP_MM)) {
+            return Err(bad("overlaps the objects' paths"));
+        }
+        return Ok((x, y));
+    }
+    let Some(o) = objects else {
+        return Ok((bed.x0 + GAP_MM, bed.y0 + GAP_MM));
+    };
+    // Right, behind, left, in front: the tower's near side GAP_MM from the objects', aligned
+    // with their front (or left) edge, or moved back onto the bed along that side.
+    let along = |lo: f64, size: f64, bed_lo: f64, bed_hi: f64| lo.min(bed_hi - size).max(bed_lo);
+    let candidates = [
+        (o.x1 + GAP_MM, along(o.y0, depth, bed.y0, bed.y1)),
+        (along(o.x0, width, bed.x0, bed.x1), o.y1 + GAP_MM),
+        (o.x0 - GAP_MM - width, along(o.y0, depth, bed.y0, bed.y1)),
+        (along(o.x0, width, bed.x0, bed.x1), o.y0 - GAP_MM - depth),
+    ];
+    candidates
+        .into_iter()
+        .find(|&(x, y)| {
+            let t = at(x, y);
+            t.within(&bed) && !t.near(&o, GAP_MM - 1e-9)
+        })
+        .ok_or(TowerError::NoRoom { width, depth })
+}
+
+/// Makes one layer's tower paths, band after band from the front.
+struct LayerBuilder {
+    tower: Rect,
+    z: f64,
+    height: f64,
+    speed: f64,
+    /// Fill the rest one bead apart (the first layer).
+    solid: bool,
+    /// Where the next band starts (Y of its front edge), mm.
+    next_y: f64,
+    /// Whether the loop is laid on this layer.
+    looped: bool,
+}
+
+impl LayerBuilder {
+    fn path(&self, points: Vec<[f64; 2]>, closed: bool, tool: usize, bead: f64) -> Toolpath {
+        Toolpath {
+            points: points
+                .into_iter()
+                .map(|[x, y]| Point3::new(x, y, self.z))
+                .collect(),
+            closed,
+            role: Role::WipeTower,
+            tool,
+            width: bead,
+            height: self.height,
+            speed: self.speed,
+            tool_axis: None,
+            segments: None,
+        }
+    }
+
+    /// The loop round the tower, the first time a tool prints on it this layer.
+    fn ring(&mut self, tool: usize, bead: f64) -> Vec<Toolpath> {
+        if self.looped {
+            return Vec::new();
+        }
+        self.looped = true;
+        let h = bead / 2.0;
+        let t = self.tower;
+        self.next_y = t.y0 + bead;
+        vec![self.path(
+            vec![
+                [t.x0 + h, t.y0 + h],
+                [t.x1 - h, t.y0 + h],
+                [t.x1 - h, t.y1 - h],
+                [t.x0 + h, t.y1 - h],
+            ],
+            true,
+            tool,
+            bead,
+        )]
+    }
+
+    /// Lines along X inside the loop from `next_y`, one bead apart, joined end to end, until
+    /// they hold `volume` mm³ (whole lines), or the tower's back is reached.
+    fn band(&mut self, tool: usize, bead: f64, volume: f64) -> Vec<Toolpath> {
+        let t = self.tower;
+        let (left, right) = (t.x0 + 1.5 * bead, t.x1 - 1.5 * bead);
+        let back = t.y1 - bead;
+        let line = (right - left) * bead * self.height;
+        if line <= 0.0 || volume <= 0.0 {
+            return Vec::new();
+        }
+        let lines = (volume / line).ceil() as usize;
+        let mut points = Vec::new();
+        for n in 0..lines {
+            let y = self.next_y + bead / 2.0;
+            if y > back - bead / 2.0 + 1e-9 {
+                break;
+            }
+            let (a, b) = if n % 2 == 0 {
+                (left, right)
+            } else {
+                (right, left)
+            };
+            points.push([a, y]);
+            points.push([b, y]);
+            self.next_y += bead;
+        }
+        if points.len() < 2 {
+            return Vec::new();
+        }
+        vec![self.path(points, false, tool, bead)]
+    }
+
+    /// The part of the tower behind the bands: lines along Y every `spacing` mm (one bead
+    /// apart on the first layer), joined end to end.
+    fn rest(&mut self, tool: usize, bead: f64, spacing: f64) -> Vec<Toolpath> {
+        let t = self.tower;
+        let (front, back) = (self.next_y + bead / 2.0, t.y1 - 1.5 * bead);
+        if back - front < bead {
+            return Vec::new();
+        }
+        let (left, right) = (t.x0 + 1.5 * bead, t.x1 - 1.5 * bead);
+        let step = if self.solid { bead } else { spacing };
+        let count = ((right - left) / step).floor() as usize + 1;
+        let mut points = Vec::new();
+        for n in 0..count {
+            let x = left + n as f64 * step;
+            let (a, b) = if n % 2 == 0 {
+                (front, back)
+            } else {
+                (back, front)
+            };
+            points.push([x, a]);
+            points.push([x, b]);
+        }
+        self.next_y = t.y1;
+        vec![self.path(points, false, tool, bead)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::program::Layer;
+
+    const BEAD: f64 = 0.45;
+    const HEIGHT: f64 = 0.2;
+
+    /// A 10 mm square at (20, 20) printed by `tool` at `z`.
+    fn square(tool: usize, z: f64) -> Toolpath {
+        let p = |x: f64, y: f64| Point3::new(x, y, z);
+        Toolpath {
+            points: vec![p(20.0, 20.0), p(30.0, 20.0), p(30.0, 30.0), p(20.0, 30.0)],
+            closed: true,
+            role: Role::Perimeter,
+            tool,
+            width: BEAD,
+            height: HEIGHT,
+            speed: 40.0,
+            tool_axis: None,
+            segments: None,
+        }
+    }
+
+    /// Layers of 0.2 mm: each a list of tools, printed in turn with a change between two
+    /// different tools (the first tool of the program is implied).
+    fn program(layers: &[&[usize]]) -> Program {
+        let mut active: Option<usize> = None;
+        let layers = layers
+            .iter()
+            .enumerate()
+            .map(|(k, tools)| {
+                let z = HEIGHT * (k + 1) as f64;
+                let mut items = Vec::new();
+                for &t in tools.iter() {
+                    if active.is_some_and(|a| a != t) {
+                        items.push(LayerItem::Event(Event::ToolChange { tool: t }));
+                    }
+                    active = Some(t);
+                    items.push(LayerItem::Path(square(t, z)));
+                }
+                Layer {
+                    index: k,
+                    z,
+                    height: HEIGHT,
+                    items,
+                }
+            })
+            .collect();
+        Program { layers }
+    }
+
+    fn machine(filament: &[bool]) -> TowerMachine {
+        TowerMachine {
+            bed: [0.0, 0.0, 200.0, 200.0],
+            filament: filament.to_vec(),
+            width: vec![BEAD; filament.len()],
+            first_layer_speed: 20.0,
+        }
+    }
+
+    fn on() -> TowerParams {
+        TowerParams {
+            enabled: true,
+            ..TowerParams::default()
+        }
+    }
+
+    /// The tower's paths of layer `k`, with the index of each among the layer's items.
+    fn tower_paths(program: &Program, k: usize) -> Vec<(usize, &Toolpath)> {
+        program.layers[k]
+            .items
+            .iter()
+            .enumerate()
+            .filter_map(|(i, item)| match item {
+                LayerItem::Path(p) if p.role == Role::WipeTower => Some((i, p)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_change_to_a_filament_tool_is_followed_by_its_purge_of_the_volume_asked() {
+        // Two tools on layers 0–3, tool 0 alone on 4–5: the tower ends at layer 3.
+        let mut p = program(&[&[0, 1], &[1, 0], &[0, 1], &[1, 0], &[0], &[0]]);
+        let params = on();
+        let summary = add_wipe_tower(&mut p, &params, &machine(&[true, true]))
+            .expect("placed")
+            .expect("built");
+        assert_eq!(summary.layers, 4);
+        assert_eq!(summary.purges, 4);
+        assert_eq!(summary.skipped_layers, 0);
+        for k in 0..4 {
+            let layer = &p.layers[k];
+            let change = layer
+                .items
+                .iter()
+                .position(|i| matches!(i, LayerItem::Event(Event::ToolChange { .. })))
+                .expect("a change");
+            let LayerItem::Event(Event::ToolChange { tool }) = layer.items[change] else {
+                unreachable!()
+            };
+            let tower = tower_paths(&p, k);
+            // Loop, band, rest: right after the change, by the new tool, one after the other.
+            let at: Vec<usize> = tower.iter().map(|(i, _)| *i).collect();
+            assert_eq!(
+                at,
+                (change + 1..change + 1 + tower.len()).collect::<Vec<_>>()
+            );
+            assert!(tower.iter().all(|(_, t)| t.tool == tool && t.z_is(layer.z)));
+            // The band: lines along X, 60 − 3 × 0.45 = 58.65 mm long, one bead apart; whole
+            // lines until 140 mm³ are laid: ceil(140 / (58.65 × 0.45 × 0.2)) = 27 lines.
+            let band = tower[1].1;
+            let lines = band.points.len() / 2;
+            assert_eq!(lines, 27);
+            let line = 58.65 * BEAD * HEIGHT;
+            let laid = volume(band);
+            assert!(laid >= params.purge_volume && laid < params.purge_volume + line + 1.0);
+            // With one purge a layer the bands fill the tower: 27 lines and the loop's two
+            // beads, 12.15 + 0.9 mm deep.
+            assert!((summary.depth - 13.05).abs() < 1e-9, "{}", summary.depth);
+        }
+        assert!(tower_paths(&p, 4).is_empty() && tower_paths(&p, 5).is_empty());
+        assert!((summary.purged_volume - 4.0 * volume(tower_paths(&p, 1)[1].1)).abs() < 1e-9);
+    }
+
+    impl Toolpath {
+        fn z_is(&self, z: f64) -> bool {
+            self.points.iter().all(|p| (p.z - z).abs() < 1e-12)
+        }
+    }
+
+    #[test]
+    fn layers_without_a_change_below_the_top_get_a_sparse_layer_by_the_active_tool() {
+        // Changes only on layer 3: layers 0–2 are tool 0 alone.
+        let mut p = program(&[&[0], &[0], &[0], &[0, 1]]);
+        let params = on();
+        let summary = add_wipe_tower(&mut p, &params, &machine(&[true, true]))
+            .expect("placed")
+            .expect("built");
+        assert_eq!(summary.layers, 4);
+        assert_eq!(summary.purges, 1);
+        for k in 0..3 {
+            let tower = tower_paths(&p, k);
+            // The loop and the rest, first thing on the layer, by tool 0.
+            assert_eq!(tower.iter().map(|(i, _)| *i).collect::<Vec<_>>(), [0, 1]);
+            assert!(tower.iter().all(|(_, t)| t.tool == 0));
+            let rest = tower[1].1;
+            // Lines along Y, every 10 mm from 1.5 beads in (every bead on the first layer):
+            // floor(58.65 / step) + 1 of them, all at the same X on every sparse layer.
+            let step = if k == 0 { BEAD } else { params.sparse_spacing };
+            assert_eq!(rest.points.len() / 2, (58.65 / step).floor() as usize + 1);
+            for pair in rest.points.chunks(2) {
+                assert!((pair[0].x - pair[1].x).abs() < 1e-12);
+            }
+            // First layer at the first layer's speed.
+            let speed = if k == 0 { 20.0 } else { params.speed };
+            assert!(tower.iter().all(|(_, t)| t.speed == speed));
+        }
+        let xs =
+            |k: usize| -> Vec<f64> { tower_paths(&p, k)[1].1.points.iter().map(|q| q.x).collect() };
+        assert_eq!(xs(1), xs(2));
+    }
+
+    #[test]
+    fn paste_tools_are_not_purged_but_the_filament_tool_coming_back_is() {
+        // Tool 1 is a paste dispenser: layers 0–1 change 0 → 1 → (next layer) 0.
+        let mut p = program(&[&[0, 1], &[1, 0], &[0]]);
+        let summary = add_wipe_tower(&mut p, &on(), &machine(&[true, false]))
+            .expect("placed")
+            .expect("built");
+        // Layer 0's only change is to the paste tool: tool 0 prints the loop and the rest at
+        // the layer's start; layer 1's change back to tool 0 purges.
+        assert_eq!(summary.purges, 1);
+        assert_eq!(summary.layers, 2);
+        assert!(tower_paths(&p, 0).iter().all(|(_, t)| t.tool == 0));
+        assert_eq!(tower_paths(&p, 0)[0].0, 0);
+        assert!(tower_paths(&p, 1).iter().all(|(_, t)| t.tool == 0));
+        assert!(p.paths().all(|t| t.role != Role::WipeTower || t.tool == 0));
+    }
+
+    #[test]
+    fn no_tower_without_a_change_or_when_off() {
+        let mut p = program(&[&[0], &[0]]);
+        let before = p.clone();
+        assert_eq!(
+            add_wipe_tower(&mut p, &on(), &machine(&[true, true])),
+            Ok(None)
+        );
+        let mut two = program(&[&[0, 1]]);
+        let two_before = two.clone();
+        assert_eq!(
+            add_wipe_tower(&mut two, &TowerParams::default(), &machine(&[true, true])),
+            Ok(None)
+        );
+        assert_eq!((p, two), (before, two_before));
+    }
+
+    #[test]
+    fn the_tower_stands_beside_the_objects_on_the_bed_or_says_why_not() {
+        let m = machine(&[true, true]);
+        // The square spans 20–30 mm (and half a bead): right of it, 5 mm clear.
+        let mut p = program(&[&[0, 1]]);
+        let s = add_wipe_tower(&mut p, &on(), &m)
+            .expect("placed")
+            .expect("built");
+        assert!((s.x - (30.225 + GAP_MM)).abs() < 1e-9 && (s.y - 19.775).abs() < 1e-9);
+        // A bed ending 60 mm right of the square: no room there, so behind it.
+        let narrow = TowerMachine {
+            bed: [0.0, 0.0, 90.0, 200.0],
+            ..m.clone()
+        };
+        let mut p = program(&[&[0, 1]]);
+        let s = add_wipe_tower(&mut p, &on(), &narrow)
+            .expect("placed")
+            .expect("built");
+        assert!((s.x - 19.775).abs() < 1e-9 && (s.y - (30.225 + GAP_MM)).abs() < 1e-9);
+        // A bed too small anywhere: an error naming the tower's size.
+        let tiny = TowerMachine {
+            bed: [10.0, 10.0, 60.0, 45.0],
+            ..m.clone()
+        };
+        let err = add_wipe_tower(&mut program(&[&[0, 1]]), &on(), &tiny).expect_err("no room");
+        assert_eq!(
+            err.to_string(),
+            "no room for the 60.0 × 13.1 mm wipe tower on the bed beside the objects \
+             (set wipe_tower.x and wipe_tower.y, or a smaller wipe_tower.width)"
+        );
+        // Set by hand: over the square, or off the bed, is an error; beside it is kept.
+        let at = |x: f64, y: f64| TowerParams {
+            x: Some(x),
+            y: Some(y),
+            ..on()
+        };
+        let over = add_wipe_tower(&mut program(&[&[0, 1]]), &at(0.0, 25.0), &m);
+        assert!(
+            matches!(over, Err(TowerError::BadPlace { ref why, .. }) if why.contains("overlaps"))
+        );
+        let off = add_wipe_tower(&mut program(&[&[0, 1]]), &at(150.0, 25.0), &m);
+        assert!(matches!(off, Err(TowerError::BadPlace { ref why, .. }) if why.contains("bed")));
+        let ok = add_wipe_tower(&mut program(&[&[0, 1]]), &at(100.0, 100.0), &m);
+        assert!(matches!(
+            ok,
+            Ok(Some(TowerSummary {
+                x: 100.0,
+                y: 100.0,
+                ..
+            }))
+        ));
+    }
+
+    #[test]
+    fn settings_out_of_range_are_named() {
+        let bad = TowerParams {
+            width: 2.0,
+            x: Some(10.0),
+            ..TowerParams::default()
+        };
+        assert_eq!(
+            bad.problems(),
+            [
+                "wipe_tower.width must be between 5 and 300, got 2",
+                "wipe_tower.x and wipe_tower.y are set together or not at all",
+            ]
+        );
+        assert!(TowerParams::default().problems().is_empty());
+    }
+}
