@@ -342,7 +342,8 @@ fn stl_content(path: &Path, bytes: &[u8]) -> Result<Content, LoadErrorKind> {
     Ok(single_mesh(name, mesh, details))
 }
 
-/// A 3MF package: one object per flattened build object (named `object <id>` when nameless),
+/// A 3MF package: one object per flattened build object (named as the slicer that wrote it
+/// names it, else as the 3MF does, else `object <id>`),
 /// holding its model parts, with its negative volumes beside them
 /// ([`super::volumes`]); the reader's warnings and what the volumes left out are added to
 /// `warnings`, each once.
@@ -359,10 +360,10 @@ fn threemf_content(
     let root = package.root();
     let mut objects = Vec::with_capacity(flat.len());
     for f in &flat {
-        let name = if f.name.is_empty() {
-            format!("object {}", f.object_id)
-        } else {
-            f.name.clone()
+        let name = match volumes.name_of(f) {
+            Some(n) if !n.is_empty() => n.to_owned(),
+            _ if f.name.is_empty() => format!("object {}", f.object_id),
+            _ => f.name.clone(),
         };
         let split = volumes.split(f, &name);
         for w in split.warnings {

@@ -67,6 +67,21 @@ impl<'s> Volumes<'s> {
             .ok_or(())
     }
 
+    /// The name the slicer gave the object `flat` places: the described object with the build
+    /// item's id, or the one whose volumes hold its first triangle (another instance).
+    pub fn name_of(&self, flat: &FlatMesh) -> Option<&'s str> {
+        let by_item = self
+            .by_mesh
+            .values()
+            .flatten()
+            .find(|(o, _)| o.id == flat.object_id);
+        let by_mesh = || {
+            let (mesh, _) = flat.triangle_sources.first()?;
+            self.by_mesh.get(mesh)?.first()
+        };
+        by_item.or_else(by_mesh)?.0.name.as_deref()
+    }
+
     /// Sorts the triangles of `flat` (named `name`).
     pub fn split(&self, flat: &FlatMesh, name: &str) -> Split {
         let mut out = Split::default();
@@ -113,38 +128,22 @@ impl<'s> Volumes<'s> {
     }
 }
 
-/// What is said about volume `v` of object `name`, if anything: a volume left out of the print
-/// (in `left_out`) or a model part whose own settings are not honoured.
+/// What is said about volume `v` of object `name` when it was left out of the print (it is in
+/// `left_out`). Its settings are named by the config, which knows which of them matter.
 fn warning(name: &str, v: &Volume, left_out: &[(&Volume, usize)]) -> Option<String> {
+    left_out.iter().find(|(l, _)| std::ptr::eq(*l, v))?;
     let label = v
         .name
         .as_deref()
         .map_or_else(String::new, |n| format!(" \"{n}\""));
-    let keys: Vec<&str> = v.settings.iter().map(|s| s.key.as_str()).collect();
-    let settings = if keys.is_empty() {
-        String::new()
-    } else {
-        format!("; its settings are not honoured: {}", keys.join(", "))
-    };
     let kind = v.kind.describe();
     match v.kind {
-        VolumeKind::ModelPart | VolumeKind::NegativeVolume if keys.is_empty() => None,
-        VolumeKind::ModelPart | VolumeKind::NegativeVolume => {
-            Some(format!("object \"{name}\": {kind}{label}{settings}"))
-        }
-        VolumeKind::Modifier => {
-            left_out.iter().find(|(l, _)| std::ptr::eq(*l, v))?;
-            Some(format!(
-                "object \"{name}\": modifier{label} not printed{settings}"
-            ))
-        }
-        VolumeKind::SupportEnforcer | VolumeKind::SupportBlocker => {
-            left_out.iter().find(|(l, _)| std::ptr::eq(*l, v))?;
-            Some(format!(
-                "object \"{name}\": {kind}{label} not printed and not honoured: supports \
-                 follow the [support] settings alone{settings}"
-            ))
-        }
+        VolumeKind::ModelPart | VolumeKind::NegativeVolume => None,
+        VolumeKind::Modifier => Some(format!("object \"{name}\": modifier{label} not printed")),
+        VolumeKind::SupportEnforcer | VolumeKind::SupportBlocker => Some(format!(
+            "object \"{name}\": {kind}{label} not printed and not honoured: supports follow \
+             the [support] settings alone"
+        )),
     }
 }
 
