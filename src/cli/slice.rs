@@ -11,11 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 
 pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
-    let (scene, stored) = load_models_and_settings(&args.models)?;
-    let mut cfg = match &stored {
-        Some((path, settings)) => resolve_for_model(&args.config, path, settings)?,
-        None => super::config::resolve(&args.config)?,
-    };
+    let (scene, mut cfg) = models_and_config(&args.models, &args.config)?;
     match args.curved.as_deref() {
         Some("tops") => cfg.curved.mode = conduit::config::CurvedMode::Tops,
         Some("clfff") => cfg.curved.mode = conduit::config::CurvedMode::Clfff,
@@ -359,6 +355,20 @@ pub(crate) fn load_electronics(
 /// One scene of every object of `models`, in order; reader warnings go to stderr.
 pub(crate) fn load_models(models: &[std::path::PathBuf]) -> Result<Scene, Failure> {
     Ok(load_models_and_settings(models)?.0)
+}
+
+/// The scene of `models` and the job's config: `src` (`-c`, `--set`) over the profile a slicer
+/// stored in the first model that has one ([`resolve_for_model`]).
+pub(crate) fn models_and_config(
+    models: &[std::path::PathBuf],
+    src: &super::args::ConfigSource,
+) -> Result<(Scene, conduit::config::Config), Failure> {
+    let (scene, stored) = load_models_and_settings(models)?;
+    let cfg = match &stored {
+        Some((path, settings)) => resolve_for_model(src, path, settings)?,
+        None => super::config::resolve(src)?,
+    };
+    Ok((scene, cfg))
 }
 
 /// [`load_models`], with the settings a slicer stored in the first model that has them (a

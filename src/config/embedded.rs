@@ -1,9 +1,10 @@
 //! The profile a slicer stored in a 3MF project, as the job's [`Config`].
 //!
 //! Place in the pipeline: a front door to [`Config`] beside [`super::load`]. `conduit slice`
-//! reads a 3MF's [`SlicerSettings`] (`conduit_3mf`: PrusaSlicer's `Metadata/Slic3r_PE.config`,
-//! OrcaSlicer's `Metadata/project_settings.config`) and, unless `--config` names a file, builds
-//! the job's config from it with [`from_3mf`]; `--set` still applies on top.
+//! and `conduit route` read a 3MF's [`SlicerSettings`] (`conduit_3mf`: PrusaSlicer's
+//! `Metadata/Slic3r_PE.config`, OrcaSlicer's `Metadata/project_settings.config`) and, unless
+//! `--config` names a file, build the job's config from it with [`from_3mf`]; `--set` still
+//! applies on top.
 //!
 //! - The profile's keys go through the PrusaSlicer mapping ([`super::prusa_ini`]); OrcaSlicer's
 //!   names are renamed to PrusaSlicer's first ([`super::host::ORCA_KEYS`]).
