@@ -226,6 +226,7 @@ fn block(grid: &Grid) -> Scene {
             mesh,
             transform: Transform::identity(),
             tool: None,
+            negative: None,
         }],
     }
 }

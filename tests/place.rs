@@ -24,6 +24,7 @@ fn block(dir: &Path, name: &str, size: [f64; 3]) -> PathBuf {
             mesh,
             transform: Transform::identity(),
             tool: None,
+            negative: None,
         }],
     };
     let path = dir.join(format!("{name}.stl"));

@@ -102,6 +102,7 @@ fn two_object_scene() -> Scene {
         mesh: Mesh::cuboid(name, Point3::new(dx, 0.0, 0.0), Point3::new(dx + s, s, s)),
         transform: Transform::identity(),
         tool: None,
+        negative: None,
     };
     Scene {
         objects: vec![cube("small", 0.1, 0.0), cube("large", 12.5, 30.0)],

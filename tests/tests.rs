@@ -39,6 +39,7 @@ mod roundtrip;
 mod route_help;
 mod route_limits;
 mod slice;
+mod slice_3mf;
 mod studio;
 mod support;
 mod thin_walls;

@@ -7,7 +7,7 @@ use conduit::config::{self, Config};
 /// Loads the config a command asked for (defaults when none), applies `--set` overrides and
 /// validates it; warnings go to stderr.
 pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
-    let (mut cfg, shown) = match &src.config {
+    let (cfg, shown) = match &src.config {
         Some(path) => {
             // Every error of `load` names the file but a failed validation.
             let (cfg, warnings) = config::load(path).map_err(|e| match e {
@@ -23,11 +23,63 @@ pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
         }
         None => (Config::default(), Vec::new()),
     };
+    with_overrides(src, cfg, &shown)
+}
+
+/// The config of a job on the model file `model`, which may carry a slicer's settings
+/// (`slicer`, a 3MF's): without `--config`, the profile and object settings stored in it
+/// (`conduit::config::embedded`), said on the terminal, then `--set`; with `--config`, that
+/// file alone, and the stored profile is said to be unused. Settings of objects and volumes
+/// that are not honoured are named either way.
+pub(crate) fn resolve_for_model(
+    src: &ConfigSource,
+    model: &std::path::Path,
+    slicer: &conduit_3mf::SlicerSettings,
+) -> Result<Config, Failure> {
+    let file = model.display();
+    if let Some(path) = &src.config {
+        if let Some(p) = &slicer.profile {
+            infoln!(
+                "{file}: the {} profile stored in it is not used: --config {} is",
+                p.writer.as_deref().unwrap_or("slicer"),
+                path.display()
+            );
+        }
+        for w in config::embedded::unhonoured(slicer, false) {
+            warnln!("{file}: {w}");
+        }
+        return resolve(src);
+    }
+    let embedded = config::embedded::from_3mf(slicer)
+        .map_err(|e| anyhow::Error::new(e).context(file.to_string()))?;
+    let Some(e) = embedded else {
+        for w in config::embedded::unhonoured(slicer, false) {
+            warnln!("{file}: {w}");
+        }
+        return resolve(src);
+    };
+    infoln!(
+        "{file}: slicing with {} stored in it (--config and --set override it)",
+        e.source
+    );
+    for w in &e.warnings {
+        show_load_warning(model, w);
+    }
+    with_overrides(src, e.config, &e.warnings)
+}
+
+/// `cfg` with the `--set` overrides of `src` applied and validated; the validation's warnings
+/// not `shown` already go to stderr.
+fn with_overrides(
+    src: &ConfigSource,
+    mut cfg: Config,
+    shown: &[String],
+) -> Result<Config, Failure> {
     for kv in &src.set {
         cfg.apply_set(kv)
             .map_err(|e| Failure::Usage(e.to_string()))?;
     }
-    // `load` validated the file already: only what `--set` brought in is new.
+    // The file was validated already: only what `--set` brought in is new.
     for w in cfg.validate().map_err(anyhow::Error::from)? {
         if !shown.contains(&w) {
             warnln!("{w}");

@@ -1,7 +1,7 @@
 //! `conduit route`: a circuit placed in models and routed, shown as one SVG per layer, without
 //! G-code.
 
-use super::{Failure, args::RouteArgs, config::resolve};
+use super::{Failure, args::RouteArgs};
 use anyhow::Context;
 use conduit::emit::route_svg::{layer_svg, view_box};
 use conduit::pipeline::route_scene;
@@ -18,8 +18,7 @@ pub(crate) fn run(args: RouteArgs) -> Result<(), Failure> {
     if let Some(report) = &args.report {
         outputs.check(report)?;
     }
-    let cfg = resolve(&args.config)?;
-    let scene = super::slice::load_models(&args.models)?;
+    let (scene, cfg) = super::slice::models_and_config(&args.models, &args.config)?;
     let electronics = super::slice::load_electronics(&args.circuit, &args.placement)?;
     let (bar, routing) = super::progress::routing_bar();
     let view = route_scene(&scene, &cfg, &electronics, |_| {}, Some(&routing))

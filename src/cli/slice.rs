@@ -1,17 +1,17 @@
 //! `conduit slice`: models → G-code through the planar pipeline, with a progress line per stage.
 
-use super::{Failure, args::SliceArgs, config::resolve};
+use super::{Failure, args::SliceArgs, config::resolve_for_model};
 use anyhow::Context;
 use conduit::circuit::Electronics;
 use conduit::circuit::stage::pnp_records;
 use conduit::circuit::{Circuit, Placement};
 use conduit::pipeline::{Stage, slice_clfff, slice_scene_watched};
-use conduit::scene::{OutputSet, Scene, load_scene};
+use conduit::scene::{OutputSet, Scene, load_scene_and_settings};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 
 pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
-    let mut cfg = resolve(&args.config)?;
+    let (scene, mut cfg) = models_and_config(&args.models, &args.config)?;
     match args.curved.as_deref() {
         Some("tops") => cfg.curved.mode = conduit::config::CurvedMode::Tops,
         Some("clfff") => cfg.curved.mode = conduit::config::CurvedMode::Clfff,
@@ -33,9 +33,8 @@ pub(crate) fn run(args: SliceArgs) -> Result<(), Failure> {
             )
             .into());
         }
-        return run_clfff(&args, &cfg, outputs);
+        return run_clfff(&args, &cfg, &scene, outputs);
     }
-    let scene = load_models(&args.models)?;
     let electronics = match (&args.circuit, &args.placement) {
         (Some(c), Some(p)) => Some(load_electronics(c, p)?),
         _ => None,
@@ -134,11 +133,11 @@ fn model_warnings(args: &SliceArgs, summary: &conduit::pipeline::SliceSummary) {
 fn run_clfff(
     args: &SliceArgs,
     cfg: &conduit::config::Config,
+    scene: &Scene,
     mut outputs: OutputSet,
 ) -> Result<(), Failure> {
-    let scene = load_models(&args.models)?;
     let bar = stage_bar();
-    let (files, summary) = slice_clfff(&scene, cfg, |stage| {
+    let (files, summary) = slice_clfff(scene, cfg, |stage| {
         bar.set_position(stage as u64);
         bar.set_message(stage.name());
     })
@@ -355,16 +354,54 @@ pub(crate) fn load_electronics(
 
 /// One scene of every object of `models`, in order; reader warnings go to stderr.
 pub(crate) fn load_models(models: &[std::path::PathBuf]) -> Result<Scene, Failure> {
+    Ok(load_models_and_settings(models)?.0)
+}
+
+/// The scene of `models` and the job's config: `src` (`-c`, `--set`) over the profile a slicer
+/// stored in the first model that has one ([`resolve_for_model`]).
+pub(crate) fn models_and_config(
+    models: &[std::path::PathBuf],
+    src: &super::args::ConfigSource,
+) -> Result<(Scene, conduit::config::Config), Failure> {
+    let (scene, stored) = load_models_and_settings(models)?;
+    let cfg = match &stored {
+        Some((path, settings)) => resolve_for_model(src, path, settings)?,
+        None => super::config::resolve(src)?,
+    };
+    Ok((scene, cfg))
+}
+
+/// [`load_models`], with the settings a slicer stored in the first model that has them (a
+/// 3MF's) and that model's path; a later model's stored profile is said to be unused.
+fn load_models_and_settings(
+    models: &[std::path::PathBuf],
+) -> Result<
+    (
+        Scene,
+        Option<(std::path::PathBuf, conduit_3mf::SlicerSettings)>,
+    ),
+    Failure,
+> {
     let mut scene = Scene::default();
+    let mut stored: Option<(std::path::PathBuf, conduit_3mf::SlicerSettings)> = None;
     for path in models {
-        let (s, warnings) =
-            load_scene(path, &super::load_options()).map_err(anyhow::Error::from)?;
+        let (s, warnings, settings) =
+            load_scene_and_settings(path, &super::load_options()).map_err(anyhow::Error::from)?;
         for w in warnings {
             warnln!("{}: {w}", path.display());
         }
         scene.objects.extend(s.objects);
+        match (&stored, settings.is_empty()) {
+            (_, true) => {}
+            (None, false) => stored = Some((path.clone(), settings)),
+            (Some((first, _)), false) => warnln!(
+                "{}: the slicer settings stored in it are not used: {} gives the job's",
+                path.display(),
+                first.display()
+            ),
+        }
     }
-    Ok(scene)
+    Ok((scene, stored))
 }
 
 /// A bar over the pipeline's stages, hidden when stderr is not a terminal or with `--quiet`.

@@ -82,6 +82,24 @@ pub const ORCA_KEYS: &[(&str, &str)] = &[
     ("retraction_length", "retract_length"),
 ];
 
+/// Gives each OrcaSlicer key of `values` ([`ORCA_KEYS`]) its PrusaSlicer name when that name
+/// is not set; with `rename` the OrcaSlicer key goes, so that it is not reported as ignored.
+pub(crate) fn add_prusa_names<V: Clone>(values: &mut BTreeMap<String, V>, rename: bool) {
+    for (orca, prusa) in ORCA_KEYS {
+        if values.contains_key(*prusa) {
+            continue;
+        }
+        let value = if rename {
+            values.remove(*orca)
+        } else {
+            values.get(*orca).cloned()
+        };
+        if let Some(value) = value {
+            values.insert((*prusa).to_owned(), value);
+        }
+    }
+}
+
 /// Cura keys and the PrusaSlicer keys of the same settings. `infill_sparse_density` (a
 /// percentage number in Cura) is written with a `%`.
 pub const CURA_KEYS: &[(&str, &str)] = &[
@@ -167,14 +185,7 @@ impl HostSettings {
                 );
             }
         }
-        for (orca, prusa) in ORCA_KEYS {
-            if settings.values.contains_key(*prusa) {
-                continue;
-            }
-            if let Some(setting) = settings.values.get(*orca).cloned() {
-                settings.values.insert((*prusa).to_owned(), setting);
-            }
-        }
+        add_prusa_names(&mut settings.values, false);
         settings
     }
 

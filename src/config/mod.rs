@@ -42,6 +42,7 @@
 
 mod defaults;
 mod electronics;
+pub mod embedded;
 pub mod host;
 pub mod prusa_ini;
 

@@ -1211,6 +1211,27 @@ fn changes_the_print(key: &str, value: &str, support: bool) -> bool {
     })
 }
 
+/// How much leaving the setting `key = value` out changes the print, for ordering lists of
+/// settings not honoured: 0 for a key conduit reads from a profile, 1 for one of
+/// [`CHANGES_THE_PRINT`] set to a value that matters, 2 for the rest.
+pub(crate) fn impact(key: &str, value: &str) -> u8 {
+    if RULES.iter().any(|(k, _)| *k == key) || PER_EXTRUDER.contains(&key) {
+        0
+    } else if changes_the_print(key, value, true) {
+        1
+    } else {
+        2
+    }
+}
+
+/// Builds a config from PrusaSlicer pairs with the line each came from, as
+/// [`from_prusa_pairs`] does.
+pub(crate) fn from_lined_pairs(
+    pairs: Vec<(String, String, Option<usize>)>,
+) -> Result<(Config, Vec<String>), ConfigError> {
+    convert(pairs)
+}
+
 /// Lists, in one warning, every key no step has read: their number, those that change the
 /// print ([`CHANGES_THE_PRINT`]) by name, then after [`IGNORED_LIST_MARK`] all of them, sorted.
 fn warn_ignored(imp: &mut Import) {

@@ -106,6 +106,17 @@ pub enum PipelineError {
         /// How many tools the config has.
         tools: usize,
     },
+    /// The walk cannot subtract an object's negative volumes (only the planar slice does).
+    ///
+    /// How to fix: slice the model without `--curved clfff`, or remove the negative volumes in
+    /// the slicer that made the 3MF.
+    #[error("object '{object}' has negative volumes, which {walk} does not subtract")]
+    NegativeVolumes {
+        /// The object's name.
+        object: String,
+        /// The walk (`--curved clfff`).
+        walk: &'static str,
+    },
     /// Slice parameters are unusable.
     #[error(transparent)]
     SliceParams(#[from] crate::slice::SliceParamsError),
@@ -364,6 +375,7 @@ fn front(
     progress(Stage::Slice);
     let params = SliceParams::new(cfg.slice.layer_height, cfg.slice.first_layer_height)?;
     let mut sliced: Vec<_> = meshes.iter().map(|m| slice_mesh(m, &params)).collect();
+    subtract_negative_volumes(scene, &offsets, &params, &mut sliced);
     // The meshes are not needed past slicing (unless curved tops follow their surface): keep
     // only what the report says about them.
     let placed: Vec<(String, Option<BoundingBox>)> = meshes
@@ -431,6 +443,34 @@ fn front(
     }
     out.sliced = sliced;
     Ok(out)
+}
+
+/// Removes each object's negative volumes ([`crate::scene::SceneObject::negative`]) from its
+/// sliced layers: the volume is placed as its object was (`offsets`) and sliced on the same
+/// layer planes, and each layer's islands lose its cross-section, as PrusaSlicer subtracts
+/// negative volumes from the model parts layer by layer.
+fn subtract_negative_volumes(
+    scene: &Scene,
+    offsets: &[[f64; 3]],
+    params: &SliceParams,
+    sliced: &mut [(Vec<crate::slice::SlicedLayer>, SliceReport)],
+) {
+    for ((object, offset), (layers, _)) in scene.objects.iter().zip(offsets).zip(sliced) {
+        let Some(negative) = &object.negative else {
+            continue;
+        };
+        let mut mesh = negative.clone();
+        mesh.transform(&object.transform);
+        mesh.transform(&Transform::translation(offset[0], offset[1], offset[2]));
+        let (cut, _) = slice_mesh(&mesh, params);
+        // Both schedules start at the bed with the same parameters: layer i is at the same
+        // height in each.
+        for (layer, hole) in layers.iter_mut().zip(&cut) {
+            if !hole.islands.is_empty() {
+                layer.islands = crate::geom::difference(&layer.islands, &hole.islands);
+            }
+        }
+    }
 }
 
 /// What `conduit route` shows: the layers with what the electronics stage made of them.
@@ -760,6 +800,12 @@ pub fn slice_clfff(
     let mut laps = Laps::new();
     if scene.triangle_count() == 0 {
         return Err(PipelineError::EmptyScene);
+    }
+    if let Some(o) = scene.objects.iter().find(|o| o.negative.is_some()) {
+        return Err(PipelineError::NegativeVolumes {
+            object: o.name.clone(),
+            walk: "curved-layer slicing (clfff)",
+        });
     }
     progress(Stage::Place);
     let mut meshes = place_on_bed(scene, cfg);

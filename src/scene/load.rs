@@ -136,6 +136,9 @@ pub struct ThreeMfDetails {
     pub metadata: Vec<(String, String)>,
     /// Required extension namespaces.
     pub required_extensions: Vec<String>,
+    /// The profile, object settings and volumes a slicer stored beside the model.
+    #[serde(skip)]
+    pub slicer: conduit_3mf::SlicerSettings,
 }
 
 /// What a file held.
@@ -205,6 +208,31 @@ pub fn load_scene(path: &Path, opts: &LoadOptions) -> Result<(Scene, Vec<String>
     }
 }
 
+/// [`load_scene`], also returning the settings a slicer stored in a 3MF (empty for other
+/// files): what `conduit slice` takes as the job's profile.
+pub fn load_scene_and_settings(
+    path: &Path,
+    opts: &LoadOptions,
+) -> Result<(Scene, Vec<String>, conduit_3mf::SlicerSettings), LoadError> {
+    let file = load(path, opts)?;
+    match file.content {
+        Content::Mesh { scene, details } => {
+            let settings = match details {
+                MeshDetails::ThreeMf(d) => d.slicer,
+                _ => conduit_3mf::SlicerSettings::default(),
+            };
+            Ok((scene, file.warnings, settings))
+        }
+        _ => Err(LoadError {
+            path: path.to_path_buf(),
+            kind: Box::new(LoadErrorKind::NotAMesh(format!(
+                "a {:?} file holds no triangle mesh",
+                file.kind
+            ))),
+        }),
+    }
+}
+
 fn read_bounded(path: &Path, limit: u64) -> Result<Vec<u8>, LoadErrorKind> {
     let size = std::fs::metadata(path)?.len();
     if size > limit {
@@ -229,6 +257,7 @@ fn object(name: String, mesh: Mesh) -> SceneObject {
         mesh,
         transform: Transform::identity(),
         tool: None,
+        negative: None,
     }
 }
 
@@ -313,28 +342,48 @@ fn stl_content(path: &Path, bytes: &[u8]) -> Result<Content, LoadErrorKind> {
     Ok(single_mesh(name, mesh, details))
 }
 
-/// A 3MF package: one object per flattened build object (named `object <id>` when nameless);
-/// the reader's warnings are added to `warnings`.
+/// A 3MF package: one object per flattened build object (named as the slicer that wrote it
+/// names it, else as the 3MF does, else `object <id>`),
+/// holding its model parts, with its negative volumes beside them
+/// ([`super::volumes`]); the reader's warnings and what the volumes left out are added to
+/// `warnings`, each once.
 fn threemf_content(
     bytes: &[u8],
     opts: &LoadOptions,
     warnings: &mut Vec<String>,
 ) -> Result<Content, LoadErrorKind> {
-    let package = conduit_3mf::read_with(bytes, &opts.threemf_limits, opts.threemf_read)?;
+    let mut package = conduit_3mf::read_with(bytes, &opts.threemf_limits, opts.threemf_read)?;
     let flat = package.flatten()?;
-    let root = package.root();
-    let objects = flat
-        .iter()
-        .map(|f| {
-            let name = if f.name.is_empty() {
-                format!("object {}", f.object_id)
-            } else {
-                f.name.clone()
-            };
-            object(name.clone(), indexed_mesh(&name, &f.vertices, &f.triangles))
-        })
-        .collect();
     warnings.extend(package.warnings.iter().cloned());
+    let slicer = std::mem::take(&mut package.slicer);
+    let volumes = super::volumes::Volumes::new(&slicer);
+    let root = package.root();
+    let mut objects = Vec::with_capacity(flat.len());
+    for f in &flat {
+        let name = match volumes.name_of(f) {
+            Some(n) if !n.is_empty() => n.to_owned(),
+            _ if f.name.is_empty() => format!("object {}", f.object_id),
+            _ => f.name.clone(),
+        };
+        let split = volumes.split(f, &name);
+        for w in split.warnings {
+            if !warnings.contains(&w) {
+                warnings.push(w);
+            }
+        }
+        let mesh = if split.printed.len() == f.triangles.len() {
+            indexed_mesh(&name, &f.vertices, &f.triangles)
+        } else {
+            let (vertices, triangles) = super::volumes::compact(&f.vertices, &split.printed);
+            indexed_mesh(&name, &vertices, &triangles)
+        };
+        let mut o = object(name.clone(), mesh);
+        if !split.negative.is_empty() {
+            let (vertices, triangles) = super::volumes::compact(&f.vertices, &split.negative);
+            o.negative = Some(indexed_mesh(&name, &vertices, &triangles));
+        }
+        objects.push(o);
+    }
     let details = ThreeMfDetails {
         unit: format!("{:?}", root.unit).to_lowercase(),
         model_parts: package.models.len(),
@@ -348,6 +397,7 @@ fn threemf_content(
             .map(|m| (m.name.clone(), m.value.clone()))
             .collect(),
         required_extensions: root.required_extensions.clone(),
+        slicer,
     };
     Ok(Content::Mesh {
         scene: Scene { objects },

@@ -9,12 +9,13 @@ mod detect;
 mod load;
 mod output;
 mod save;
+pub mod volumes;
 pub mod words;
 
 pub use detect::FileKind;
 pub use load::{
     Content, LoadError, LoadErrorKind, LoadOptions, LoadedFile, MeshDetails, ThreeMfDetails, load,
-    load_scene,
+    load_scene, load_scene_and_settings,
 };
 pub use output::{OutputError, OutputSet, write_atomically};
 pub use save::{MeshFormat, SaveError, SaveErrorKind, placed_meshes, save, to_3mf_model};
@@ -33,6 +34,9 @@ pub struct SceneObject {
     pub transform: Transform,
     /// The tool (extruder) that prints it, when known.
     pub tool: Option<usize>,
+    /// Its negative volumes (a slicer's 3MF), in the same coordinates as `mesh`: the planar
+    /// slice subtracts them layer by layer.
+    pub negative: Option<Mesh>,
 }
 
 /// Objects as a 3MF build would place them.
@@ -43,6 +47,11 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// True when an object has negative volumes to subtract.
+    pub fn has_negative_volumes(&self) -> bool {
+        self.objects.iter().any(|o| o.negative.is_some())
+    }
+
     /// Total triangle count over all objects.
     pub fn triangle_count(&self) -> usize {
         self.objects.iter().map(|o| o.mesh.triangles.len()).sum()

@@ -29,6 +29,8 @@ impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if self.line == 0 {
             write!(f, "{}", self.part)
+        } else if self.column == 0 {
+            write!(f, "{}:{}", self.part, self.line)
         } else {
             write!(f, "{}:{}:{}", self.part, self.line, self.column)
         }
@@ -276,6 +278,18 @@ pub enum ThreeMfError {
         part: String,
         /// An object on the cycle.
         object_id: u32,
+    },
+    /// A slicer's settings part (`Metadata/Slic3r_PE.config`, `project_settings.config`, ...)
+    /// does not read.
+    ///
+    /// How to fix: re-save the project from the slicer, or delete the part to slice the model
+    /// without it.
+    #[error("{at}: slicer settings: {message}")]
+    SlicerSettings {
+        /// The part, and the line when known.
+        at: Location,
+        /// What is wrong.
+        message: String,
     },
     /// The writer was given a model it cannot write as a valid single-part 3MF.
     #[error("cannot write model: {reason}")]

@@ -27,6 +27,9 @@ pub struct FlatMesh {
     /// (`None` when neither gives both). Ids refer to resources of the model part that
     /// defines the mesh.
     pub triangle_properties: Vec<Option<(u32, u32)>>,
+    /// Per triangle: the id of the mesh object it comes from and its index in that mesh, which
+    /// is how a slicer's volumes ([`crate::VolumeMesh`]) name triangles.
+    pub triangle_sources: Vec<(u32, u32)>,
     /// Whether any mesh of this item was placed by a transform with negative determinant.
     pub mirrored: bool,
 }
@@ -103,6 +106,7 @@ impl Package {
                 vertices: Vec::new(),
                 triangles: Vec::new(),
                 triangle_properties: Vec::new(),
+                triangle_sources: Vec::new(),
                 mirrored: false,
             };
             // Transforms stay in model units; the unit scale is applied per vertex at the end.
@@ -181,7 +185,10 @@ impl Package {
                     let [x, y, z] = apply(t, p);
                     [x * scale, y * scale, z * scale]
                 }));
-                for tri in &mesh.triangles {
+                for (i, tri) in mesh.triangles.iter().enumerate() {
+                    // The triangle count is bounded by `max_triangles`, far below u32::MAX.
+                    fm.triangle_sources
+                        .push((object_id, u32::try_from(i).unwrap_or(u32::MAX)));
                     let [a, b, c] = tri.v.map(|v| v + base);
                     fm.triangles
                         .push(if mirror { [a, c, b] } else { [a, b, c] });

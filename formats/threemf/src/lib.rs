@@ -45,6 +45,11 @@
 //!   multiproperties layers naming a `texture2d` or indexing out of range) are warnings in both
 //!   modes.
 //!
+//! - **Slicer settings** ([`Package::slicer`], [`SlicerSettings`]): the profile, per-object
+//!   settings and volume types PrusaSlicer (`Metadata/Slic3r_PE*.config`) and OrcaSlicer
+//!   (`Metadata/project_settings.config`, `model_settings.config`) store beside the model;
+//!   [`FlatMesh::triangle_sources`] ties each flattened triangle to its volume.
+//!
 //! # Two modes: default and strict
 //! [`read`] (and [`read_with`] with [`ReadOptions::default`]) reads past *harmless defects*,
 //! the ones lib3mf's lenient mode and PrusaSlicer accept, with one warning each naming the
@@ -109,6 +114,7 @@ mod limits;
 mod model;
 mod opc;
 mod read;
+mod slicer;
 mod write;
 mod xml;
 
@@ -125,4 +131,8 @@ pub use model::{
     Object, ObjectContent, ObjectType, Package, Triangle, Unit,
 };
 pub use read::{ReadOptions, read, read_with};
+pub use slicer::{
+    Layout, ORCA_MODEL_PART, ORCA_PROFILE_PART, ObjectSettings, PRUSA_MODEL_PART,
+    PRUSA_PROFILE_PART, Profile, Setting, SlicerSettings, Volume, VolumeKind, VolumeMesh,
+};
 pub use write::{ROOT_MODEL_PATH, format_number, write};

@@ -78,6 +78,9 @@ pub struct Package {
     pub warnings: Vec<String>,
     /// The limits the package was read with; [`Package::flatten`] enforces them on its output.
     pub limits: Limits,
+    /// The profile, object settings and volume types a slicer stored beside the model (empty
+    /// for other producers).
+    pub slicer: crate::SlicerSettings,
 }
 
 impl Package {

@@ -73,8 +73,12 @@ pub fn read_with(
     check_component_graph(&parts, limits)?;
     check_extra_starts(&mut ar, &root_path, &extra_starts, &seen, &mut ctx)?;
 
-    let models = parts.into_iter().map(|(k, v)| (k, v.model)).collect();
+    let models: BTreeMap<String, Model> = parts.into_iter().map(|(k, v)| (k, v.model)).collect();
+    let empty = Model::default();
+    let root = models.get(&root_path).unwrap_or(&empty);
+    let slicer = crate::slicer::read_settings(&mut ar, root, &mut ctx.warnings)?;
     Ok(Package {
+        slicer,
         root_path,
         models,
         warnings: {

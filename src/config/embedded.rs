@@ -1,0 +1,160 @@
+//! The profile a slicer stored in a 3MF project, as the job's [`Config`].
+//!
+//! Place in the pipeline: a front door to [`Config`] beside [`super::load`]. `conduit slice`
+//! and `conduit route` read a 3MF's [`SlicerSettings`] (`conduit_3mf`: PrusaSlicer's
+//! `Metadata/Slic3r_PE.config`, OrcaSlicer's `Metadata/project_settings.config`) and, unless
+//! `--config` names a file, build the job's config from it with [`from_3mf`]; `--set` still
+//! applies on top.
+//!
+//! - The profile's keys go through the PrusaSlicer mapping ([`super::prusa_ini`]); OrcaSlicer's
+//!   names are renamed to PrusaSlicer's first ([`super::host::ORCA_KEYS`]).
+//! - An object's own settings (`<metadata type="object">`) override the profile when every
+//!   object of the project has the same ones (a single object always does); otherwise conduit,
+//!   which slices all objects with one profile, names each object's keys as not honoured.
+//! - A volume's settings (a modifier's, or a part's own) are never honoured and are named.
+//!
+//! Lists of keys not honoured are sorted by impact ([`super::prusa_ini::impact`]): keys conduit
+//! reads from a profile first, then those that change the print, then the rest, each
+//! alphabetically; every key is named once per object or volume.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use conduit_3mf::{Layout, ObjectSettings, Setting, SlicerSettings};
+
+use super::prusa_ini::{from_lined_pairs, impact};
+use super::{Config, ConfigError};
+
+/// The job's config taken from a 3MF.
+#[derive(Debug, Clone)]
+pub struct Embedded {
+    /// The config.
+    pub config: Config,
+    /// Settings ignored or adapted, and settings of objects and volumes not honoured.
+    pub warnings: Vec<String>,
+    /// What was used, for the terminal: `the PrusaSlicer 2.5.0 profile (Metadata/Slic3r_PE.config,
+    /// 300 settings)`.
+    pub source: String,
+}
+
+/// The config of the profile and object settings in `s`; `None` when the 3MF carries
+/// neither. An error names the part and line of the value that does not read.
+pub fn from_3mf(s: &SlicerSettings) -> Result<Option<Embedded>, ConfigError> {
+    let object_settings = shared_object_settings(&s.objects);
+    if s.profile.is_none() && object_settings.is_none_or(<[Setting]>::is_empty) {
+        return Ok(None);
+    }
+    let layout = s.profile.as_ref().map_or(Layout::Prusa, |p| p.layout);
+    // Key -> (value, line, part): later entries (the objects') override the profile's.
+    let mut values: BTreeMap<String, (String, Option<usize>, &str)> = BTreeMap::new();
+    if let Some(p) = &s.profile {
+        for set in &p.settings {
+            values.insert(set.key.clone(), (set.value.clone(), set.line, &p.part));
+        }
+    }
+    let objects_part = s.objects_part.as_deref().unwrap_or_default();
+    for set in object_settings.unwrap_or_default() {
+        values.insert(set.key.clone(), (set.value.clone(), set.line, objects_part));
+    }
+    if layout == Layout::Orca {
+        super::host::add_prusa_names(&mut values, true);
+    }
+    let parts: BTreeMap<String, &str> = values.iter().map(|(k, v)| (k.clone(), v.2)).collect();
+    let pairs = values.into_iter().map(|(k, (v, l, _))| (k, v, l)).collect();
+    let (config, mut warnings) = from_lined_pairs(pairs).map_err(|e| match e {
+        ConfigError::Ini {
+            line,
+            key,
+            value,
+            message,
+            ..
+        } => ConfigError::Ini {
+            path: parts
+                .get(&key)
+                .map(|p| PathBuf::from(p.trim_start_matches('/'))),
+            line,
+            key,
+            value,
+            message,
+        },
+        other => other,
+    })?;
+    warnings.extend(unhonoured(s, object_settings.is_some()));
+    let source = match &s.profile {
+        Some(p) => format!(
+            "the {} profile ({}, {} settings)",
+            p.writer.as_deref().unwrap_or("slicer"),
+            p.part.trim_start_matches('/'),
+            p.settings.len()
+        ),
+        None => "the objects' settings".to_owned(),
+    };
+    let source = match object_settings {
+        Some(o) if s.profile.is_some() && !o.is_empty() => {
+            format!("{source} with the objects' own settings")
+        }
+        _ => source,
+    };
+    Ok(Some(Embedded {
+        config,
+        warnings,
+        source,
+    }))
+}
+
+/// The settings of `s` conduit does not honour besides the profile's: each object's own
+/// settings unless they were applied (`objects_applied`), and every volume's, one line per
+/// object or volume naming its keys by impact.
+pub fn unhonoured(s: &SlicerSettings, objects_applied: bool) -> Vec<String> {
+    let mut out = Vec::new();
+    for o in &s.objects {
+        let name = o.name.clone().unwrap_or_else(|| format!("object {}", o.id));
+        if !objects_applied && !o.settings.is_empty() {
+            out.push(format!(
+                "object \"{name}\": its own settings are not honoured (the objects' settings \
+                 differ and conduit slices every object with one profile): {}",
+                by_impact(&o.settings)
+            ));
+        }
+        for v in o.volumes.iter().filter(|v| !v.settings.is_empty()) {
+            let label = v
+                .name
+                .as_deref()
+                .map_or_else(String::new, |n| format!(" \"{n}\""));
+            out.push(format!(
+                "object \"{name}\": the settings of {}{label} are not honoured: {}",
+                v.kind.describe(),
+                by_impact(&v.settings)
+            ));
+        }
+    }
+    out
+}
+
+/// The objects' own settings when every object has the same ones (`Some(&[])` when none has
+/// any), `None` when they differ.
+fn shared_object_settings(objects: &[ObjectSettings]) -> Option<&[Setting]> {
+    fn key(o: &ObjectSettings) -> Vec<(&str, &str)> {
+        let mut kv: Vec<(&str, &str)> = o
+            .settings
+            .iter()
+            .map(|s| (s.key.as_str(), s.value.as_str()))
+            .collect();
+        kv.sort_unstable();
+        kv
+    }
+    let first = objects.first()?;
+    let same = objects.iter().all(|o| key(o) == key(first));
+    same.then_some(first.settings.as_slice())
+}
+
+/// The keys of `settings`, once each, sorted by [`impact`] then name.
+fn by_impact(settings: &[Setting]) -> String {
+    let mut keys: Vec<(u8, &str)> = settings
+        .iter()
+        .map(|s| (impact(&s.key, &s.value), s.key.as_str()))
+        .collect();
+    keys.sort_unstable();
+    keys.dedup_by(|a, b| a.1 == b.1);
+    keys.iter().map(|(_, k)| *k).collect::<Vec<_>>().join(", ")
+}
