@@ -649,8 +649,12 @@ pub fn slice_scene_watched(
             dropped: summaries.iter().map(|o| o.slice.open_chains_dropped).sum(),
         });
     }
-    let wipe_tower =
-        crate::toolpaths::add_wipe_tower(&mut program, &cfg.wipe_tower, &cfg.tower_machine())?;
+    // Every print speed is held to printer.max_print_speed, the tower's too.
+    let tower = crate::toolpaths::TowerParams {
+        speed: cfg.wipe_tower.speed.min(cfg.printer.max_print_speed),
+        ..cfg.wipe_tower.clone()
+    };
+    let wipe_tower = crate::toolpaths::add_wipe_tower(&mut program, &tower, &cfg.tower_machine())?;
     laps.lap(Stage::Program);
 
     progress(Stage::Emit);

@@ -73,8 +73,8 @@ pub struct TowerParams {
     /// Gap between the lines of the tower's sparse part, 1 to 50. Default 10 (PrusaSlicer's
     /// `wipe_tower_bridging`).
     pub sparse_spacing: f64,
-    /// Print speed on the tower, mm/s (the first layer at `slice.first_layer_speed`).
-    /// Default 40.
+    /// Print speed on the tower, mm/s, at most `printer.max_print_speed` (the first layer at
+    /// `slice.first_layer_speed`). Default 40.
     pub speed: f64,
 }
 
