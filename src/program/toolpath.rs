@@ -644,6 +644,7 @@ mod tests {
             };
             assert_eq!(back, Some(want));
         }
-        assert_eq!(Role::from_type_name("Wipe tower"), None);
+        assert_eq!(Role::WipeTower.type_name(), "Wipe tower");
+        assert_eq!(Role::from_type_name("Ironing"), None);
     }
 }
