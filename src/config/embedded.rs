@@ -61,23 +61,14 @@ pub fn from_3mf(s: &SlicerSettings) -> Result<Option<Embedded>, ConfigError> {
     }
     let parts: BTreeMap<String, &str> = values.iter().map(|(k, v)| (k.clone(), v.2)).collect();
     let pairs = values.into_iter().map(|(k, (v, l, _))| (k, v, l)).collect();
-    let (config, mut warnings) = from_lined_pairs(pairs).map_err(|e| match e {
-        ConfigError::Ini {
-            line,
-            key,
-            value,
-            message,
-            ..
-        } => ConfigError::Ini {
-            path: parts
-                .get(&key)
+    let (config, mut warnings) = from_lined_pairs(pairs).map_err(|e| {
+        let path = match &e {
+            ConfigError::Ini { key, .. } => parts
+                .get(key)
                 .map(|p| PathBuf::from(p.trim_start_matches('/'))),
-            line,
-            key,
-            value,
-            message,
-        },
-        other => other,
+            _ => None,
+        };
+        e.in_ini_file(path)
     })?;
     warnings.extend(unhonoured(s, object_settings.is_some()));
     let source = match &s.profile {

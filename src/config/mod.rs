@@ -514,6 +514,27 @@ impl ConfigError {
             message: explain(err.error.message().trim(), err.key.as_deref()),
         }
     }
+
+    /// This error with an `.ini` error's file set to `path` (the file the key was read from);
+    /// other errors as they are.
+    fn in_ini_file(self, path: Option<PathBuf>) -> Self {
+        match self {
+            Self::Ini {
+                line,
+                key,
+                value,
+                message,
+                ..
+            } => Self::Ini {
+                path,
+                line,
+                key,
+                value,
+                message,
+            },
+            other => other,
+        }
+    }
 }
 
 /// serde's message about the value of `key` in words: an unknown key as [`explain_unknown_key`]
@@ -596,22 +617,7 @@ pub fn load(path: &Path) -> Result<(Config, Vec<String>), ConfigError> {
         }
         Some("ini") => {
             let src = text()?;
-            prusa_ini::from_ini_str(&src).map_err(|e| match e {
-                ConfigError::Ini {
-                    line,
-                    key,
-                    value,
-                    message,
-                    ..
-                } => ConfigError::Ini {
-                    path: Some(path.to_path_buf()),
-                    line,
-                    key,
-                    value,
-                    message,
-                },
-                other => other,
-            })
+            prusa_ini::from_ini_str(&src).map_err(|e| e.in_ini_file(Some(path.to_path_buf())))
         }
         _ => Err(ConfigError::UnknownFormat {
             path: path.to_path_buf(),

@@ -341,6 +341,23 @@ fn band_depth(params: &TowerParams, bead: f64, height: f64) -> f64 {
     (params.purge_volume / (line_area * length)).ceil() * bead
 }
 
+/// The axis a zig-zag's lines run along.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Axis {
+    X,
+    Y,
+}
+
+/// Line `n` of a zig-zag whose lines run along `axis` between `ends` at `at` on the other axis:
+/// even lines from the first end to the second, odd lines back.
+fn zigzag_line(n: usize, ends: (f64, f64), at: f64, axis: Axis) -> [[f64; 2]; 2] {
+    let (a, b) = if n % 2 == 0 { ends } else { (ends.1, ends.0) };
+    match axis {
+        Axis::X => [[a, at], [b, at]],
+        Axis::Y => [[at, a], [at, b]],
+    }
+}
+
 /// Plastic in a path, mm³.
 fn volume(p: &Toolpath) -> f64 {
     p.length() * p.width * p.height
@@ -521,13 +538,7 @@ impl LayerBuilder {
             if y > back - bead / 2.0 + 1e-9 {
                 break;
             }
-            let (a, b) = if n % 2 == 0 {
-                (left, right)
-            } else {
-                (right, left)
-            };
-            points.push([a, y]);
-            points.push([b, y]);
+            points.extend(zigzag_line(n, (left, right), y, Axis::X));
             self.next_y += bead;
         }
         if points.len() < 2 {
@@ -550,13 +561,7 @@ impl LayerBuilder {
         let mut points = Vec::new();
         for n in 0..count {
             let x = left + n as f64 * step;
-            let (a, b) = if n % 2 == 0 {
-                (front, back)
-            } else {
-                (back, front)
-            };
-            points.push([x, a]);
-            points.push([x, b]);
+            points.extend(zigzag_line(n, (front, back), x, Axis::Y));
         }
         self.next_y = t.y1;
         vec![self.path(points, false, tool, bead)]
