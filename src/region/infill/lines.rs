@@ -6,8 +6,8 @@
 //! anchored at the origin, not at the area, so neighbouring areas (and the same area on other
 //! layers) share lines. A phase of ½ keeps lines off edges that sit on multiples of `S`.
 //!
-//! **Clipping.** The lines are clipped together, as one serpentine path whose hops between
-//! lines lie outside the area, with [`clip_polylines`].
+//! **Clipping.** The lines are clipped together in one scan-line sweep over the area's edges
+//! ([`super::scanline`]), which gives each piece its lattice line.
 //!
 //! **Connection.** Pieces are joined into zig-zags by links that run *along the area's
 //! boundary* between two piece ends that are neighbours on a ring (no other line meets the ring
@@ -26,9 +26,8 @@
 //! **Order.** Chains are then ordered greedily: after each, the nearest free end of any other
 //! comes next (ties go to the lower index, so output is deterministic).
 
-use crate::geom::{
-    ExPolygon, Point2, Polygon, Polyline, clip_polylines, scaled, segment_distance, segment_param,
-};
+use super::scanline::{Lattice, clip_lines};
+use crate::geom::{ExPolygon, Point2, Polygon, Polyline, scaled, segment_distance, segment_param};
 
 /// Longest connector, in line spacings (a boundary meeting the lines at 20° needs ~2.9).
 pub const CONNECT_LIMIT: f64 = 3.0;
@@ -81,47 +80,27 @@ pub fn fill_family(area: &[ExPolygon], family: LineFamily, connect: bool) -> Vec
         ((cos, sin), (-sin, cos))
     };
     let dot = |p: Point2, v: (f64, f64)| p.x as f64 * v.0 + p.y as f64 * v.1;
-    let (mut n_lo, mut n_hi, mut d_lo, mut d_hi) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    let (mut n_lo, mut n_hi) = (f64::MAX, f64::MIN);
     for p in area.iter().map(|e| &e.contour).flat_map(|c| &c.points) {
-        let (pn, pd) = (dot(*p, n), dot(*p, d));
-        (n_lo, n_hi, d_lo, d_hi) = (n_lo.min(pn), n_hi.max(pn), d_lo.min(pd), d_hi.max(pd));
+        let pn = dot(*p, n);
+        (n_lo, n_hi) = (n_lo.min(pn), n_hi.max(pn));
     }
     let k_lo = (n_lo / s - family.phase).ceil();
     let k_hi = (n_hi / s - family.phase).floor();
     if k_hi < k_lo || k_hi - k_lo > MAX_LINES {
         return Vec::new();
     }
-    // Extend past the area so clipping, not rounding, makes the ends.
-    let (t0, t1) = (d_lo - s, d_hi + s);
-    let at = |c: f64, t: f64| {
-        Point2::new(
-            (c * n.0 + t * d.0).round() as i64,
-            (c * n.1 + t * d.1).round() as i64,
-        )
+    let lattice = Lattice {
+        d,
+        n,
+        spacing: s,
+        phase: family.phase,
     };
-    // All lines as one serpentine: line k runs t0 → t1 when k is even, t1 → t0 when odd, and the
-    // hops between lines run outside the area (at t0 or t1), so clipping drops them. One clip of
-    // one path costs O((E + L) log) instead of L clips of O(E log E) each.
-    let serpentine: Vec<Point2> = (k_lo as i64..=k_hi as i64)
-        .flat_map(|k| {
-            let c = (k as f64 + family.phase) * s;
-            let (from, to) = if k.rem_euclid(2) == 0 {
-                (t0, t1)
-            } else {
-                (t1, t0)
-            };
-            [at(c, from), at(c, to)]
-        })
-        .collect();
-    let pieces: Vec<Piece> = clip_polylines(&[Polyline { points: serpentine }], area)
+    let pieces: Vec<Piece> = clip_lines(area, &lattice, k_lo as i64, k_hi as i64)
         .into_iter()
-        .filter(|p| p.points.len() >= 2 && p.points[0] != p.points[p.points.len() - 1])
-        .map(|p| {
-            let line = (dot(p.points[0], n) / s - family.phase).round() as i64;
-            Piece {
-                points: p.points,
-                line,
-            }
+        .map(|span| Piece {
+            points: span.points.to_vec(),
+            line: span.line,
         })
         .collect();
     let pieces = if connect {

@@ -1,8 +1,8 @@
 //! Infill patterns: one file per pattern behind [`InfillPattern`], on shared line machinery.
 //!
 //! Every pattern here is made of straight lines on a lattice anchored at the origin
-//! ([`lines`]): generated in scaled integer coordinates, clipped to the area with
-//! [`crate::geom::clip_polylines`], joined into zig-zags by links along the area's boundary
+//! ([`lines`]): generated in scaled integer coordinates, clipped to the area in one scan-line
+//! sweep ([`scanline`]), joined into zig-zags by links along the area's boundary
 //! (around holes too) and ordered nearest-first.
 //!
 //! The area handed to a pattern is where line *centrelines* may go (see
@@ -23,6 +23,7 @@
 mod grid;
 pub mod lines;
 mod rectilinear;
+mod scanline;
 mod triangles;
 
 pub use grid::Grid;
