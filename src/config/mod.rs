@@ -1049,6 +1049,15 @@ impl Config {
         }
     }
 
+    /// The wipe tower's settings as printed: `[wipe_tower]` with its speed held to
+    /// `printer.max_print_speed`, like every print speed.
+    pub fn tower_params(&self) -> crate::toolpaths::TowerParams {
+        crate::toolpaths::TowerParams {
+            speed: self.wipe_tower.speed.min(self.printer.max_print_speed),
+            ..self.wipe_tower.clone()
+        }
+    }
+
     /// What the wipe tower pass needs of the machine: the bed, which tools are filament tools,
     /// their bead width on the tower (`slice.infill_width`) and the first layer's speed.
     pub fn tower_machine(&self) -> crate::toolpaths::TowerMachine {

@@ -649,12 +649,8 @@ pub fn slice_scene_watched(
             dropped: summaries.iter().map(|o| o.slice.open_chains_dropped).sum(),
         });
     }
-    // Every print speed is held to printer.max_print_speed, the tower's too.
-    let tower = crate::toolpaths::TowerParams {
-        speed: cfg.wipe_tower.speed.min(cfg.printer.max_print_speed),
-        ..cfg.wipe_tower.clone()
-    };
-    let wipe_tower = crate::toolpaths::add_wipe_tower(&mut program, &tower, &cfg.tower_machine())?;
+    let wipe_tower =
+        crate::toolpaths::add_wipe_tower(&mut program, &cfg.tower_params(), &cfg.tower_machine())?;
     laps.lap(Stage::Program);
 
     progress(Stage::Emit);

@@ -211,8 +211,7 @@ pub fn add_wipe_tower(
     if !params.enabled {
         return Ok(None);
     }
-    let mut plans = plan(program);
-    keep_filament(&mut plans, machine);
+    let plans = plan(program, machine);
     let Some(top) = plans.iter().rposition(|p| !p.purges.is_empty()) else {
         return Ok(None);
     };
@@ -298,9 +297,10 @@ pub fn add_wipe_tower(
     Ok(Some(summary))
 }
 
-/// Each layer's changes to a filament tool and its first tool. A layer's first tool is the one
-/// active when it starts: the previous layer's last, or the program's first tool.
-fn plan(program: &Program) -> Vec<LayerPlan> {
+/// Each layer's changes to a filament tool (the machine's tool kinds decide which changes
+/// purge) and its first tool. A layer's first tool is the one active when it starts: the
+/// previous layer's last, or the program's first tool.
+fn plan(program: &Program, machine: &TowerMachine) -> Vec<LayerPlan> {
     let mut active = program.first_tool();
     let mut plans = Vec::with_capacity(program.layers.len());
     for layer in &program.layers {
@@ -310,7 +310,9 @@ fn plan(program: &Program) -> Vec<LayerPlan> {
             match item {
                 LayerItem::Event(Event::ToolChange { tool }) => {
                     active = Some(*tool);
-                    purges.push((i, *tool));
+                    if machine.is_filament(*tool) {
+                        purges.push((i, *tool));
+                    }
                 }
                 LayerItem::Path(p) if active.is_none() => active = Some(p.tool),
                 _ => {}
@@ -319,13 +321,6 @@ fn plan(program: &Program) -> Vec<LayerPlan> {
         plans.push(LayerPlan { purges, first_tool });
     }
     plans
-}
-
-/// Filament tools only: the caller's tool kinds decide which changes purge.
-fn keep_filament(plans: &mut [LayerPlan], machine: &TowerMachine) {
-    for plan in plans {
-        plan.purges.retain(|&(_, tool)| machine.is_filament(tool));
-    }
 }
 
 /// Depth along Y of a band of `purge_volume` in lines of `bead` at `height`, mm: whole lines.
