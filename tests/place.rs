@@ -189,6 +189,76 @@ fn every_corpus_board_is_placed_from_its_board_and_slices() {
     }
 }
 
+/// OpenLog laid out as its first summary suggests routes every wire: the summary names the
+/// TQFP's 0.8 mm pitch and the widest trace that fits between its pins, the scale suggested is
+/// the one for that width, and slicing with both leaves no wire unrouted.
+#[test]
+fn openlog_laid_out_as_the_summary_suggests_routes_every_wire() {
+    let Some(corpus) = corpus() else {
+        return;
+    };
+    let dir = temp_dir();
+    let d = dir.path();
+    let brd = eagle_file(&corpus, "OpenLog", "brd");
+    let model = block(d, "block", [150.0, 150.0, 6.0]);
+    let out = d.join("openlog.toml");
+    let (_, first, err) = place_into(&model, &out, &["--from-brd".as_ref(), brd.as_os_str()]);
+    let fine = &first["fine_pitch"];
+    assert_eq!(fine["part"], "U1", "{first} {err}");
+    let distance = fine["distance_mm"].as_f64().expect("distance");
+    assert!((distance - 0.8).abs() < 1e-6, "{fine}");
+    assert!(
+        fine["spacing_mm"].as_f64().expect("spacing") > distance,
+        "{fine}"
+    );
+    // 0.55 mm traces keep the spacing the default 0.6 mm ones break at this pitch.
+    let width = fine["suggested_width_mm"].as_f64().expect("width");
+    assert!((width - 0.55).abs() < 1e-9, "{fine}");
+    assert!(
+        (first["room_mm"]["trace"].as_f64().expect("room") - (width + 2.0 * 0.2)).abs() < 1e-9,
+        "{first}"
+    );
+    let scale = first["suggested_scale"].as_f64().expect("a scale");
+    let set_width = format!("route.conductive_width={width}");
+    let scale = format!("{scale}");
+    let (code, summary, err) = place_into(
+        &model,
+        &out,
+        &[
+            "--from-brd".as_ref(),
+            brd.as_os_str(),
+            "--scale".as_ref(),
+            scale.as_ref(),
+            "--set".as_ref(),
+            set_width.as_ref(),
+        ],
+    );
+    assert_eq!(code, Some(0), "{summary} {err}");
+    let report = d.join("report.json");
+    let o = conduit([
+        "slice".as_ref(),
+        model.as_os_str(),
+        "--circuit".as_ref(),
+        brd.as_os_str(),
+        "--placement".as_ref(),
+        out.as_os_str(),
+        "-o".as_ref(),
+        d.join("openlog.gcode").as_os_str(),
+        "--report".as_ref(),
+        report.as_os_str(),
+        "--set".as_ref(),
+        set_width.as_ref(),
+        "-q".as_ref(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let e = &report["electronics"];
+    assert_eq!(e["unrouted"], 0, "{}", e["wires"]);
+    assert_eq!(e["routed"], 46);
+    assert_eq!(e["warnings"], Value::Array(Vec::new()));
+}
+
 /// The layout is the board's, moved, turned and spread as asked: between any two parts the
 /// offset is the board's offset turned by `--rotate` and multiplied by `--scale`, each part
 /// turns by `--rotate`, and `--at` moves every part by the same amount.

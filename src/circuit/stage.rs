@@ -926,10 +926,26 @@ fn total_up(report: &mut ElectronicsReport) {
         .sum();
 }
 
-/// A warning when two connected pads of different nets on `part` are closer than two traces
-/// of different nets may run ([`min_trace_spacing`]): traces cannot reach both. Names the
-/// closest such pair.
-fn pitch_warning(part: &PlacedPart, params: &RouteParams) -> Option<String> {
+/// Two pads of different nets on one part closer than two traces of different nets may run
+/// ([`min_trace_spacing`]): at the configured width, traces cannot reach both.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FinePitch {
+    /// The part's name.
+    pub part: String,
+    /// The two pads (pad names), the closest such pair of the part.
+    pub pads: [String; 2],
+    /// Distance between the pads' centres, mm.
+    pub distance: f64,
+    /// The spacing two traces need at the configured width, mm.
+    pub spacing: f64,
+    /// The widest `route.conductive_width`, in 0.05 mm steps, whose traces may run
+    /// `distance` apart.
+    pub width: f64,
+}
+
+/// The closest pair of connected pads of different nets on `part` that two traces of
+/// different nets cannot both reach at `params`' width, if any.
+pub fn fine_pitch(part: &PlacedPart, params: &RouteParams) -> Option<FinePitch> {
     let spacing = min_trace_spacing(params);
     let mut closest: Option<(f64, &str, &str)> = None;
     for (i, a) in part.pads.iter().enumerate() {
@@ -946,15 +962,30 @@ fn pitch_warning(part: &PlacedPart, params: &RouteParams) -> Option<String> {
             }
         }
     }
-    closest.map(|(d, a, b)| {
+    closest.map(|(distance, a, b)| FinePitch {
+        part: part.name.clone(),
+        pads: [a.to_owned(), b.to_owned()],
+        distance,
+        spacing,
+        width: fitting_width(distance, params),
+    })
+}
+
+/// A warning naming `part`'s [`fine_pitch`] pads, if any.
+fn pitch_warning(part: &PlacedPart, params: &RouteParams) -> Option<String> {
+    fine_pitch(part, params).map(|f| {
         format!(
             "pads {p}.{a} and {p}.{b} are {d:.2} mm apart, closer than two traces can run \
              ({spacing:.2} mm with route.conductive_width {w} and route.channel_extra {x}): \
              their nets cannot both be routed; a conductive_width of {max:.2} mm fits",
-            p = part.name,
+            p = f.part,
+            a = f.pads[0],
+            b = f.pads[1],
+            d = f.distance,
+            spacing = f.spacing,
             w = params.conductive_width,
             x = params.channel_extra,
-            max = fitting_width(d, params),
+            max = f.width,
         )
     })
 }

@@ -148,6 +148,13 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
             "closest_pads": closest,
             "room_mm": { "trace": o.room.trace, "parts": o.room.parts },
             "suggested_scale": o.suggested_scale,
+            "fine_pitch": o.fine_pitch.as_ref().map(|f| serde_json::json!({
+                "part": f.part,
+                "pads": f.pads,
+                "distance_mm": f.distance,
+                "spacing_mm": f.spacing,
+                "suggested_width_mm": f.width,
+            })),
         }));
     }
     let planes: Vec<String> = o.planes.iter().map(|z| format!("z {z:.3} mm")).collect();
@@ -168,7 +175,22 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
         };
         outln!("closest pads of different nets: {gap:.2} mm ({a}, {b}), {verdict} ({need:.2} mm)")?;
     }
+    if let Some(f) = &o.fine_pitch {
+        outln!(
+            "pads {p}.{a} and {p}.{b} are {d:.2} mm apart, closer than two traces can run \
+             ({s:.2} mm): route with --set route.conductive_width={w:.2}, the widest that fits",
+            p = f.part,
+            a = f.pads[0],
+            b = f.pads[1],
+            d = f.distance,
+            s = f.spacing,
+            w = f.width,
+        )?;
+    }
     if args.from_brd.is_some() || args.from_pcb.is_some() {
+        let width = o.fine_pitch.as_ref().map_or(String::new(), |f| {
+            format!(" at route.conductive_width {:.2}", f.width)
+        });
         let scale = match o.suggested_scale {
             Some(s) if (s - args.scale).abs() < 1e-9 => format!("--scale {s:.2} is the smallest"),
             Some(s) => format!("try --scale {s:.2}, the smallest"),
@@ -179,7 +201,7 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
         };
         outln!(
             "{scale} that leaves {:.2} mm between pads of different nets and {:.2} mm between \
-             parts (route.conductive_width, channel_extra, cavity_offset, wall_clearance)",
+             parts{width} (route.conductive_width, channel_extra, cavity_offset, wall_clearance)",
             o.room.trace,
             o.room.parts
         )?;

@@ -14,7 +14,7 @@ use crate::circuit::board_layout::{
 };
 use crate::circuit::fit::{FitParams, placement_problems};
 use crate::circuit::placement_toml::placement_toml;
-use crate::circuit::stage::place_circuit;
+use crate::circuit::stage::{FinePitch, fine_pitch, place_circuit};
 use crate::circuit::{Circuit, Electronics, Placement, PlacementError};
 use crate::config::Config;
 use crate::geom::{BoundingBox, ExPolygon};
@@ -85,8 +85,12 @@ pub struct PlaceOutcome {
     /// The room wanted between pads and between parts.
     pub room: Room,
     /// For a board layout: the smallest scale giving every pad pair and every part pair its
-    /// room.
+    /// room (at the width of `fine_pitch` when there is one).
     pub suggested_scale: Option<f64>,
+    /// The part whose pads of different nets lie closest for the configured trace width, when
+    /// two traces cannot reach them both: its pair of pads and the widest trace that fits
+    /// (the narrowest such width over all parts).
+    pub fine_pitch: Option<FinePitch>,
 }
 
 /// Why no placement could be made.
@@ -400,8 +404,14 @@ pub fn place_from_board(
         solid.check_plane(z)?;
     }
     layout.placement.source = source;
-    let room = room(cfg);
-    let suggested_scale = suggest_scale(board, circuit, &params, room);
+    // Traces narrow enough for the finest pitch need less room between parts too: the scale
+    // suggested is the one for the width suggested, so that following both routes.
+    let fine = layout_fine_pitch(circuit, &layout.placement, cfg);
+    let mut narrowed = cfg.clone();
+    if let Some(f) = &fine {
+        narrowed.route.conductive_width = narrowed.route.conductive_width.min(f.width);
+    }
+    let suggested_scale = suggest_scale(board, circuit, &params, room(&narrowed));
     let header = vec![
         format!(
             "Board layout: centre at x {:.3}, y {:.3} mm, turned {} deg, scale {}; edit freely.",
@@ -435,7 +445,27 @@ pub fn place_from_board(
     let mut outcome = check(&solid, cfg, circuit, toml, planes)?;
     outcome.left_out = layout.left_out;
     outcome.suggested_scale = suggested_scale;
+    if fine.is_some() {
+        outcome.room = room(&narrowed);
+    }
+    outcome.fine_pitch = fine;
     Ok(outcome)
+}
+
+/// The [`FinePitch`] of the parts of `placement` that asks for the narrowest trace (ties: the
+/// closest pads, then the part's name), at `cfg`'s route settings.
+fn layout_fine_pitch(circuit: &Circuit, placement: &Placement, cfg: &Config) -> Option<FinePitch> {
+    let parts = crate::circuit::board_layout::placed_parts(circuit, placement)?;
+    let params = cfg.electronics_params().route;
+    parts
+        .iter()
+        .filter_map(|p| fine_pitch(p, &params))
+        .min_by(|a, b| {
+            a.width
+                .total_cmp(&b.width)
+                .then(a.distance.total_cmp(&b.distance))
+                .then_with(|| a.part.cmp(&b.part))
+        })
 }
 
 /// The room a trace needs between two pads of different nets (`route.conductive_width` and
@@ -543,5 +573,6 @@ fn check(
         closest_pads,
         room: room(cfg),
         suggested_scale: None,
+        fine_pitch: None,
     })
 }
