@@ -72,6 +72,7 @@
 
 pub mod estimate;
 mod flavor;
+pub mod macros;
 mod params;
 mod sink;
 mod template;
