@@ -657,11 +657,8 @@ impl Rule {
             }
             Rule::Gcode(field) => {
                 if let Some(g) = p.gcode(key) {
-                    if has_macros(&g) {
-                        imp.warnings.push(format!(
-                            "{key} uses PrusaSlicer macros ({{if …}} or expressions) that conduit \
-                             cannot fill; edit printer.{key}"
-                        ));
+                    if let Some(w) = syntax_warning(key, &format!("printer.{key}"), &g) {
+                        imp.warnings.push(w);
                     }
                     *field(cfg) = g;
                 }
@@ -703,8 +700,12 @@ fn convert(
     }
     warn_ignored(&mut imp);
     let Import {
-        cfg, mut warnings, ..
+        mut cfg,
+        mut warnings,
+        p,
     } = imp;
+    // Every key as written, for the templates' macros (`{filament_type[0]}`, `{z_offset}`).
+    cfg.printer.profile = p.values.into_iter().map(|(k, (v, _))| (k, v)).collect();
     let more = cfg.validate()?;
     warnings.extend(more);
     Ok((cfg, warnings))
@@ -848,12 +849,8 @@ fn gcode_flavor(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
 fn toolchange_gcode(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     if let Some(g) = imp.p.gcode(key) {
         let g = tool_placeholders(&g);
-        if has_macros(&g) {
-            imp.warnings.push(
-                "toolchange_gcode uses PrusaSlicer macros ({if …} or expressions) that conduit \
-                 cannot fill; edit printer.before_tool_change_gcode"
-                    .to_owned(),
-            );
+        if let Some(w) = syntax_warning(key, "printer.before_tool_change_gcode", &g) {
+            imp.warnings.push(w);
         }
         imp.cfg.printer.before_tool_change_gcode = g;
     }
@@ -1298,16 +1295,12 @@ fn tool_placeholders(g: &str) -> String {
     out
 }
 
-/// True when a template has `{…}` that is not a plain `{key}` / `{key[N]}` placeholder.
-fn has_macros(g: &str) -> bool {
-    g.split('{').skip(1).any(|part| {
-        let inner = part.split('}').next().unwrap_or_default();
-        let name = inner
-            .strip_suffix(']')
-            .and_then(|n| n.split_once('['))
-            .map_or(inner, |(k, _)| k);
-        !part.contains('}') || !name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')
-    })
+/// A warning when the G-code `g` of `key` (conduit's `field`) does not parse as PrusaSlicer's
+/// macro language; the G-code is kept, and writing it fails with the same error.
+fn syntax_warning(key: &str, field: &str, g: &str) -> Option<String> {
+    crate::emit::gcode::macros::check_syntax(g)
+        .err()
+        .map(|e| format!("{key}: {e}; edit {field}"))
 }
 
 #[cfg(test)]
@@ -1525,7 +1518,10 @@ gcode_comments = 0
         );
         let all = warnings.join("\n");
         assert!(all.contains("gyroid") && all.contains("monotonic"), "{all}");
-        assert!(all.contains("start_gcode uses PrusaSlicer macros"), "{all}");
+        assert!(
+            all.contains("start_gcode: line 3: syntax error: missing {endif} in {if x}; edit printer.start_gcode"),
+            "{all}"
+        );
         assert!(
             all.contains(
                 "2 PrusaSlicer keys ignored (none that change the print); all of them: \
@@ -1616,11 +1612,14 @@ gcode_comments = 0
             "G1 Z{layer_z} ; from {previous_tool}\nT{next_tool}"
         );
         assert!(warnings.is_empty(), "{warnings:?}");
+        // Macros parse: no warning; a syntax error is named with its line.
         let (_, warnings) = from_ini_str("toolchange_gcode = {if next_extruder==1}T1{endif}\n")?;
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let (_, warnings) = from_ini_str("toolchange_gcode = T{next_extruder}\\n{1 +}\n")?;
         assert!(
-            warnings
-                .iter()
-                .any(|w| w.starts_with("toolchange_gcode uses")),
+            warnings.iter().any(|w| w.starts_with(
+                "toolchange_gcode: line 2: syntax error: expected an expression in {1 +}"
+            )),
             "{warnings:?}"
         );
         Ok(())
