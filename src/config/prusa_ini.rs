@@ -63,6 +63,12 @@
 //!   (solid) infill, 1 × nozzle for top solid infill. A first-layer width of 0 means each role's
 //!   own width; conduit has one first-layer width and takes the perimeter width.
 //!
+//! The G-code snippets (`start_gcode`, `end_gcode`, `toolchange_gcode`) keep PrusaSlicer's
+//! macros, which the G-code writer fills (`emit::gcode::macros`); one that does not parse is
+//! named in a warning. Every key of the profile, read or not, is kept as written in
+//! `printer.profile`, where those macros find what conduit has no field for
+//! (`{filament_type[0]}`, `{z_offset}`).
+//!
 //! Every other key is listed, once, in a warning as ignored — among them `max_print_speed`,
 //! which in PrusaSlicer only limits automatic speeds while conduit's clamps every speed. The
 //! warning counts them and names first those that change what is printed (a curated list:
@@ -844,11 +850,10 @@ fn gcode_flavor(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
 }
 
 /// `toolchange_gcode`: PrusaSlicer's tool-change G-code runs before each tool change, as
-/// conduit's `before_tool_change_gcode` does; its extruder placeholders are conduit's tool
-/// ones.
+/// conduit's `before_tool_change_gcode` does; it is kept as written (the templates know
+/// `next_extruder` and `previous_extruder` as the writer's `next_tool` and `previous_tool`).
 fn toolchange_gcode(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     if let Some(g) = imp.p.gcode(key) {
-        let g = tool_placeholders(&g);
         if let Some(w) = syntax_warning(key, "printer.before_tool_change_gcode", &g) {
             imp.warnings.push(w);
         }
@@ -1279,22 +1284,6 @@ fn parse_xy(s: &str) -> Option<[f64; 2]> {
     Some([x.trim().parse().ok()?, y.trim().parse().ok()?])
 }
 
-/// `g` with PrusaSlicer's extruder placeholders (`{next_extruder}`, `[next_extruder]`,
-/// `{previous_extruder}`, `[previous_extruder]`) written as conduit's `{next_tool}` and
-/// `{previous_tool}`.
-fn tool_placeholders(g: &str) -> String {
-    let mut out = g.to_owned();
-    for (prusa, conduit) in [
-        ("next_extruder", "{next_tool}"),
-        ("previous_extruder", "{previous_tool}"),
-    ] {
-        out = out
-            .replace(&format!("{{{prusa}}}"), conduit)
-            .replace(&format!("[{prusa}]"), conduit);
-    }
-    out
-}
-
 /// A warning when the G-code `g` of `key` (conduit's `field`) does not parse as PrusaSlicer's
 /// macro language; the G-code is kept, and writing it fails with the same error.
 fn syntax_warning(key: &str, field: &str, g: &str) -> Option<String> {
@@ -1306,6 +1295,7 @@ fn syntax_warning(key: &str, field: &str, g: &str) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::emit::gcode::macros::{Value, Var};
 
     const BENCH_INI: &str = concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -1609,9 +1599,27 @@ gcode_comments = 0
         )?;
         assert_eq!(
             cfg.printer.before_tool_change_gcode,
-            "G1 Z{layer_z} ; from {previous_tool}\nT{next_tool}"
+            "G1 Z{layer_z} ; from [previous_extruder]\nT{next_extruder}"
         );
         assert!(warnings.is_empty(), "{warnings:?}");
+        let vars = [
+            ("previous_tool", Var::Scalar(Value::Int(0))),
+            ("next_tool", Var::Scalar(Value::Int(1))),
+            ("layer_z", Var::Scalar(Value::Float(0.6))),
+        ];
+        assert_eq!(
+            cfg.render_template(&cfg.printer.before_tool_change_gcode, 0, &vars)?,
+            "G1 Z0.6 ; from 0\nT1"
+        );
+        // The indexed form inside an expression, as PrusaSlicer's XL profile writes it.
+        let (cfg, _) = from_ini_str(
+            "first_layer_temperature = 215,240\n\
+             toolchange_gcode = M109 S{first_layer_temperature[next_extruder] - 5}\n",
+        )?;
+        assert_eq!(
+            cfg.render_template(&cfg.printer.before_tool_change_gcode, 0, &vars)?,
+            "M109 S235"
+        );
         // Macros parse: no warning; a syntax error is named with its line.
         let (_, warnings) = from_ini_str("toolchange_gcode = {if next_extruder==1}T1{endif}\n")?;
         assert!(warnings.is_empty(), "{warnings:?}");
