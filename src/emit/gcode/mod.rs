@@ -114,8 +114,8 @@ pub enum EmitError {
     /// `conduit config --defaults` lists the keys. The writer provides `{previous_tool}`,
     /// `{next_tool}`, `{layer_num}` and `{layer_z}` in tool-change templates; `{initial_tool}`,
     /// `{initial_extruder}`, `{total_layer_count}`, `{max_layer_z}`, `{has_wipe_tower}`,
-    /// `{is_extruder_used[N]}` and `{first_layer_print_min}` / `_max` / `_size` in the start
-    /// G-code; `{layer_num}`, `{layer_z}` and `{max_layer_z}` in the end G-code.
+    /// `{is_extruder_used[N]}` and `{first_layer_print_min}` / `_max` / `_size` from the start
+    /// G-code on; `{layer_num}` and `{layer_z}` in the end G-code.
     #[error("{template}, {error}")]
     Template {
         /// Which template (`printer.start_gcode`, `tools.1.paste_on_gcode`, ...).

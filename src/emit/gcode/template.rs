@@ -13,7 +13,8 @@
 //! last among the names derived from these: `print_bed_min`, `print_bed_max`,
 //! `print_bed_size` (the bed's corners and size), `current_extruder` (the current tool),
 //! `next_extruder` / `previous_extruder` (the writer's `next_tool` / `previous_tool`),
-//! `num_extruders` (the filament tools) and `filament_type` (the tools' names).
+//! `num_extruders` (the filament tools), `filament_type` (the tools' names) and
+//! `has_single_extruder_multi_material_priming` (a wipe tower and the profile's priming on).
 //!
 //! Place in the pipeline: inside the G-code writer, which fills every template it writes; the
 //! `[slice]` keys come from [`GcodeParams::template_keys`].
@@ -129,6 +130,20 @@ impl Scope<'_> {
                     .filter(|t| t.kind == ToolKind::Filament)
                     .count(),
             )),
+            // PrusaSlicer: a wipe tower with single-extruder priming on.
+            "has_single_extruder_multi_material_priming" => {
+                let tower = match caller("has_wipe_tower") {
+                    Some(Var::Scalar(v)) => v.truth().unwrap_or(false),
+                    _ => false,
+                };
+                let priming = self
+                    .params
+                    .printer
+                    .profile
+                    .get("single_extruder_multi_material_priming")
+                    .is_some_and(|v| v.trim() == "1");
+                Var::Scalar(Value::Bool(tower && priming))
+            }
             "filament_type" => Var::Vector(
                 self.params
                     .tools

@@ -135,6 +135,9 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     /// The next travel stays inside the internal infill ([`Event::TravelInsideInfill`]): no
     /// retraction for it.
     travel_inside: bool,
+    /// The template variables that describe the whole print ([`print_variables`]), set by
+    /// [`Self::start`] and given to every later template, as PrusaSlicer keeps them.
+    print_vars: Vec<(&'static str, Var)>,
 }
 
 impl<'a, S: GcodeSink> Writer<'a, S> {
@@ -209,6 +212,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             layer_fan: 0.0,
             switch: switched::SwitchState::default(),
             travel_inside: false,
+            print_vars: Vec::new(),
         })
     }
 
@@ -633,12 +637,13 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             return Ok(());
         };
         self.retract();
-        let vars = [
+        let mut vars = vec![
             ("previous_tool", scalar(old)),
             ("next_tool", scalar(tool)),
             ("layer_num", scalar(self.layer_index)),
             ("layer_z", scalar(self.layer_z)),
         ];
+        vars.extend(self.print_vars.iter().cloned());
         let before = render(
             self.cfg,
             "printer.before_tool_change_gcode",
@@ -731,13 +736,16 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         let cfg = self.cfg;
         let layers = program.layers.len();
         let max_z = max_layer_z(program);
-        let mut vars = vec![
+        self.print_vars = print_variables(program, cfg.tools.len());
+        self.print_vars.extend([
             ("initial_tool", scalar(first_tool)),
             ("initial_extruder", scalar(first_tool)),
             ("total_layer_count", scalar(layers)),
             ("max_layer_z", scalar(max_z)),
-        ];
-        vars.extend(start_variables(program, cfg.tools.len()));
+        ]);
+        let mut vars = self.print_vars.clone();
+        // PrusaSlicer's current z-hop: none before the print.
+        vars.push(("zhop", scalar(0.0)));
         let start = render(
             cfg,
             "printer.start_gcode",
@@ -1170,18 +1178,19 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         let cfg = self.cfg;
         self.retract();
         let tool = self.tool.unwrap_or(0);
+        let mut vars = vec![
+            ("layer_num", scalar(self.layer_index)),
+            // As PrusaSlicer: where the nozzle is, a lift after the last retraction included.
+            ("layer_z", scalar(self.z.unwrap_or(self.layer_z))),
+            ("max_layer_z", scalar(max_layer_z(program))),
+        ];
+        vars.extend(self.print_vars.iter().cloned());
         let end = render(
             cfg,
             "printer.end_gcode",
             &cfg.printer.end_gcode,
             tool,
-            &[
-                ("layer_num", scalar(self.layer_index)),
-                // As PrusaSlicer: where the nozzle is, a lift after the last retraction
-                // included.
-                ("layer_z", scalar(self.z.unwrap_or(self.layer_z))),
-                ("max_layer_z", scalar(max_layer_z(program))),
-            ],
+            &vars,
         )?;
         self.line(";TYPE:Custom");
         self.lines(&end);
@@ -1240,13 +1249,14 @@ fn max_layer_z(program: &Program) -> f64 {
     program.layers.iter().map(|l| l.z).fold(0.0, f64::max)
 }
 
-/// The start G-code's variables that describe the print, as PrusaSlicer names them:
+/// The template variables that describe the print, as PrusaSlicer names them (set before the
+/// start G-code and kept for every later template):
 /// `first_layer_print_min`, `_max` and `_size` (the bounding box of the material the first
 /// layer lays down: every path's centre line grown by half its width, skirt, brim and wipe
 /// tower included, close to PrusaSlicer's hull of the layer's outlines; zeros without any),
 /// `is_extruder_used` (one flag per tool, and false up to tool 255 as in PrusaSlicer, since an
 /// index past a vector's end reads element 0) and `has_wipe_tower`.
-fn start_variables(program: &Program, tools: usize) -> Vec<(&'static str, Var)> {
+fn print_variables(program: &Program, tools: usize) -> Vec<(&'static str, Var)> {
     let mut min = [f64::INFINITY; 2];
     let mut max = [f64::NEG_INFINITY; 2];
     for p in program.layers.first().into_iter().flat_map(|l| l.paths()) {
