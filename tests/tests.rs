@@ -30,6 +30,7 @@ mod postprocess;
 mod postprocess_e2e;
 mod postprocess_octopnp;
 mod preview;
+mod prusa_macros;
 mod regressions_conform;
 mod regressions_route;
 mod regressions_slice;

@@ -65,7 +65,8 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::check::CheckParams;
 use crate::curved::CurvedParams;
-use crate::emit::gcode::{GcodeParams, SwitchedParams, UnknownPlaceholder};
+use crate::emit::gcode::macros::Var;
+use crate::emit::gcode::{GcodeParams, SwitchedParams, TemplateError};
 use crate::program::Role;
 pub use crate::program::machine::{
     DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, PnpSettings, Printer, Tool, ToolKind,
@@ -471,15 +472,14 @@ pub enum ConfigError {
         /// Every problem found.
         problems: Vec<String>,
     },
-    /// A G-code template has a placeholder that is not a config key.
+    /// A G-code template cannot be filled: a placeholder that is not a config key, a profile key
+    /// or a variable the caller gives, or a macro with a syntax or type error.
     ///
     /// How to fix: use `{key}` with a `printer` or `slice` key, `{key[N]}` with a tool key (or an
-    /// array such as `bed_size[0]`), or one of the variables the caller documents.
-    #[error("G-code template: unknown placeholder {{{placeholder}}}")]
-    Template {
-        /// The placeholder's text without braces.
-        placeholder: String,
-    },
+    /// array such as `bed_size[0]`), a key of the imported profile, or one of the variables the
+    /// caller documents; correct the macro on the named line.
+    #[error("G-code template, {0}")]
+    Template(TemplateError),
 }
 
 /// `message` about `key`: `slice.layer_height must be …` when the message says what the value
@@ -1126,11 +1126,11 @@ impl Config {
         &self,
         template: &str,
         tool: usize,
-        vars: &[(&str, String)],
+        vars: &[(&str, Var)],
     ) -> Result<String, ConfigError> {
         self.gcode_params()
             .render_template(template, tool, vars)
-            .map_err(|UnknownPlaceholder(placeholder)| ConfigError::Template { placeholder })
+            .map_err(ConfigError::Template)
     }
 
     /// Applies one `KEY=VALUE` override, as given to `--set`: `KEY` is a dotted path into the

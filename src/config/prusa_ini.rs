@@ -63,6 +63,12 @@
 //!   (solid) infill, 1 × nozzle for top solid infill. A first-layer width of 0 means each role's
 //!   own width; conduit has one first-layer width and takes the perimeter width.
 //!
+//! The G-code snippets (`start_gcode`, `end_gcode`, `toolchange_gcode`) keep PrusaSlicer's
+//! macros, which the G-code writer fills (`emit::gcode::macros`); one that does not parse is
+//! named in a warning. Every key of the profile, read or not, is kept as written in
+//! `printer.profile`, where those macros find what conduit has no field for
+//! (`{filament_type[0]}`, `{z_offset}`).
+//!
 //! Every other key is listed, once, in a warning as ignored — among them `max_print_speed`,
 //! which in PrusaSlicer only limits automatic speeds while conduit's clamps every speed. The
 //! warning counts them and names first those that change what is printed (a curated list:
@@ -657,11 +663,8 @@ impl Rule {
             }
             Rule::Gcode(field) => {
                 if let Some(g) = p.gcode(key) {
-                    if has_macros(&g) {
-                        imp.warnings.push(format!(
-                            "{key} uses PrusaSlicer macros ({{if …}} or expressions) that conduit \
-                             cannot fill; edit printer.{key}"
-                        ));
+                    if let Some(w) = syntax_warning(key, &format!("printer.{key}"), &g) {
+                        imp.warnings.push(w);
                     }
                     *field(cfg) = g;
                 }
@@ -703,8 +706,12 @@ fn convert(
     }
     warn_ignored(&mut imp);
     let Import {
-        cfg, mut warnings, ..
+        mut cfg,
+        mut warnings,
+        p,
     } = imp;
+    // Every key as written, for the templates' macros (`{filament_type[0]}`, `{z_offset}`).
+    cfg.printer.profile = p.values.into_iter().map(|(k, (v, _))| (k, v)).collect();
     let more = cfg.validate()?;
     warnings.extend(more);
     Ok((cfg, warnings))
@@ -843,17 +850,12 @@ fn gcode_flavor(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
 }
 
 /// `toolchange_gcode`: PrusaSlicer's tool-change G-code runs before each tool change, as
-/// conduit's `before_tool_change_gcode` does; its extruder placeholders are conduit's tool
-/// ones.
+/// conduit's `before_tool_change_gcode` does; it is kept as written (the templates know
+/// `next_extruder` and `previous_extruder` as the writer's `next_tool` and `previous_tool`).
 fn toolchange_gcode(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     if let Some(g) = imp.p.gcode(key) {
-        let g = tool_placeholders(&g);
-        if has_macros(&g) {
-            imp.warnings.push(
-                "toolchange_gcode uses PrusaSlicer macros ({if …} or expressions) that conduit \
-                 cannot fill; edit printer.before_tool_change_gcode"
-                    .to_owned(),
-            );
+        if let Some(w) = syntax_warning(key, "printer.before_tool_change_gcode", &g) {
+            imp.warnings.push(w);
         }
         imp.cfg.printer.before_tool_change_gcode = g;
     }
@@ -1282,37 +1284,18 @@ fn parse_xy(s: &str) -> Option<[f64; 2]> {
     Some([x.trim().parse().ok()?, y.trim().parse().ok()?])
 }
 
-/// `g` with PrusaSlicer's extruder placeholders (`{next_extruder}`, `[next_extruder]`,
-/// `{previous_extruder}`, `[previous_extruder]`) written as conduit's `{next_tool}` and
-/// `{previous_tool}`.
-fn tool_placeholders(g: &str) -> String {
-    let mut out = g.to_owned();
-    for (prusa, conduit) in [
-        ("next_extruder", "{next_tool}"),
-        ("previous_extruder", "{previous_tool}"),
-    ] {
-        out = out
-            .replace(&format!("{{{prusa}}}"), conduit)
-            .replace(&format!("[{prusa}]"), conduit);
-    }
-    out
-}
-
-/// True when a template has `{…}` that is not a plain `{key}` / `{key[N]}` placeholder.
-fn has_macros(g: &str) -> bool {
-    g.split('{').skip(1).any(|part| {
-        let inner = part.split('}').next().unwrap_or_default();
-        let name = inner
-            .strip_suffix(']')
-            .and_then(|n| n.split_once('['))
-            .map_or(inner, |(k, _)| k);
-        !part.contains('}') || !name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')
-    })
+/// A warning when the G-code `g` of `key` (conduit's `field`) does not parse as PrusaSlicer's
+/// macro language; the G-code is kept, and writing it fails with the same error.
+fn syntax_warning(key: &str, field: &str, g: &str) -> Option<String> {
+    crate::emit::gcode::macros::check_syntax(g)
+        .err()
+        .map(|e| format!("{key}: {e}; edit {field}"))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::emit::gcode::macros::{Value, Var};
 
     const BENCH_INI: &str = concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -1525,7 +1508,10 @@ gcode_comments = 0
         );
         let all = warnings.join("\n");
         assert!(all.contains("gyroid") && all.contains("monotonic"), "{all}");
-        assert!(all.contains("start_gcode uses PrusaSlicer macros"), "{all}");
+        assert!(
+            all.contains("start_gcode: line 3: syntax error: missing {endif} in {if x}; edit printer.start_gcode"),
+            "{all}"
+        );
         assert!(
             all.contains(
                 "2 PrusaSlicer keys ignored (none that change the print); all of them: \
@@ -1613,14 +1599,35 @@ gcode_comments = 0
         )?;
         assert_eq!(
             cfg.printer.before_tool_change_gcode,
-            "G1 Z{layer_z} ; from {previous_tool}\nT{next_tool}"
+            "G1 Z{layer_z} ; from [previous_extruder]\nT{next_extruder}"
         );
         assert!(warnings.is_empty(), "{warnings:?}");
+        let vars = [
+            ("previous_tool", Var::Scalar(Value::Int(0))),
+            ("next_tool", Var::Scalar(Value::Int(1))),
+            ("layer_z", Var::Scalar(Value::Float(0.6))),
+        ];
+        assert_eq!(
+            cfg.render_template(&cfg.printer.before_tool_change_gcode, 0, &vars)?,
+            "G1 Z0.6 ; from 0\nT1"
+        );
+        // The indexed form inside an expression, as PrusaSlicer's XL profile writes it.
+        let (cfg, _) = from_ini_str(
+            "first_layer_temperature = 215,240\n\
+             toolchange_gcode = M109 S{first_layer_temperature[next_extruder] - 5}\n",
+        )?;
+        assert_eq!(
+            cfg.render_template(&cfg.printer.before_tool_change_gcode, 0, &vars)?,
+            "M109 S235"
+        );
+        // Macros parse: no warning; a syntax error is named with its line.
         let (_, warnings) = from_ini_str("toolchange_gcode = {if next_extruder==1}T1{endif}\n")?;
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let (_, warnings) = from_ini_str("toolchange_gcode = T{next_extruder}\\n{1 +}\n")?;
         assert!(
-            warnings
-                .iter()
-                .any(|w| w.starts_with("toolchange_gcode uses")),
+            warnings.iter().any(|w| w.starts_with(
+                "toolchange_gcode: line 2: syntax error: expected an expression in {1 +}"
+            )),
             "{warnings:?}"
         );
         Ok(())

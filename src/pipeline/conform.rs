@@ -20,7 +20,7 @@ use crate::conform::scan::Scan;
 use crate::conform::{
     self, ConformError, ConformParams, ConformReport, Placement, Registration, Surface,
 };
-use crate::emit::gcode::{GcodeParams, UnknownPlaceholder, write_gcode};
+use crate::emit::gcode::{GcodeParams, TemplateError, write_gcode};
 use crate::emit::robot::{Dialect, RobotError, RobotJob, write_robot};
 use crate::geom::Point3;
 use crate::program::Program;
@@ -129,15 +129,15 @@ pub enum ConformWalkError {
     /// The program could not be written.
     #[error("[conform]: {0}")]
     Write(ConformError),
-    /// A dispensing snippet has an unknown placeholder.
-    #[error("tools.{tool}.{key}: G-code template: unknown placeholder {{{placeholder}}}")]
+    /// A dispensing snippet cannot be filled (an unknown placeholder, a macro error).
+    #[error("tools.{tool}.{key}: G-code template, {error}")]
     Template {
         /// The dispensing tool.
         tool: usize,
         /// `paste_on_gcode` or `paste_off_gcode`.
         key: &'static str,
-        /// The placeholder without braces.
-        placeholder: String,
+        /// The line, the placeholder and the problem.
+        error: TemplateError,
     },
     /// The robot program could not be written.
     #[error("writing the {dialect} program: {error}")]
@@ -320,13 +320,7 @@ pub fn robot_program(
             .unwrap_or_default();
         writer
             .render_template(&text, tool, &[])
-            .map_err(
-                |UnknownPlaceholder(placeholder)| ConformWalkError::Template {
-                    tool,
-                    key,
-                    placeholder,
-                },
-            )
+            .map_err(|error| ConformWalkError::Template { tool, key, error })
     };
     let on = snippet("paste_on_gcode", |t| &t.paste_on_gcode)?;
     let off = snippet("paste_off_gcode", |t| &t.paste_off_gcode)?;

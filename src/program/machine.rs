@@ -7,6 +7,7 @@
 //! (`emit::gcode`), the replay (`check`) and the walks read them from here, so no stage needs
 //! the whole configuration to know what machine it drives.
 
+use std::collections::BTreeMap;
 use std::fmt;
 
 use serde::{Deserialize, Serialize};
@@ -128,6 +129,13 @@ pub struct Printer {
     pub overhang_fan_speed_3: f64,
     /// Retract with the firmware's `G10`/`G11` instead of E moves. Default false.
     pub use_firmware_retraction: bool,
+    /// The settings of the slicer profile the printer was imported from (a PrusaSlicer `.ini`,
+    /// or the profile a 3MF stores), key → value as written there: variables the macros of the
+    /// G-code templates read beside conduit's own keys (`{filament_type[0]}`, `{z_offset}`).
+    /// Default empty.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[schemars(example = profile_example())]
+    pub profile: BTreeMap<String, String>,
 }
 
 /// What a tool deposits and therefore how it is driven.
@@ -198,6 +206,14 @@ pub struct Tool {
     pub travel_lift: Option<f64>,
 }
 
+/// The example of [`Printer::profile`] in the documented defaults.
+fn profile_example() -> BTreeMap<String, String> {
+    [("filament_type", "PETG"), ("z_offset", "0")]
+        .into_iter()
+        .map(|(k, v)| (k.to_owned(), v.to_owned()))
+        .collect()
+}
+
 impl Printer {
     /// Where `G28` puts the axes: `home`, or the bed's front-left corner at `max_height`.
     pub fn home_position(&self) -> [f64; 3] {
@@ -243,6 +259,7 @@ impl Default for Printer {
             overhang_fan_speed_2: 0.0,
             overhang_fan_speed_3: 0.0,
             use_firmware_retraction: false,
+            profile: BTreeMap::new(),
         }
     }
 }

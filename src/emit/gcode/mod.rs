@@ -72,6 +72,7 @@
 
 pub mod estimate;
 mod flavor;
+pub mod macros;
 mod params;
 mod sink;
 mod template;
@@ -82,7 +83,7 @@ mod tests;
 
 pub use params::{GcodeParams, SwitchedParams};
 pub use sink::{GcodeSink, Motion, MotionKind, Recorder};
-pub use template::UnknownPlaceholder;
+pub use template::TemplateError;
 
 use std::io::Write;
 
@@ -106,19 +107,21 @@ pub enum EmitError {
     /// How to fix: check the output path, the free space and the permissions.
     #[error("writing G-code: {0}")]
     Io(#[from] std::io::Error),
-    /// A custom G-code template has a placeholder that is neither a config key nor a variable
-    /// the writer provides.
+    /// A custom G-code template cannot be filled: a placeholder names neither a config key, a
+    /// profile key nor a variable the writer provides, or a macro has a syntax or type error.
     ///
-    /// How to fix: correct the placeholder in the named template; `conduit config --defaults`
-    /// lists the keys. The writer provides `{previous_tool}`, `{next_tool}`, `{layer_num}` and
-    /// `{layer_z}` in tool-change templates, `{initial_tool}`, `{initial_extruder}`,
-    /// `{total_layer_count}` and `{max_layer_z}` in the start G-code.
-    #[error("{template}: unknown placeholder {{{placeholder}}}")]
+    /// How to fix: correct the placeholder on the named line of the named template;
+    /// `conduit config --defaults` lists the keys. The writer provides `{previous_tool}`,
+    /// `{next_tool}`, `{layer_num}` and `{layer_z}` in tool-change templates; `{initial_tool}`,
+    /// `{initial_extruder}`, `{total_layer_count}`, `{max_layer_z}`, `{has_wipe_tower}`,
+    /// `{is_extruder_used[N]}` and `{first_layer_print_min}` / `_max` / `_size` from the start
+    /// G-code on; `{layer_num}` and `{layer_z}` in the end G-code.
+    #[error("{template}, {error}")]
     Template {
         /// Which template (`printer.start_gcode`, `tools.1.paste_on_gcode`, ...).
         template: String,
-        /// The placeholder without braces.
-        placeholder: String,
+        /// The line, the placeholder and the problem.
+        error: TemplateError,
     },
     /// The program uses a tool the config does not define.
     ///

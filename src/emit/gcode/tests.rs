@@ -559,15 +559,16 @@ fn unknown_placeholders_are_errors_naming_them() {
     cfg.printer.start_gcode = "M190 S{bed_temperature}\nM104 S{nozzle_temp}\n".to_owned();
     let err = write_gcode(&one_layer_program(), &cfg, &mut Vec::new());
     assert!(
-        matches!(&err, Err(EmitError::Template { template, placeholder })
-            if template == "printer.start_gcode" && placeholder == "nozzle_temp"),
+        matches!(&err, Err(EmitError::Template { template, error })
+            if template == "printer.start_gcode" && error.placeholder == "{nozzle_temp}"
+                && error.line == 2),
         "{err:?}"
     );
     let mut cfg = two_tool_config();
     cfg.printer.after_tool_change_gcode = "G1 E{purge_length}".to_owned();
     let err = write_gcode(&two_tool_program(), &cfg, &mut Vec::new());
     assert!(
-        matches!(&err, Err(EmitError::Template { placeholder, .. }) if placeholder == "purge_length")
+        matches!(&err, Err(EmitError::Template { error, .. }) if error.placeholder == "{purge_length}")
     );
     // Known placeholders of every kind are filled.
     let mut cfg = two_tool_config();

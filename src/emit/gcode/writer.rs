@@ -11,12 +11,13 @@ use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
 
 use super::GcodeParams;
 use super::flavor::{Dialect, fan, set_bed, wait_bed};
+use super::macros::{Value, Var};
 use super::sink::{GcodeSink, Motion, MotionKind};
 use super::{EmitError, GcodeStats, Resume, ToolStats};
 use crate::geom::Point3;
 use crate::program::machine::{Flavor, ToolKind};
 use crate::program::motion::{DEFAULT_FEEDRATE_MM_S, JERK_MM_S, MAX_FEEDRATE_MM_S, Planner};
-use crate::program::{Event, Feed, Layer, LayerItem, Program, Toolpath};
+use crate::program::{Event, Feed, Layer, LayerItem, Program, Role, Toolpath};
 
 /// Largest distance between an arc of a path's segments and the chords the FFF style writes
 /// for it, mm: half the output resolution.
@@ -51,18 +52,23 @@ fn render(
     name: &str,
     template: &str,
     tool: usize,
-    vars: &[(&str, String)],
+    vars: &[(&str, Var)],
 ) -> Result<Vec<String>, EmitError> {
     if template.trim().is_empty() {
         return Ok(Vec::new());
     }
     match cfg.render_template(template, tool, vars) {
         Ok(text) => Ok(text.lines().map(str::to_owned).collect()),
-        Err(super::UnknownPlaceholder(placeholder)) => Err(EmitError::Template {
+        Err(error) => Err(EmitError::Template {
             template: name.to_owned(),
-            placeholder,
+            error,
         }),
     }
+}
+
+/// A scalar variable of a template.
+fn scalar(v: impl Into<Value>) -> Var {
+    Var::Scalar(v.into())
 }
 
 /// Replaces line breaks and `;` in text that goes into one G-code line or comment.
@@ -129,6 +135,9 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     /// The next travel stays inside the internal infill ([`Event::TravelInsideInfill`]): no
     /// retraction for it.
     travel_inside: bool,
+    /// The template variables that describe the whole print ([`print_variables`]), set by
+    /// [`Self::start`] and given to every later template, as PrusaSlicer keeps them.
+    print_vars: Vec<(&'static str, Var)>,
 }
 
 impl<'a, S: GcodeSink> Writer<'a, S> {
@@ -203,6 +212,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             layer_fan: 0.0,
             switch: switched::SwitchState::default(),
             travel_inside: false,
+            print_vars: Vec::new(),
         })
     }
 
@@ -627,12 +637,13 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             return Ok(());
         };
         self.retract();
-        let vars = [
-            ("previous_tool", old.to_string()),
-            ("next_tool", tool.to_string()),
-            ("layer_num", self.layer_index.to_string()),
-            ("layer_z", fmt_xyz(self.layer_z)),
+        let mut vars = vec![
+            ("previous_tool", scalar(old)),
+            ("next_tool", scalar(tool)),
+            ("layer_num", scalar(self.layer_index)),
+            ("layer_z", scalar(self.layer_z)),
         ];
+        vars.extend(self.print_vars.iter().cloned());
         let before = render(
             self.cfg,
             "printer.before_tool_change_gcode",
@@ -724,13 +735,17 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
     pub fn start(&mut self, program: &Program, first_tool: usize) -> Result<(), EmitError> {
         let cfg = self.cfg;
         let layers = program.layers.len();
-        let max_z = program.layers.iter().map(|l| l.z).fold(0.0, f64::max);
-        let vars = [
-            ("initial_tool", first_tool.to_string()),
-            ("initial_extruder", first_tool.to_string()),
-            ("total_layer_count", layers.to_string()),
-            ("max_layer_z", fmt_xyz(max_z)),
-        ];
+        let max_z = max_layer_z(program);
+        self.print_vars = print_variables(program, cfg.tools.len());
+        self.print_vars.extend([
+            ("initial_tool", scalar(first_tool)),
+            ("initial_extruder", scalar(first_tool)),
+            ("total_layer_count", scalar(layers)),
+            ("max_layer_z", scalar(max_z)),
+        ]);
+        let mut vars = self.print_vars.clone();
+        // PrusaSlicer's current z-hop: none before the print.
+        vars.push(("zhop", scalar(0.0)));
         let start = render(
             cfg,
             "printer.start_gcode",
@@ -1163,15 +1178,19 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         let cfg = self.cfg;
         self.retract();
         let tool = self.tool.unwrap_or(0);
+        let mut vars = vec![
+            ("layer_num", scalar(self.layer_index)),
+            // As PrusaSlicer: where the nozzle is, a lift after the last retraction included.
+            ("layer_z", scalar(self.z.unwrap_or(self.layer_z))),
+            ("max_layer_z", scalar(max_layer_z(program))),
+        ];
+        vars.extend(self.print_vars.iter().cloned());
         let end = render(
             cfg,
             "printer.end_gcode",
             &cfg.printer.end_gcode,
             tool,
-            &[
-                ("layer_num", self.layer_index.to_string()),
-                ("layer_z", fmt_xyz(self.layer_z)),
-            ],
+            &vars,
         )?;
         self.line(";TYPE:Custom");
         self.lines(&end);
@@ -1225,6 +1244,49 @@ fn is_finite(path: &Toolpath) -> bool {
 }
 
 /// Tools the program extrudes with or changes to, ascending.
+/// The highest layer's z, mm (0 without layers).
+fn max_layer_z(program: &Program) -> f64 {
+    program.layers.iter().map(|l| l.z).fold(0.0, f64::max)
+}
+
+/// The template variables that describe the print, as PrusaSlicer names them (set before the
+/// start G-code and kept for every later template):
+/// `first_layer_print_min`, `_max` and `_size` (the bounding box of the material the first
+/// layer lays down: every path's centre line grown by half its width, skirt, brim and wipe
+/// tower included, close to PrusaSlicer's hull of the layer's outlines; zeros without any),
+/// `is_extruder_used` (one flag per tool, and false up to tool 255 as in PrusaSlicer, since an
+/// index past a vector's end reads element 0) and `has_wipe_tower`.
+fn print_variables(program: &Program, tools: usize) -> Vec<(&'static str, Var)> {
+    let mut min = [f64::INFINITY; 2];
+    let mut max = [f64::NEG_INFINITY; 2];
+    for p in program.layers.first().into_iter().flat_map(|l| l.paths()) {
+        let r = p.width.max(0.0) / 2.0;
+        for q in &p.points {
+            min = [min[0].min(q.x - r), min[1].min(q.y - r)];
+            max = [max[0].max(q.x + r), max[1].max(q.y + r)];
+        }
+    }
+    if min[0] > max[0] {
+        (min, max) = ([0.0; 2], [0.0; 2]);
+    }
+    let pair = |a: f64, b: f64| Var::Vector(vec![Value::Float(a), Value::Float(b)]);
+    let used = used_tools(program);
+    let flags = (0..tools.max(256))
+        .map(|t| Value::Bool(used.contains(&t)))
+        .collect();
+    let tower = program.paths().any(|p| p.role == Role::WipeTower);
+    vec![
+        ("first_layer_print_min", pair(min[0], min[1])),
+        ("first_layer_print_max", pair(max[0], max[1])),
+        (
+            "first_layer_print_size",
+            pair(max[0] - min[0], max[1] - min[1]),
+        ),
+        ("is_extruder_used", Var::Vector(flags)),
+        ("has_wipe_tower", scalar(tower)),
+    ]
+}
+
 pub(super) fn used_tools(program: &Program) -> Vec<usize> {
     let mut tools = program.tools_used();
     for layer in &program.layers {
