@@ -224,6 +224,7 @@ pub fn parse(src: &str) -> Result<Vec<Node>, SyntaxError> {
         lx: Lexer::new(src, 0),
         src,
         open: 0,
+        depth: 0,
     };
     p.text(false)
 }
@@ -233,16 +234,37 @@ fn ends_branch(t: &Tok) -> bool {
     matches!(t, Tok::Ident(k) if k == "elsif" || k == "else" || k == "endif")
 }
 
+/// How deep expressions and `if` blocks may nest (operators of one chain count as levels):
+/// far beyond any profile's templates, and shallow enough that parsing and evaluating
+/// recursively cannot run out of stack on a template made to be deep.
+const MAX_DEPTH: usize = 256;
+
 struct Parser<'a> {
     lx: Lexer<'a>,
     src: &'a str,
     /// Offset of the `{` of the macro being read.
     open: usize,
+    /// Levels of nesting open at the token being read (see [`MAX_DEPTH`]).
+    depth: usize,
 }
 
 type Parsed<T> = Result<T, SyntaxError>;
 
 impl Parser<'_> {
+    /// Runs `f` one level deeper, or fails at `at` past [`MAX_DEPTH`].
+    fn deeper<T>(&mut self, at: usize, f: impl FnOnce(&mut Self) -> Parsed<T>) -> Parsed<T> {
+        if self.depth >= MAX_DEPTH {
+            return self.err(
+                Problem::Syntax(format!("nested more than {MAX_DEPTH} levels deep")),
+                at,
+            );
+        }
+        self.depth += 1;
+        let r = f(self);
+        self.depth -= 1;
+        r
+    }
+
     fn err<T>(&self, problem: Problem, at: usize) -> Parsed<T> {
         Err(SyntaxError {
             problem,
@@ -401,6 +423,12 @@ impl Parser<'_> {
 
     /// An `if` block, after its `if`.
     fn if_block(&mut self) -> Parsed<Stmt> {
+        let at = self.peek()?.1;
+        self.deeper(at, Self::if_branches)
+    }
+
+    /// The branches of an `if` block, after its `if`.
+    fn if_branches(&mut self) -> Parsed<Stmt> {
         let mut branches = Vec::new();
         let mut otherwise = None;
         loop {
@@ -553,12 +581,22 @@ impl Parser<'_> {
         next: fn(&mut Self) -> Parsed<Expr>,
         ops: fn(&Tok) -> Option<BinOp>,
     ) -> Parsed<Expr> {
+        let base = self.depth;
         let mut lhs = next(self)?;
         while let Some(op) = ops(&self.peek()?.0) {
-            self.next()?;
+            let (_, at) = self.next()?;
+            // Each operator puts the chain so far one level further down the tree.
+            if self.depth >= MAX_DEPTH {
+                return self.err(
+                    Problem::Syntax(format!("nested more than {MAX_DEPTH} levels deep")),
+                    at,
+                );
+            }
+            self.depth += 1;
             let rhs = next(self)?;
             lhs = Expr::Binary(op, Box::new(lhs), Box::new(rhs));
         }
+        self.depth = base;
         Ok(lhs)
     }
 
@@ -630,6 +668,13 @@ impl Parser<'_> {
     }
 
     fn unary(&mut self) -> Parsed<Expr> {
+        let at = self.peek()?.1;
+        self.deeper(at, Self::operand)
+    }
+
+    /// An operand: a literal, a variable, a call, a parenthesised expression or a prefix
+    /// operator and its operand.
+    fn operand(&mut self) -> Parsed<Expr> {
         let (t, at) = self.next()?;
         Ok(match t {
             Tok::Int(i) => Expr::Lit(Value::Int(i)),

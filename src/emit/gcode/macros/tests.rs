@@ -392,3 +392,31 @@ fn mk4_style_start_and_end_gcode() -> Result<(), TemplateError> {
     assert!(end.contains("\nG1 Z220 F300"), "{end}");
     Ok(())
 }
+
+#[test]
+fn nesting_is_bounded_so_a_deep_template_is_an_error_not_a_crash() {
+    let deep = Some(Problem::Syntax(
+        "nested more than 256 levels deep".to_owned(),
+    ));
+    let parens = |n: usize| format!("{{{}1{}}}", "(".repeat(n), ")".repeat(n));
+    assert_eq!(fill(&parens(200)).ok(), Some("1".to_owned()));
+    assert_eq!(problem(&parens(20_000)), deep);
+    assert_eq!(
+        problem(&format!("{{{}}}", vec!["1"; 100_000].join("+"))),
+        deep
+    );
+    assert_eq!(problem(&format!("{{{}1}}", "-".repeat(100_000))), deep);
+    assert_eq!(
+        problem(&format!(
+            "{}x{}",
+            "{if true}".repeat(5000),
+            "{endif}".repeat(5000)
+        )),
+        deep
+    );
+    // A long chain within the bound evaluates.
+    assert_eq!(
+        fill(&format!("{{{}}}", vec!["1"; 200].join("+"))).ok(),
+        Some("200".to_owned())
+    );
+}
