@@ -95,39 +95,16 @@ fn canonical_ring(mut points: Vec<Point2>) -> Polygon {
     Polygon::new(points)
 }
 
-/// Mean width (scaled units, 1 µm) below which a ring of a result is a sliver and is dropped:
-/// nearly collinear edges of two operands (a diagonal edge and its offset, rounded to the
-/// nanometre on either side) leave chains of triangles a few nanometres wide along them.
-/// Nothing can be printed in them, and hundreds of them stacked in one place make later
-/// booleans and offsets crawl.
-const SLIVER_WIDTH_NM: f64 = 1_000.0;
-
-/// Whether `ring` is a sliver: its mean width (twice its area over its perimeter, the width of
-/// a long thin strip) is under [`SLIVER_WIDTH_NM`]; a square under 2 µm a side is one too.
-fn is_sliver(ring: &[IntPoint<i64>]) -> bool {
-    let n = ring.len();
-    let (mut area2, mut perimeter) = (0i128, 0f64);
-    for k in 0..n {
-        let (a, b) = (ring[k], ring[(k + 1) % n]);
-        area2 += a.x as i128 * b.y as i128 - b.x as i128 * a.y as i128;
-        perimeter += ((b.x - a.x) as f64).hypot((b.y - a.y) as f64);
-    }
-    (area2.unsigned_abs() as f64) < SLIVER_WIDTH_NM * perimeter
-}
-
-/// Converts i_overlay shapes (outer CCW first, then CW holes) into canonical ExPolygons,
-/// without slivers (see [`is_sliver`]): a sliver contour goes with its holes, a sliver hole
-/// alone.
+/// Converts i_overlay shapes (outer CCW first, then CW holes) into canonical ExPolygons.
 fn shapes_to_expolygons(shapes: IntShapes<i64>) -> Vec<ExPolygon> {
     let mut out: Vec<ExPolygon> = shapes
         .into_iter()
         .filter_map(|shape| {
-            let mut rings = shape.into_iter();
-            let first = rings.next().filter(|c| c.len() >= 3 && !is_sliver(c))?;
-            let mut contour = canonical_ring(first.into_iter().map(from_int).collect());
-            let rings = rings
-                .filter(|c| c.len() >= 3 && !is_sliver(c))
+            let mut rings = shape
+                .into_iter()
+                .filter(|c| c.len() >= 3)
                 .map(|c| canonical_ring(c.into_iter().map(from_int).collect()));
+            let mut contour = rings.next()?;
             if !contour.is_counter_clockwise() {
                 contour.points.reverse();
                 contour = canonical_ring(contour.points);
@@ -523,42 +500,6 @@ mod tests {
         let ba = union(&[b, a]);
         assert_eq!(ab, ba);
         assert_eq!(ab.len(), 2);
-    }
-
-    /// The square's lower triangle with its diagonal's lower end `lift` nm up the left side.
-    fn lower_triangle(lift: i64) -> ExPolygon {
-        ex(Polygon::new(vec![
-            Point2::new(0, 0),
-            Point2::new(10_000_000, 0),
-            Point2::new(10_000_000, 10_000_000),
-            Point2::new(0, lift),
-        ]))
-    }
-
-    #[test]
-    fn slivers_between_nearly_equal_edges_are_dropped_thin_strips_kept() {
-        // Two diagonals 3 nm apart at one end: what lies between them is a strip about 1 nm
-        // wide on average, which nothing can print.
-        let base = lower_triangle(0);
-        assert_eq!(
-            difference(&[lower_triangle(3)], std::slice::from_ref(&base)),
-            vec![]
-        );
-        // 10 µm apart: a strip of 3.5 µm mean width, 0.05 mm² of it, stays.
-        let strip = difference(&[lower_triangle(10_000)], std::slice::from_ref(&base));
-        assert_eq!(strip.len(), 1);
-        assert!((area(&strip) - 0.05).abs() < 1e-9, "{}", area(&strip));
-        // A hole 1 nm wide is no hole; the contour around it stays whole.
-        let square = ex(rect(0., 0., 20., 20.));
-        let slit = ex(Polygon::new(vec![
-            Point2::from_mm(5., 5.),
-            Point2::from_mm(15., 5.),
-            Point2::new(15_000_000, 5_000_001),
-        ]));
-        let d = difference(&[square], &[slit]);
-        assert_eq!(d.len(), 1);
-        assert!(d[0].holes.is_empty(), "{d:?}");
-        assert_eq!(area(&d), 400.0);
     }
 
     #[test]
