@@ -195,7 +195,7 @@ fn profile_var(key: &str, raw: &str) -> Var {
     match numbers {
         Some(mut n) if n.len() == 1 => Var::Scalar(n.remove(0)),
         Some(n) => Var::Vector(n),
-        None => Var::Scalar(Value::Str(unescape(raw))),
+        None => Var::Scalar(Value::Str(crate::config::prusa_ini::unescape(raw))),
     }
 }
 
@@ -246,26 +246,6 @@ fn quoted_list(raw: &str) -> Option<Vec<String>> {
             Some(_) => return None,
         }
     }
-}
-
-/// A profile string with its `\n`, `\r`, `\t` and `\\` escapes undone.
-fn unescape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    let mut chars = s.chars();
-    while let Some(c) = chars.next() {
-        if c != '\\' {
-            out.push(c);
-            continue;
-        }
-        match chars.next() {
-            Some('n') => out.push('\n'),
-            Some('r') => out.push('\r'),
-            Some('t') => out.push('\t'),
-            Some(c) => out.push(c),
-            None => out.push('\\'),
-        }
-    }
-    out
 }
 
 #[cfg(test)]
