@@ -279,26 +279,7 @@ impl Pairs {
     }
 }
 
-/// Undoes PrusaSlicer's `escape_string_cstyle`: `\n`, `\r`, `\t`, and `\x` → `x`. Cura
-/// escapes the settings JSON it cuts into `;SETTING_3` comments the same way.
-pub(crate) fn unescape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    let mut chars = s.chars();
-    while let Some(c) = chars.next() {
-        if c != '\\' {
-            out.push(c);
-            continue;
-        }
-        match chars.next() {
-            Some('n') => out.push('\n'),
-            Some('r') => out.push('\r'),
-            Some('t') => out.push('\t'),
-            Some(other) => out.push(other),
-            None => out.push('\\'),
-        }
-    }
-    out
-}
+pub(crate) use conduit_gcode::unescape_cstyle as unescape;
 
 /// Keys read elsewhere that give no warning when present.
 const ACCEPTED: &[&str] = &["printer_technology", "perimeter_generator", "thin_walls"];

@@ -195,7 +195,7 @@ fn profile_var(key: &str, raw: &str) -> Var {
     match numbers {
         Some(mut n) if n.len() == 1 => Var::Scalar(n.remove(0)),
         Some(n) => Var::Vector(n),
-        None => Var::Scalar(Value::Str(crate::config::prusa_ini::unescape(raw))),
+        None => Var::Scalar(Value::Str(conduit_gcode::unescape_cstyle(raw))),
     }
 }
 
