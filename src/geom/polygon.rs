@@ -82,6 +82,22 @@ impl Polygon {
         self.signed_area2() as f64 / 2.0 / 1e12
     }
 
+    /// The width (mm) of a strip with this polygon's area and half its perimeter, `2A/P`: a
+    /// long band's width, a disc's radius. Near 0 for the slivers booleans leave where two
+    /// operands' edges almost coincide. 0 for a polygon of fewer than three points.
+    pub fn mean_width_mm(&self) -> f64 {
+        let mut ring = self.points.clone();
+        let Some(&first) = ring.first() else {
+            return 0.0;
+        };
+        ring.push(first);
+        let perimeter_mm = polyline_length(&ring) / super::point::UNITS_PER_MM;
+        if self.points.len() < 3 || perimeter_mm <= 0.0 {
+            return 0.0;
+        }
+        2.0 * self.area_mm2().abs() / perimeter_mm
+    }
+
     /// Whether the vertices run counter-clockwise.
     pub fn is_counter_clockwise(&self) -> bool {
         self.signed_area2() > 0
@@ -165,5 +181,31 @@ mod tests {
         assert!(!ex.contains(Point2::from_mm(1.0, 1.0)));
         assert!(!ex.contains(Point2::from_mm(11.0, 5.0)));
         assert!(ex.contour.contains(Point2::from_mm(1.0, 1.0)));
+    }
+
+    #[test]
+    fn mean_width_is_a_bands_width_and_tells_slivers() {
+        let rect = |w: f64, h: f64| {
+            Polygon::new(vec![
+                Point2::from_mm(0.0, 0.0),
+                Point2::from_mm(w, 0.0),
+                Point2::from_mm(w, h),
+                Point2::from_mm(0.0, h),
+            ])
+        };
+        // 2A/P of a 10 × 1 band: 20 / 22.
+        assert!((rect(10.0, 1.0).mean_width_mm() - 20.0 / 22.0).abs() < 1e-12);
+        // A 10 mm long triangle 3 nm high, as a boolean leaves between near-coincident edges.
+        let sliver = Polygon::new(vec![
+            Point2::new(0, 0),
+            Point2::new(10_000_000, 0),
+            Point2::new(5_000_000, 3),
+        ]);
+        assert!(sliver.mean_width_mm() < 1e-5);
+        assert_eq!(
+            Polygon::new(vec![Point2::new(0, 0), Point2::new(5, 5)]).mean_width_mm(),
+            0.0
+        );
+        assert_eq!(Polygon::default().mean_width_mm(), 0.0);
     }
 }

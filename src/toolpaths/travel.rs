@@ -29,6 +29,10 @@ use crate::region::LayerRegions;
 /// a bead beyond that edge, so the grown area still stays clear of it.
 pub const EDGE_TOLERANCE_MM: f64 = 0.05;
 
+/// Pieces of the infill area (and holes in it) narrower on average than this (mm) are
+/// slivers, not area a travel could use: see [`crate::geom::Polygon::mean_width_mm`].
+const SLIVER_WIDTH_MM: f64 = 0.001;
+
 /// Which travels [`mark_inside_travels`] marks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TravelParams {
@@ -73,7 +77,18 @@ impl InsideArea {
         if parts.is_empty() {
             return Self::default();
         }
-        let grown = offset(&union(&parts), EDGE_TOLERANCE_MM, Join::Miter(2.0));
+        // Slivers a few nanometres wide, left where two skins' edges almost coincide, hold no
+        // travel, and hundreds of them make the offset below take minutes on a layer of a
+        // dense circuit; they go before it.
+        let merged = union(&parts)
+            .into_iter()
+            .filter(|e| e.contour.mean_width_mm() >= SLIVER_WIDTH_MM)
+            .map(|mut e| {
+                e.holes.retain(|h| h.mean_width_mm() >= SLIVER_WIDTH_MM);
+                e
+            })
+            .collect::<Vec<_>>();
+        let grown = offset(&merged, EDGE_TOLERANCE_MM, Join::Miter(2.0));
         let pieces = grown
             .into_iter()
             .map(|e| {
