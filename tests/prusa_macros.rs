@@ -145,6 +145,33 @@ fn prusaslicer_mk4_project_renders_its_start_and_end_gcode() {
     };
     assert!(close(lift("F720 ; Move print head up"), 49.05));
     assert!(close(lift("F300 ; Move print head up"), 71.05));
+    // The filament's own G-code, where PrusaSlicer 2.5 writes it: its start after the
+    // preamble's `M83` and before the first layer (its pressure advance for the MK4IS's 0.4 mm
+    // nozzle), its end after the last retraction and before the printer's end G-code.
+    let at = |l: &str| lines.iter().position(|x| *x == l).unwrap_or(usize::MAX);
+    let preamble = at("M83 ; use relative distances for extrusion");
+    let first_layer = lines
+        .iter()
+        .position(|l| l.starts_with(";LAYER_CHANGE"))
+        .expect("layers");
+    for l in [
+        "M900 K0.05 ; Filament gcode",
+        "M572 S0.036 ; Filament gcode",
+        "M142 S36 ; set heatbreak target temp",
+    ] {
+        assert!(
+            at(l) > preamble && at(l) < first_layer,
+            "`{l}` at {}",
+            at(l)
+        );
+    }
+    let end_filament = at("; Filament-specific end gcode");
+    assert!(end_filament > first_layer && end_filament < usize::MAX);
+    assert_eq!(
+        lines[end_filament + 1],
+        "G1 Z49.05 F720 ; Move print head up"
+    );
+    assert_eq!(lines.iter().filter(|l| l.starts_with("M572 ")).count(), 2);
 }
 
 #[test]

@@ -1214,6 +1214,8 @@ struct ToolSpec {
     paste_flow_mm3_s: Option<f64>,
     retract_length: Option<f64>,
     travel_lift: Option<f64>,
+    start_gcode: Option<String>,
+    end_gcode: Option<String>,
 }
 
 impl<'de> Deserialize<'de> for Tool {
@@ -1238,6 +1240,8 @@ impl<'de> Deserialize<'de> for Tool {
             paste_flow_mm3_s: s.paste_flow_mm3_s.unwrap_or(d.paste_flow_mm3_s),
             retract_length: s.retract_length.or(d.retract_length),
             travel_lift: s.travel_lift.or(d.travel_lift),
+            start_gcode: s.start_gcode.unwrap_or(d.start_gcode),
+            end_gcode: s.end_gcode.unwrap_or(d.end_gcode),
         })
     }
 }

@@ -25,7 +25,8 @@
 //!   `filament_type` (the tool's name), `temperature`,
 //!   `first_layer_temperature`, `idle_temperature`, `extrusion_multiplier`, `extruder_offset`,
 //!   per-extruder `retract_length` (the first is the printer's, others that differ become tool
-//!   overrides). PrusaSlicer's extruders become filament tools `0..n`; conduit's default paste
+//!   overrides), `start_filament_gcode` / `end_filament_gcode` (→ the tools' `start_gcode` /
+//!   `end_gcode`; one value serves every extruder). PrusaSlicer's extruders become filament tools `0..n`; conduit's default paste
 //!   tool ([`super::Tool::paste`]) is appended as tool `n` so that a plastic-only profile can
 //!   still drive the conductive tool.
 //! - slice: `layer_height`, `first_layer_height` (mm, or % of `layer_height`), `perimeters`,
@@ -218,6 +219,20 @@ impl Pairs {
                     .collect()
             })
             .unwrap_or_default()
+    }
+
+    /// A per-extruder list of G-code strings (`"M900 K0.05";"M900 K0"`, escapes undone), its
+    /// first item repeated after the last as PrusaSlicer's `get_at` does; a single unquoted
+    /// value is the one item. Empty when the key is missing.
+    fn gcodes(&mut self, key: &str) -> impl Iterator<Item = String> + use<> {
+        let items = match self.raw(key) {
+            None => Vec::new(),
+            Some(raw) => conduit_gcode::string_list(raw).unwrap_or_else(|| vec![unescape(raw)]),
+        };
+        let first = items.first().cloned();
+        items
+            .into_iter()
+            .chain(std::iter::repeat_with(move || first.clone()).map_while(|f| f))
     }
 
     /// An integer count.
@@ -731,6 +746,12 @@ fn read_tools(imp: &mut Import) -> Result<(), ConfigError> {
         }
     }
     read_idle_temperatures(p, &mut tools)?;
+    for (t, start) in tools.iter_mut().zip(p.gcodes("start_filament_gcode")) {
+        t.start_gcode = start;
+    }
+    for (t, end) in tools.iter_mut().zip(p.gcodes("end_filament_gcode")) {
+        t.end_gcode = end;
+    }
     if let Some(raw) = p.raw("extruder_offset").map(str::to_owned) {
         for (t, xy) in tools.iter_mut().zip(raw.split(',')) {
             t.offset = parse_xy(xy).ok_or_else(|| p.err("extruder_offset", "expected XxY"))?;
@@ -1570,6 +1591,33 @@ gcode_comments = 0
             "{err:?}"
         );
         assert!(from_ini_str("printer_technology = SLA").is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn filament_gcode_lists_go_to_their_tools() -> Result<(), ConfigError> {
+        let (cfg, warnings) = from_ini_str(
+            "nozzle_diameter = 0.4,0.4,0.6\n\
+             start_filament_gcode = \"M900 K0.05 ; {filament_extruder_id}\\nM142\";M900 K0;\n\
+             end_filament_gcode = \"; Filament-specific end gcode\"\n",
+        )?;
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let starts: Vec<&str> = cfg.tools.iter().map(|t| t.start_gcode.as_str()).collect();
+        // Three extruders and the paste tool; a trailing `;` is one more (empty) item.
+        assert_eq!(
+            starts,
+            [
+                "M900 K0.05 ; {filament_extruder_id}\nM142",
+                "M900 K0",
+                "",
+                ""
+            ]
+        );
+        // A single value serves every extruder, as PrusaSlicer's `get_at` does; the paste
+        // tool keeps its own (none).
+        let ends: Vec<&str> = cfg.tools.iter().map(|t| t.end_gcode.as_str()).collect();
+        let end = "; Filament-specific end gcode";
+        assert_eq!(ends, [end, end, end, ""]);
         Ok(())
     }
 

@@ -204,6 +204,16 @@ pub struct Tool {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schemars(example = 0.5)]
     pub travel_lift: Option<f64>,
+    /// G-code written each time this tool is selected, once it is at temperature: after the
+    /// start G-code for the first tool, after the tool-change snippets for the others
+    /// (PrusaSlicer's `start_filament_gcode`, where profiles set linear or pressure advance).
+    /// The template language of `printer.start_gcode`, with `{filament_extruder_id}` this
+    /// tool's number. Default empty.
+    pub start_gcode: String,
+    /// G-code written when this tool is put away: before the tool-change snippets, and at the
+    /// end of the print before `printer.end_gcode` for every tool that has one, in tool order
+    /// (PrusaSlicer's `end_filament_gcode`). Default empty.
+    pub end_gcode: String,
 }
 
 /// The example of [`Printer::profile`] in the documented defaults.
@@ -313,6 +323,8 @@ impl Tool {
             paste_flow_mm3_s: 0.0,
             retract_length: None,
             travel_lift: None,
+            start_gcode: String::new(),
+            end_gcode: String::new(),
         }
     }
 

@@ -57,7 +57,7 @@ mod summary;
 #[cfg(test)]
 mod corpus_tests;
 
-pub use escape::unescape_cstyle;
+pub use escape::{string_list, unescape_cstyle};
 pub use line::{Line, LineEnding, STRING_ARG_COMMANDS, Word};
 pub use machine::{Command, Firmware, Machine, Move, Moves, Position, Reading, moves, moves_on};
 pub use number::{E_DECIMALS, XYZ_DECIMALS, fmt_e, fmt_f, fmt_fixed, fmt_xyz};

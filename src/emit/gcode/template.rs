@@ -184,7 +184,7 @@ fn toml_value(v: &toml::Value) -> Option<Value> {
 fn profile_var(key: &str, raw: &str) -> Var {
     let raw = raw.trim();
     if raw.starts_with('"')
-        && let Some(items) = quoted_list(raw)
+        && let Some(items) = conduit_gcode::string_list(raw)
     {
         return Var::Vector(items.into_iter().map(Value::Str).collect());
     }
@@ -210,42 +210,6 @@ fn number(s: &str) -> Option<Value> {
     plain
         .then(|| s.parse::<f64>().ok().map(Value::Float))
         .flatten()
-}
-
-/// `"a";"b c"` → [`a`, `b c`] (escapes undone); `None` when the text is not such a list.
-fn quoted_list(raw: &str) -> Option<Vec<String>> {
-    let mut items = Vec::new();
-    let mut chars = raw.chars().peekable();
-    loop {
-        while chars.peek().is_some_and(|c| c.is_whitespace()) {
-            chars.next();
-        }
-        if chars.next()? != '"' {
-            return None;
-        }
-        let mut item = String::new();
-        loop {
-            match chars.next()? {
-                '"' => break,
-                '\\' => match chars.next()? {
-                    'n' => item.push('\n'),
-                    'r' => item.push('\r'),
-                    't' => item.push('\t'),
-                    c => item.push(c),
-                },
-                c => item.push(c),
-            }
-        }
-        items.push(item);
-        while chars.peek().is_some_and(|c| c.is_whitespace()) {
-            chars.next();
-        }
-        match chars.next() {
-            None => return Some(items),
-            Some(';') => {}
-            Some(_) => return None,
-        }
-    }
 }
 
 #[cfg(test)]

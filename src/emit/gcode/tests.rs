@@ -581,6 +581,50 @@ fn unknown_placeholders_are_errors_naming_them() {
 }
 
 #[test]
+fn each_tools_own_gcode_frames_its_work() {
+    let mut cfg = two_tool_config();
+    for (t, tool) in cfg.tools.iter_mut().enumerate() {
+        tool.start_gcode = format!("M117 start {{filament_extruder_id}} of {t}");
+        tool.end_gcode = "M117 end {filament_extruder_id} at {layer_num}".to_owned();
+    }
+    cfg.printer.before_tool_change_gcode = "; before {next_tool}".to_owned();
+    cfg.printer.after_tool_change_gcode = "; after {next_tool}".to_owned();
+    cfg.printer.end_gcode = "M84 ; printer end".to_owned();
+    let (text, _) = write(&two_tool_program(), &cfg);
+    let lines: Vec<&str> = text.lines().collect();
+    let at = |l: &str| {
+        lines
+            .iter()
+            .enumerate()
+            .filter(|(_, x)| **x == l)
+            .map(|(i, _)| i)
+            .collect::<Vec<_>>()
+    };
+    // Tool 0 starts the print once, after the preamble; each of the two changes puts the old
+    // tool away before the change snippets and starts the new one after them; at the end every
+    // tool's end G-code, in tool order, comes before the printer's.
+    let (start0, start1) = (at("M117 start 0 of 0"), at("M117 start 1 of 1"));
+    assert_eq!(start0.len(), 2, "{text}");
+    assert_eq!(start1.len(), 1, "{text}");
+    assert!(start0[0] > at("G90 ; use absolute coordinates")[0]);
+    let before = at("; before 1")[0];
+    assert_eq!(lines[before - 1], "M117 end 0 at 0");
+    let after = at("; after 1")[0];
+    assert_eq!(lines[after + 1], "M117 start 1 of 1");
+    assert!(lines[before..after].contains(&"T1"));
+    let printer_end = at("M84 ; printer end")[0];
+    assert_eq!(
+        lines[printer_end - 2..printer_end],
+        ["M117 end 0 at 1", "M117 end 1 at 1"]
+    );
+    assert_eq!(
+        at("M117 end 1 at 1").len(),
+        2,
+        "tool 1 put away at layer 1 and at the end"
+    );
+}
+
+#[test]
 fn unknown_tools_are_errors() {
     let mut program = one_layer_program();
     program.layers[0].items.push(LayerItem::Path(square(

@@ -644,6 +644,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             ("layer_z", scalar(self.layer_z)),
         ];
         vars.extend(self.print_vars.iter().cloned());
+        // As PrusaSlicer: the old filament's end G-code before the tool-change G-code, the new
+        // one's start G-code after it.
+        self.filament_gcode(old, true, &vars)?;
         let before = render(
             self.cfg,
             "printer.before_tool_change_gcode",
@@ -681,12 +684,43 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             &vars,
         )?;
         self.lines(&after);
+        self.filament_gcode(tool, false, &vars)?;
         if !self.relative_e {
             self.line("G92 E0");
             self.e = 0.0;
         }
         self.type_name = None;
         self.width = None;
+        Ok(())
+    }
+
+    /// Writes tool `tool`'s own G-code, its `start_gcode` (`end` false) or its `end_gcode`
+    /// (PrusaSlicer's `start_filament_gcode` / `end_filament_gcode`), with
+    /// `{filament_extruder_id}` the tool and `vars` besides.
+    fn filament_gcode(
+        &mut self,
+        tool: usize,
+        end: bool,
+        vars: &[(&'static str, Var)],
+    ) -> Result<(), EmitError> {
+        let Some(t) = self.cfg.tools.get(tool) else {
+            return Ok(());
+        };
+        let (key, template) = if end {
+            ("end_gcode", &t.end_gcode)
+        } else {
+            ("start_gcode", &t.start_gcode)
+        };
+        let mut all = vec![("filament_extruder_id", scalar(tool))];
+        all.extend(vars.iter().cloned());
+        let lines = render(
+            self.cfg,
+            &format!("tools.{tool}.{key}"),
+            template,
+            tool,
+            &all,
+        )?;
+        self.lines(&lines);
         Ok(())
     }
 
@@ -809,6 +843,8 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         if !scan.any_tool {
             self.wait_for_tool(first_tool);
         }
+        let vars = self.print_vars.clone();
+        self.filament_gcode(first_tool, false, &vars)?;
         Ok(())
     }
 
@@ -1193,6 +1229,10 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             &vars,
         )?;
         self.line(";TYPE:Custom");
+        // As PrusaSlicer: every tool's end G-code, in tool order, before the printer's.
+        for t in 0..cfg.tools.len() {
+            self.filament_gcode(t, true, &vars)?;
+        }
         self.lines(&end);
         self.planner.flush();
         self.take_planned_times();
