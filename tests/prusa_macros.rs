@@ -172,6 +172,37 @@ fn prusaslicer_mk4_project_renders_its_start_and_end_gcode() {
         "G1 Z49.05 F720 ; Move print head up"
     );
     assert_eq!(lines.iter().filter(|l| l.starts_with("M572 ")).count(), 2);
+    // The layer G-code frames every layer change: before the move, the acceleration from the
+    // weight printed so far (`interpolate_table(extruded_weight_total, (0,4000), (1400,2500),
+    // …)`) and `M74` with that weight; after it, the layer's z.
+    let layers = lines.iter().filter(|l| **l == ";LAYER_CHANGE").count();
+    let count = |l: &str| lines.iter().filter(|x| **x == l).count();
+    assert_eq!(count(";BEFORE_LAYER_CHANGE"), layers);
+    assert_eq!(count(";AFTER_LAYER_CHANGE"), layers);
+    let numbers = |prefix: &str, letter: char| -> Vec<f64> {
+        lines
+            .iter()
+            .filter(|l| l.starts_with(prefix))
+            .map(|l| word(l, letter))
+            .collect()
+    };
+    let (accels, weights) = (numbers("M201 X", 'X'), numbers("M74 W", 'W'));
+    assert_eq!((accels.len(), weights.len()), (layers, layers));
+    assert!(
+        weights.windows(2).all(|w| w[0] <= w[1]),
+        "the weight only grows"
+    );
+    // 12.84 g in all (the filament total of the summary); the last layer's is nearly that.
+    let last = weights[layers - 1];
+    assert!(last > 12.0 && last < 12.85, "{last}");
+    for (a, w) in accels.iter().zip(&weights) {
+        let want = if *w < 1400.0 {
+            4000.0 - 1500.0 * w / 1400.0
+        } else {
+            2500.0
+        };
+        assert!((a - want).abs() < 0.01 + 1e-4 * want, "M201 {a} at {w} g");
+    }
 }
 
 #[test]

@@ -65,6 +65,15 @@ pub struct Printer {
     /// G-code template written after every tool change (`{previous_tool}` and `{next_tool}` are
     /// available). Default empty.
     pub after_tool_change_gcode: String,
+    /// G-code template written at every layer change, after the `;LAYER_CHANGE`, `;Z:` and
+    /// `;HEIGHT:` comments and before the move to the new layer (`{layer_num}`, counted from 0,
+    /// `{layer_z}` and `{max_layer_z}` are available). PrusaSlicer's `before_layer_gcode`
+    /// imports here. Default empty.
+    pub before_layer_gcode: String,
+    /// G-code template written at every layer change after the move to the new layer, before
+    /// its first path (the variables of `before_layer_gcode`). PrusaSlicer's `layer_gcode`
+    /// imports here. Default empty.
+    pub layer_gcode: String,
     /// Filament pulled back before travels, mm (a tool's own `retract_length` overrides it).
     /// Default 0.8.
     pub retract_length: f64,
@@ -246,6 +255,8 @@ impl Default for Printer {
             end_gcode: DEFAULT_END_GCODE.to_owned(),
             before_tool_change_gcode: String::new(),
             after_tool_change_gcode: String::new(),
+            before_layer_gcode: String::new(),
+            layer_gcode: String::new(),
             retract_length: 0.8,
             retract_speed: 35.0,
             deretract_speed: 0.0,

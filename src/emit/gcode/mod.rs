@@ -22,9 +22,9 @@
 //!   `G21`, `G90`, `M82`/`M83`, `G92 E0`; a preheat (to the standby or first-layer
 //!   temperature) of the other used tools the start G-code leaves cold; `T<n>` of the first tool
 //!   on multi-tool prints; a wait for the first tool when the start G-code does not wait for it.
-//! - Per layer, PrusaSlicer's markers: `;LAYER_CHANGE`, `;Z:<z>`, `;HEIGHT:<h>`, then
-//!   `G1 Z<z>` (after a retraction when the way to the layer's first path is long) and, in
-//!   absolute E mode, `G92 E0`. On layer 1 the bed and tool temperatures change to their
+//! - Per layer, PrusaSlicer's markers: `;LAYER_CHANGE`, `;Z:<z>`, `;HEIGHT:<h>`, the rendered
+//!   `before_layer_gcode`, then `G1 Z<z>` (after a retraction when the way to the layer's first
+//!   path is long), in absolute E mode `G92 E0`, and the rendered `layer_gcode`. On layer 1 the bed and tool temperatures change to their
 //!   after-first-layer values. The fan is off for the first `disable_fan_first_layers` layers,
 //!   then follows the layer's extrusion time as PrusaSlicer's cooling does with its default
 //!   thresholds: `fan_max_speed` under 5 s, `fan_min_speed` over 60 s, linear in between
@@ -43,14 +43,19 @@
 //! - Tool changes: retract, `before_tool_change_gcode` (`{previous_tool}`, `{next_tool}`), the
 //!   old tool to its standby temperature, `T<n>` (left out when the snippet selects the tool
 //!   itself, as PrusaSlicer does for `T{next_extruder}`), heat-and-wait for the new tool,
-//!   `after_tool_change_gcode`, `G92 E0` (absolute E). Coordinates of tool `n` are the program's
+//!   `after_tool_change_gcode`, `G92 E0` (absolute E). The old tool's `end_gcode` comes before
+//!   the tool-change snippets, the new tool's `start_gcode` after them (and after the start
+//!   G-code for the first tool). Coordinates of tool `n` are the program's
 //!   minus `tools.n.offset` (PrusaSlicer's `extruder_offset` convention). Flavour differences
 //!   are listed in [`flavor`](self#flavours).
 //! - Events: `;PICK_AND_PLACE PART=.. X=.. Y=.. Z=.. ROTATION=..` (a marker for a host plugin),
 //!   a manual-insert pause in the flavour's way, comments, `G4 P<ms>` dwells, the active paste
 //!   tool's `paste_on_gcode`/`paste_off_gcode` for a switch on/off.
 //! - Arcs of paths with segments are written as chords within half the output resolution.
-//! - The end: retract, `;TYPE:Custom`, the rendered `printer.end_gcode`, then PrusaSlicer's
+//! - Custom G-code is replayed as it is written: the writer takes over the position, Z, feed
+//!   and (absolute E) the E register it leaves.
+//! - The end: retract, `;TYPE:Custom`, every tool's `end_gcode`, the rendered
+//!   `printer.end_gcode`, then PrusaSlicer's
 //!   footer lines (`; filament used [mm] = ...`, `; estimated printing time (normal mode) =
 //!   ...`) that OctoPrint and other tools read.
 //!

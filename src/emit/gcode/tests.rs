@@ -524,6 +524,63 @@ fn the_paste_tool_lifts_over_its_traces_on_long_travels() {
 }
 
 #[test]
+fn layer_templates_frame_the_layer_change_and_an_e_reset_in_them_is_followed() {
+    let program = two_tool_program();
+    let mut cfg = two_tool_config();
+    cfg.printer.before_layer_gcode =
+        ";before {layer_num} at {layer_z} of {max_layer_z}\nG92 E0".to_owned();
+    cfg.printer.layer_gcode = ";after {layer_num} {extruded_weight_total > 0}".to_owned();
+    let (abs_text, _) = write(&program, &cfg);
+    let lines: Vec<&str> = abs_text.lines().collect();
+    let at = |l: &str| lines.iter().position(|x| *x == l).unwrap_or(usize::MAX);
+    for (n, z, some) in [(0, "0.2", false), (1, "0.4", true)] {
+        let before = at(&format!(";before {n} at {z} of 0.4"));
+        assert_eq!(lines[before - 1], ";HEIGHT:0.2", "{abs_text}");
+        assert_eq!(lines[before + 1], "G92 E0");
+        let after = at(&format!(";after {n} {some}"));
+        let lift = lines[before..after]
+            .iter()
+            .position(|l| l.starts_with("G1 Z") || l.contains(" Z"))
+            .expect("the move to the layer lies between the two templates");
+        assert!(lift > 1, "{abs_text}");
+    }
+    // The `G92 E0` of the template is the writer's too: absolute E replays as relative E does
+    // (no retraction measured against an E register the printer no longer has). Layer 1
+    // starts 50 mm from where layer 0 ends, so the layer change retracts after the template.
+    let layer = |index: usize, x: f64| Layer {
+        index,
+        z: 0.2 * (index + 1) as f64,
+        height: 0.2,
+        items: vec![LayerItem::Path(square(
+            x,
+            10.0,
+            10.0,
+            0.2 * (index + 1) as f64,
+            Role::ExternalPerimeter,
+            0,
+        ))],
+    };
+    let program = Program {
+        layers: vec![layer(0, 10.0), layer(1, 60.0)],
+    };
+    let (abs_text, _) = write(&program, &cfg);
+    cfg.printer.use_relative_e_distances = true;
+    let (rel_text, _) = write(&program, &cfg);
+    let ((_, a), (_, r)) = (replay(&abs_text), replay(&rel_text));
+    assert_eq!(a.len(), r.len());
+    for (x, y) in a.iter().zip(&r) {
+        assert_eq!(x.to, y.to);
+        assert!(
+            (x.de - y.de).abs() <= 1.1e-5,
+            "line {}: {} vs {}",
+            x.line,
+            x.de,
+            y.de
+        );
+    }
+}
+
+#[test]
 fn relative_and_absolute_e_give_the_same_moves() {
     let program = two_tool_program();
     let mut cfg = two_tool_config();

@@ -46,6 +46,17 @@ struct ToolState {
     extrusion_time_s: f64,
 }
 
+impl ToolState {
+    /// Material laid so far, mm³: filament fed times its cross-section, or paste flow times
+    /// the time it was on.
+    fn volume_mm3(&self, tool: &crate::program::machine::Tool) -> f64 {
+        match self.feed {
+            Feed::Filament { .. } => self.filament_mm * tool.filament_area(),
+            Feed::Paste => self.extrusion_time_s * tool.paste_flow_mm3_s,
+        }
+    }
+}
+
 /// Renders `template` for `tool`, naming the template in errors.
 fn render(
     cfg: &GcodeParams,
@@ -247,10 +258,12 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             LineEnding::Lf,
         ));
         let (mut moved_xy, mut moved_z, mut sets_feed) = (false, false, false);
+        let mut names_e = false;
         for l in lines {
             let parsed = Line::new(l.as_str(), LineEnding::Lf);
             self.plan_parsed(&parsed);
             sets_feed |= parsed.get(b'F').is_some();
+            names_e |= parsed.get(b'E').is_some();
             if let Some(mv) = machine.step(&parsed) {
                 moved_xy |= mv.from[0] != mv.to[0] || mv.from[1] != mv.to[1];
                 moved_z |= mv.from[2] != mv.to[2];
@@ -283,6 +296,11 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         }
         if sets_feed {
             self.feed = None;
+        }
+        // A block that sets or moves E (a layer G-code's `G92 E0`) leaves the absolute E
+        // register where the next extrusion counts from.
+        if names_e && !self.relative_e {
+            self.e = machine.e();
         }
     }
 
@@ -644,6 +662,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             ("layer_z", scalar(self.layer_z)),
         ];
         vars.extend(self.print_vars.iter().cloned());
+        vars.extend(self.extruded_vars());
         // As PrusaSlicer: the old filament's end G-code before the tool-change G-code, the new
         // one's start G-code after it.
         self.filament_gcode(old, true, &vars)?;
@@ -932,6 +951,22 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         let h = fmt_xyz(layer.height);
         self.line(&format!(";HEIGHT:{h}"));
         self.height = Some(h);
+        // As PrusaSlicer: the layer's number from 0, its top and the print's highest layer.
+        let mut layer_vars = vec![
+            ("layer_num", scalar(layer.index)),
+            ("layer_z", scalar(layer.z)),
+        ];
+        layer_vars.extend(self.print_vars.iter().cloned());
+        layer_vars.extend(self.extruded_vars());
+        let tool = self.tool.unwrap_or(0);
+        let before = render(
+            cfg,
+            "printer.before_layer_gcode",
+            &cfg.printer.before_layer_gcode,
+            tool,
+            &layer_vars,
+        )?;
+        self.lines(&before);
         if layer.index == 1 {
             if cfg.printer.bed_temperature != cfg.printer.first_layer_bed_temperature {
                 self.line(&set_bed(cfg.printer.bed_temperature));
@@ -982,6 +1017,14 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             self.line("G92 E0");
             self.e = 0.0;
         }
+        let after = render(
+            cfg,
+            "printer.layer_gcode",
+            &cfg.printer.layer_gcode,
+            tool,
+            &layer_vars,
+        )?;
+        self.lines(&after);
         for item in &layer.items {
             match item {
                 LayerItem::Path(p) => self.path(p)?,
@@ -1221,6 +1264,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             ("max_layer_z", scalar(max_layer_z(program))),
         ];
         vars.extend(self.print_vars.iter().cloned());
+        vars.extend(self.extruded_vars());
         let end = render(
             cfg,
             "printer.end_gcode",
@@ -1244,6 +1288,29 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         })
     }
 
+    /// PrusaSlicer's running totals for custom G-code: `extruded_volume[N]` (mm³) and
+    /// `extruded_weight[N]` (g) of each tool so far, and their sums `extruded_volume_total` and
+    /// `extruded_weight_total` (a Prusa profile sets the acceleration by the weight carried).
+    fn extruded_vars(&self) -> [(&'static str, Var); 4] {
+        let (volumes, weights): (Vec<f64>, Vec<f64>) = self
+            .tools
+            .iter()
+            .zip(&self.cfg.tools)
+            .map(|(ts, tc)| {
+                let v = ts.volume_mm3(tc);
+                (v, v / 1000.0 * tc.filament_density)
+            })
+            .unzip();
+        let (volume, weight) = (volumes.iter().sum::<f64>(), weights.iter().sum::<f64>());
+        let vector = |xs: Vec<f64>| Var::Vector(xs.into_iter().map(Value::from).collect());
+        [
+            ("extruded_volume", vector(volumes)),
+            ("extruded_weight", vector(weights)),
+            ("extruded_volume_total", scalar(volume)),
+            ("extruded_weight_total", scalar(weight)),
+        ]
+    }
+
     /// Material used by each tool `program` uses.
     fn tool_stats(&self, program: &Program) -> Vec<ToolStats> {
         let cfg = self.cfg;
@@ -1251,10 +1318,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             .into_iter()
             .filter_map(|t| {
                 let (ts, tc) = (self.tools.get(t)?, cfg.tools.get(t)?);
-                let volume_mm3 = match ts.feed {
-                    Feed::Filament { .. } => ts.filament_mm * tc.filament_area(),
-                    Feed::Paste => ts.extrusion_time_s * tc.paste_flow_mm3_s,
-                };
+                let volume_mm3 = ts.volume_mm3(tc);
                 Some(ToolStats {
                     tool: t,
                     name: tc.name.clone(),
