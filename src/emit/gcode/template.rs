@@ -48,6 +48,18 @@ impl GcodeParams {
         tool: usize,
         vars: &[(&str, Var)],
     ) -> Result<String, TemplateError> {
+        self.render_template_with(template, tool, vars, &mut macros::Globals::new())
+    }
+
+    /// [`Self::render_template`] with the `global` variables of the templates before it, which
+    /// keep what this one defines or assigns.
+    pub fn render_template_with(
+        &self,
+        template: &str,
+        tool: usize,
+        vars: &[(&str, Var)],
+        globals: &mut macros::Globals,
+    ) -> Result<String, TemplateError> {
         let scope = Scope {
             params: self,
             printer: toml::Value::try_from(&self.printer).ok(),
@@ -59,7 +71,7 @@ impl GcodeParams {
             tool,
             vars,
         };
-        macros::render(template, &scope)
+        macros::render_with(template, &scope, globals)
     }
 }
 

@@ -682,6 +682,57 @@ fn each_tools_own_gcode_frames_its_work() {
 }
 
 #[test]
+fn globals_carry_across_templates_and_a_position_set_is_taken_over() {
+    let mut cfg = two_tool_config();
+    cfg.printer.start_gcode = "G28\n{global changes = 0}".to_owned();
+    // As the XL's tool change: the firmware lifts the nozzle 2 mm, and the template says so.
+    cfg.printer.before_tool_change_gcode =
+        "{changes = changes + 1}; change {changes} at z {position[2]}\n\
+         {position[2] = position[2] + 2}"
+            .to_owned();
+    cfg.printer.end_gcode = "; {changes} changes".to_owned();
+    let (text, _) = write(&two_tool_program(), &cfg);
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines.contains(&"; 2 changes"), "{text}");
+    for (n, z) in [(1, "0.2"), (2, "0.4")] {
+        let change = lines
+            .iter()
+            .position(|l| *l == format!("; change {n} at z {z}"))
+            .unwrap_or_else(|| panic!("change {n} in {text}"));
+        // The writer believes the nozzle 2 mm up: its travel's lift starts from there, and it
+        // comes back down to the layer before it extrudes again.
+        let z_of = |l: &&str| {
+            l.split_whitespace()
+                .find_map(|w| w.strip_prefix('Z'))
+                .and_then(|v| v.parse::<f64>().ok())
+        };
+        let first_z = lines[change..].iter().find_map(z_of).expect("a Z move");
+        let layer_z: f64 = z.parse().expect("z");
+        assert!(
+            first_z >= layer_z + 2.0,
+            "first Z {first_z} after change {n}: {text}"
+        );
+        let first_extrusion = change
+            + lines[change..]
+                .iter()
+                .position(|l| l.starts_with("G1 X") && l.contains(" E"))
+                .expect("an extrusion after the change");
+        let down = lines[change..first_extrusion]
+            .iter()
+            .any(|l| l.starts_with("G1") && l.contains(&format!("Z{z}")));
+        assert!(down, "no move back to z {z} after change {n}: {text}");
+    }
+    // A `position` that is no longer three numbers is an error naming the template.
+    cfg.printer.before_tool_change_gcode = "{position = 1}".to_owned();
+    let err = write_gcode(&two_tool_program(), &cfg, &mut Vec::new());
+    assert!(
+        matches!(&err, Err(EmitError::Template { template, .. })
+            if template == "printer.before_tool_change_gcode"),
+        "{err:?}"
+    );
+}
+
+#[test]
 fn unknown_tools_are_errors() {
     let mut program = one_layer_program();
     program.layers[0].items.push(LayerItem::Path(square(

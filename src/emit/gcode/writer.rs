@@ -11,7 +11,7 @@ use conduit_gcode::{fmt_e, fmt_f, fmt_xyz};
 
 use super::GcodeParams;
 use super::flavor::{Dialect, fan, set_bed, wait_bed};
-use super::macros::{Value, Var};
+use super::macros::{Globals, Value, Var};
 use super::sink::{GcodeSink, Motion, MotionKind};
 use super::{EmitError, GcodeStats, Resume, ToolStats};
 use crate::geom::Point3;
@@ -64,11 +64,12 @@ fn render(
     template: &str,
     tool: usize,
     vars: &[(&str, Var)],
+    globals: &mut Globals,
 ) -> Result<Vec<String>, EmitError> {
     if template.trim().is_empty() {
         return Ok(Vec::new());
     }
-    match cfg.render_template(template, tool, vars) {
+    match cfg.render_template_with(template, tool, vars, globals) {
         Ok(text) => Ok(text.lines().map(str::to_owned).collect()),
         Err(error) => Err(EmitError::Template {
             template: name.to_owned(),
@@ -76,6 +77,9 @@ fn render(
         }),
     }
 }
+
+/// PrusaSlicer's writable variable for where the nozzle is.
+const POSITION: &str = "position";
 
 /// A scalar variable of a template.
 fn scalar(v: impl Into<Value>) -> Var {
@@ -149,6 +153,10 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     /// The template variables that describe the whole print ([`print_variables`]), set by
     /// [`Self::start`] and given to every later template, as PrusaSlicer keeps them.
     print_vars: Vec<(&'static str, Var)>,
+    /// The `global` variables the templates defined so far.
+    globals: Globals,
+    /// Where the last template rendered said its G-code leaves the nozzle, if it said so.
+    set_position: Option<[f64; 3]>,
 }
 
 impl<'a, S: GcodeSink> Writer<'a, S> {
@@ -173,6 +181,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                         &t.paste_on_gcode,
                         i,
                         &[],
+                        &mut Globals::new(),
                     )?,
                     render(
                         cfg,
@@ -180,6 +189,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                         &t.paste_off_gcode,
                         i,
                         &[],
+                        &mut Globals::new(),
                     )?,
                 ),
             };
@@ -224,6 +234,8 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             switch: switched::SwitchState::default(),
             travel_inside: false,
             print_vars: Vec::new(),
+            globals: Globals::new(),
+            set_position: None,
         })
     }
 
@@ -301,6 +313,17 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         // register where the next extrusion counts from.
         if names_e && !self.relative_e {
             self.e = machine.e();
+        }
+        // A template that set `position` has the last word on where the nozzle is.
+        if let Some([x, y, z]) = self.set_position.take() {
+            let at = Point3::new(x, y, z);
+            self.at = Some(at);
+            if self.pos.is_some() {
+                self.pos = Some(at);
+            }
+            if self.z.is_some() {
+                self.set_z(z);
+            }
         }
     }
 
@@ -655,6 +678,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             return Ok(());
         };
         self.retract();
+        let cfg = self.cfg;
         let mut vars = vec![
             ("previous_tool", scalar(old)),
             ("next_tool", scalar(tool)),
@@ -666,10 +690,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         // As PrusaSlicer: the old filament's end G-code before the tool-change G-code, the new
         // one's start G-code after it.
         self.filament_gcode(old, true, &vars)?;
-        let before = render(
-            self.cfg,
+        let before = self.render_custom(
             "printer.before_tool_change_gcode",
-            &self.cfg.printer.before_tool_change_gcode,
+            &cfg.printer.before_tool_change_gcode,
             old,
             &vars,
         )?;
@@ -695,10 +718,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         }
         self.tool = Some(tool);
         self.wait_for_tool(tool);
-        let after = render(
-            self.cfg,
+        let after = self.render_custom(
             "printer.after_tool_change_gcode",
-            &self.cfg.printer.after_tool_change_gcode,
+            &cfg.printer.after_tool_change_gcode,
             tool,
             &vars,
         )?;
@@ -713,6 +735,52 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         Ok(())
     }
 
+    /// Renders a custom G-code template with the file's `global` variables and PrusaSlicer's
+    /// writable `position` ([x, y, z] where the nozzle is, mm). A template that assigns
+    /// `position` says where its G-code leaves the nozzle (the XL's tool change lifts Z by
+    /// `position[2] = position[2] + 2`): the writer takes that over once it has written the
+    /// lines ([`Self::lines`]).
+    fn render_custom(
+        &mut self,
+        name: &str,
+        template: &str,
+        tool: usize,
+        vars: &[(&str, Var)],
+    ) -> Result<Vec<String>, EmitError> {
+        let here = match self.at {
+            Some(p) => [p.x, p.y, p.z],
+            None => [0.0, 0.0, self.z.unwrap_or(self.layer_z)],
+        };
+        let seeded = Var::Vector(here.iter().map(|&c| Value::Float(c)).collect());
+        self.globals.insert(POSITION.to_owned(), seeded.clone());
+        let lines = render(self.cfg, name, template, tool, vars, &mut self.globals);
+        let set = self.globals.remove(POSITION).filter(|v| *v != seeded);
+        let lines = lines?;
+        self.set_position = match set {
+            None => None,
+            Some(var) => {
+                let xyz: Option<Vec<f64>> = match var {
+                    Var::Vector(v) => v.iter().map(|c| c.as_f64().ok()).collect(),
+                    Var::Scalar(_) => None,
+                };
+                match xyz.as_deref() {
+                    Some(&[x, y, z]) if [x, y, z].iter().all(|c| c.is_finite()) => Some([x, y, z]),
+                    _ => {
+                        return Err(EmitError::Template {
+                            template: name.to_owned(),
+                            error: super::macros::TemplateError {
+                                line: 1,
+                                placeholder: POSITION.to_owned(),
+                                problem: super::macros::Problem::NotNumeric,
+                            },
+                        });
+                    }
+                }
+            }
+        };
+        Ok(lines)
+    }
+
     /// Writes tool `tool`'s own G-code, its `start_gcode` (`end` false) or its `end_gcode`
     /// (PrusaSlicer's `start_filament_gcode` / `end_filament_gcode`), with
     /// `{filament_extruder_id}` the tool and `vars` besides.
@@ -722,7 +790,8 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         end: bool,
         vars: &[(&'static str, Var)],
     ) -> Result<(), EmitError> {
-        let Some(t) = self.cfg.tools.get(tool) else {
+        let cfg = self.cfg;
+        let Some(t) = cfg.tools.get(tool) else {
             return Ok(());
         };
         let (key, template) = if end {
@@ -732,13 +801,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         };
         let mut all = vec![("filament_extruder_id", scalar(tool))];
         all.extend(vars.iter().cloned());
-        let lines = render(
-            self.cfg,
-            &format!("tools.{tool}.{key}"),
-            template,
-            tool,
-            &all,
-        )?;
+        let lines = self.render_custom(&format!("tools.{tool}.{key}"), template, tool, &all)?;
         self.lines(&lines);
         Ok(())
     }
@@ -799,8 +862,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         let mut vars = self.print_vars.clone();
         // PrusaSlicer's current z-hop: none before the print.
         vars.push(("zhop", scalar(0.0)));
-        let start = render(
-            cfg,
+        let start = self.render_custom(
             "printer.start_gcode",
             &cfg.printer.start_gcode,
             first_tool,
@@ -959,8 +1021,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         layer_vars.extend(self.print_vars.iter().cloned());
         layer_vars.extend(self.extruded_vars());
         let tool = self.tool.unwrap_or(0);
-        let before = render(
-            cfg,
+        let before = self.render_custom(
             "printer.before_layer_gcode",
             &cfg.printer.before_layer_gcode,
             tool,
@@ -1017,8 +1078,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             self.line("G92 E0");
             self.e = 0.0;
         }
-        let after = render(
-            cfg,
+        let after = self.render_custom(
             "printer.layer_gcode",
             &cfg.printer.layer_gcode,
             tool,
@@ -1265,13 +1325,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         ];
         vars.extend(self.print_vars.iter().cloned());
         vars.extend(self.extruded_vars());
-        let end = render(
-            cfg,
-            "printer.end_gcode",
-            &cfg.printer.end_gcode,
-            tool,
-            &vars,
-        )?;
+        let end = self.render_custom("printer.end_gcode", &cfg.printer.end_gcode, tool, &vars)?;
         self.line(";TYPE:Custom");
         // As PrusaSlicer: every tool's end G-code, in tool order, before the printer's.
         for t in 0..cfg.tools.len() {

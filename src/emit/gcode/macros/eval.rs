@@ -20,20 +20,31 @@ pub struct EvalError {
     pub loc: Loc,
 }
 
-/// Runs parsed templates: the variables, and those the template defines itself.
+/// Runs parsed templates: the variables, and those the templates define themselves.
 pub struct Evaluator<'a> {
     vars: &'a dyn Variables,
-    /// `local` and `global` variables defined so far.
-    defined: BTreeMap<String, Var>,
+    /// `local` variables defined so far in this template.
+    locals: BTreeMap<String, Var>,
+    /// `global` variables, which outlive the template (the caller keeps them from one
+    /// template to the next), and the writable variables the caller put among them.
+    globals: &'a mut BTreeMap<String, Var>,
 }
 
 impl<'a> Evaluator<'a> {
-    /// An evaluator reading `vars`.
-    pub fn new(vars: &'a dyn Variables) -> Self {
+    /// An evaluator reading `vars`, with `globals` the global (and writable) variables so far.
+    pub fn new(vars: &'a dyn Variables, globals: &'a mut BTreeMap<String, Var>) -> Self {
         Self {
             vars,
-            defined: BTreeMap::new(),
+            locals: BTreeMap::new(),
+            globals,
         }
+    }
+
+    /// Whether `name` is a variable already.
+    fn exists(&self, name: &str) -> bool {
+        self.locals.contains_key(name)
+            || self.globals.contains_key(name)
+            || self.vars.var(name).is_some()
     }
 
     /// Writes `nodes` into `out`.
@@ -75,13 +86,20 @@ impl<'a> Evaluator<'a> {
                 out.push_str(&v.to_string());
             }
             Stmt::Define {
-                name, value, loc, ..
+                global,
+                name,
+                value,
+                loc,
             } => {
-                if self.defined.contains_key(name) || self.vars.var(name).is_some() {
+                if self.exists(name) {
                     return Err(at(loc)(Problem::Redefined(name.clone())));
                 }
                 let v = self.init(value).map_err(at(loc))?;
-                self.defined.insert(name.clone(), v);
+                if *global {
+                    self.globals.insert(name.clone(), v);
+                } else {
+                    self.locals.insert(name.clone(), v);
+                }
             }
             Stmt::Assign {
                 name,
@@ -139,7 +157,7 @@ impl<'a> Evaluator<'a> {
     }
 
     fn assign(&mut self, name: &str, index: Option<&Expr>, value: &Init) -> Result<(), Problem> {
-        if !self.defined.contains_key(name) {
+        if !self.locals.contains_key(name) && !self.globals.contains_key(name) {
             return Err(if self.vars.var(name).is_some() {
                 Problem::ReadOnly(name.to_owned())
             } else {
@@ -148,10 +166,13 @@ impl<'a> Evaluator<'a> {
         }
         let index = index.map(|i| self.index(i)).transpose()?;
         let new = self.init(value)?;
-        let slot = self
-            .defined
-            .get_mut(name)
-            .ok_or_else(|| Problem::UnknownVariable(name.to_owned()))?;
+        let slot = match self.locals.get_mut(name) {
+            Some(slot) => slot,
+            None => self
+                .globals
+                .get_mut(name)
+                .ok_or_else(|| Problem::UnknownVariable(name.to_owned()))?,
+        };
         match (slot, index, new) {
             (Var::Vector(v), Some(i), Var::Scalar(x)) => {
                 *v.get_mut(i).ok_or(Problem::IndexOutOfRange(i))? = x;
@@ -163,8 +184,9 @@ impl<'a> Evaluator<'a> {
     }
 
     fn lookup(&self, name: &str) -> Result<Var, Problem> {
-        self.defined
+        self.locals
             .get(name)
+            .or_else(|| self.globals.get(name))
             .cloned()
             .or_else(|| self.vars.var(name))
             .ok_or_else(|| Problem::UnknownVariable(name.to_owned()))

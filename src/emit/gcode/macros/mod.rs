@@ -13,9 +13,11 @@
 //!   `[name[index_name]]` element N); a `[…]` that names no variable stays text.
 //! - `{if cond}…{elsif cond}…{else}…{endif}`, nested and spanning lines, writes the text of
 //!   the first true branch; inside one macro, `{if cond then stmt; … elsif … else … endif}`.
-//! - Statements in one macro are separated by `;`: `local name = expr`, `global name = expr`
-//!   (both live until the end of the template), `name = expr` and `name[i] = expr` on such a
-//!   variable, `(a, b, …)` and `repeat(n, value)` vectors.
+//! - Statements in one macro are separated by `;`: `local name = expr` (lives until the end of
+//!   the template), `global name = expr` (lives on into the templates after it, see
+//!   [`render_with`]), `name = expr` and `name[i] = expr` on such a variable or on a writable
+//!   one the caller provides (the writer's `position`), `(a, b, …)` and `repeat(n, value)`
+//!   vectors.
 //! - Literals: integers, floats (`1.5`, `2e3`), `"strings"` (escapes `\n \r \" \\`), `true`,
 //!   `false`. Operators by precedence: `? :`; `or ||`; `and &&`; `== != <> =~ !~`
 //!   (`=~ /regex/` matches the whole string); `< > <= >=`; `+ -` (`+` joins strings); `* / %`;
@@ -142,9 +144,41 @@ pub struct TemplateError {
 /// # Ok::<(), conduit::emit::gcode::macros::TemplateError>(())
 /// ```
 pub fn render(template: &str, vars: &dyn Variables) -> Result<String, TemplateError> {
+    render_with(template, vars, &mut Globals::new())
+}
+
+/// The `global` variables of one G-code file, carried from each template to the next, and the
+/// writable variables a writer puts among them for one template (`position`).
+pub type Globals = std::collections::BTreeMap<String, Var>;
+
+/// Fills `template` with `vars` and `globals`: what it defines as `global` (or assigns to a
+/// variable of `globals`) stays in `globals` for the next template.
+///
+/// ```
+/// use conduit::emit::gcode::macros::{render_with, Globals, Value, Var, Variables};
+/// struct None_;
+/// impl Variables for None_ {
+///     fn var(&self, _: &str) -> Option<Var> {
+///         None
+///     }
+///     fn tool(&self) -> usize {
+///         0
+///     }
+/// }
+/// let mut globals = Globals::new();
+/// render_with("{global purged = 0}", &None_, &mut globals)?;
+/// assert_eq!(render_with("{purged = purged + 5}{purged}", &None_, &mut globals)?, "5");
+/// assert_eq!(globals["purged"], Var::Scalar(Value::Int(5)));
+/// # Ok::<(), conduit::emit::gcode::macros::TemplateError>(())
+/// ```
+pub fn render_with(
+    template: &str,
+    vars: &dyn Variables,
+    globals: &mut Globals,
+) -> Result<String, TemplateError> {
     let nodes = parser::parse(template).map_err(|e| error(template, e.loc, e.problem))?;
     let mut out = String::with_capacity(template.len());
-    eval::Evaluator::new(vars)
+    eval::Evaluator::new(vars, globals)
         .nodes(&nodes, &mut out)
         .map_err(|e| error(template, e.loc, e.problem))?;
     Ok(out)
