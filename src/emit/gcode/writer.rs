@@ -1325,12 +1325,12 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         ];
         vars.extend(self.print_vars.iter().cloned());
         vars.extend(self.extruded_vars());
-        let end = self.render_custom("printer.end_gcode", &cfg.printer.end_gcode, tool, &vars)?;
         self.line(";TYPE:Custom");
         // As PrusaSlicer: every tool's end G-code, in tool order, before the printer's.
         for t in 0..cfg.tools.len() {
             self.filament_gcode(t, true, &vars)?;
         }
+        let end = self.render_custom("printer.end_gcode", &cfg.printer.end_gcode, tool, &vars)?;
         self.lines(&end);
         self.planner.flush();
         self.take_planned_times();
