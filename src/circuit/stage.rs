@@ -943,6 +943,20 @@ pub struct FinePitch {
     pub width: f64,
 }
 
+impl FinePitch {
+    /// `pads U1.3 and U1.4 are 0.80 mm apart, closer than two traces can run`: what the
+    /// slice's warning and `conduit place` say first.
+    pub fn too_close(&self) -> String {
+        format!(
+            "pads {p}.{a} and {p}.{b} are {d:.2} mm apart, closer than two traces can run",
+            p = self.part,
+            a = self.pads[0],
+            b = self.pads[1],
+            d = self.distance,
+        )
+    }
+}
+
 /// The closest pair of connected pads of different nets on `part` that two traces of
 /// different nets cannot both reach at `params`' width, if any.
 pub fn fine_pitch(part: &PlacedPart, params: &RouteParams) -> Option<FinePitch> {
@@ -975,13 +989,9 @@ pub fn fine_pitch(part: &PlacedPart, params: &RouteParams) -> Option<FinePitch> 
 fn pitch_warning(part: &PlacedPart, params: &RouteParams) -> Option<String> {
     fine_pitch(part, params).map(|f| {
         format!(
-            "pads {p}.{a} and {p}.{b} are {d:.2} mm apart, closer than two traces can run \
-             ({spacing:.2} mm with route.conductive_width {w} and route.channel_extra {x}): \
+            "{} ({spacing:.2} mm with route.conductive_width {w} and route.channel_extra {x}): \
              their nets cannot both be routed; a conductive_width of {max:.2} mm fits",
-            p = f.part,
-            a = f.pads[0],
-            b = f.pads[1],
-            d = f.distance,
+            f.too_close(),
             spacing = f.spacing,
             w = params.conductive_width,
             x = params.channel_extra,

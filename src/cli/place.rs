@@ -177,12 +177,8 @@ fn report(args: &PlaceArgs, o: &PlaceOutcome, from: &str) -> Result<(), Failure>
     }
     if let Some(f) = &o.fine_pitch {
         outln!(
-            "pads {p}.{a} and {p}.{b} are {d:.2} mm apart, closer than two traces can run \
-             ({s:.2} mm): route with --set route.conductive_width={w:.2}, the widest that fits",
-            p = f.part,
-            a = f.pads[0],
-            b = f.pads[1],
-            d = f.distance,
+            "{} ({s:.2} mm): route with --set route.conductive_width={w:.2}, the widest that fits",
+            f.too_close(),
             s = f.spacing,
             w = f.width,
         )?;

@@ -86,12 +86,11 @@ impl Polygon {
     /// long band's width, a disc's radius. Near 0 for the slivers booleans leave where two
     /// operands' edges almost coincide. 0 for a polygon of fewer than three points.
     pub fn mean_width_mm(&self) -> f64 {
-        let mut ring = self.points.clone();
-        let Some(&first) = ring.first() else {
+        let (Some(&first), Some(&last)) = (self.points.first(), self.points.last()) else {
             return 0.0;
         };
-        ring.push(first);
-        let perimeter_mm = polyline_length(&ring) / super::point::UNITS_PER_MM;
+        let closing = (first.distance_squared(last) as f64).sqrt();
+        let perimeter_mm = (polyline_length(&self.points) + closing) / super::point::UNITS_PER_MM;
         if self.points.len() < 3 || perimeter_mm <= 0.0 {
             return 0.0;
         }

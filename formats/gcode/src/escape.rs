@@ -19,13 +19,7 @@ pub fn unescape_cstyle(s: &str) -> String {
             out.push(c);
             continue;
         }
-        match chars.next() {
-            Some('n') => out.push('\n'),
-            Some('r') => out.push('\r'),
-            Some('t') => out.push('\t'),
-            Some(other) => out.push(other),
-            None => out.push('\\'),
-        }
+        out.push(chars.next().map_or('\\', escaped));
     }
     out
 }
@@ -58,12 +52,7 @@ pub fn string_list(raw: &str) -> Option<Vec<String>> {
             loop {
                 match chars.next()? {
                     '"' => break,
-                    '\\' => match chars.next()? {
-                        'n' => item.push('\n'),
-                        'r' => item.push('\r'),
-                        't' => item.push('\t'),
-                        c => item.push(c),
-                    },
+                    '\\' => item.push(escaped(chars.next()?)),
                     c => item.push(c),
                 }
             }
@@ -83,6 +72,16 @@ pub fn string_list(raw: &str) -> Option<Vec<String>> {
             Some(';') => {}
             Some(_) => return None,
         }
+    }
+}
+
+/// The character a backslash before `c` stands for: `\n`, `\r`, `\t`, or `c` itself.
+fn escaped(c: char) -> char {
+    match c {
+        'n' => '\n',
+        'r' => '\r',
+        't' => '\t',
+        c => c,
     }
 }
 

@@ -55,6 +55,24 @@ fn replay(text: &str) -> (Vec<String>, Vec<Move>) {
     (lines, moves)
 }
 
+/// Asserts that the G-code of absolute E `abs_text` and of relative E `rel_text` replay as the
+/// same moves with the same extrusion.
+fn assert_same_moves(abs_text: &str, rel_text: &str) {
+    let ((_, a), (_, r)) = (replay(abs_text), replay(rel_text));
+    assert_eq!(a.len(), r.len());
+    for (x, y) in a.iter().zip(&r) {
+        assert_eq!(x.to, y.to);
+        // Absolute E is rounded once per position, relative once per move: 2 roundings apart.
+        assert!(
+            (x.de - y.de).abs() <= 1.1e-5,
+            "line {}: {} vs {}",
+            x.line,
+            x.de,
+            y.de
+        );
+    }
+}
+
 fn path(points: &[(f64, f64)], z: f64, closed: bool, role: Role, tool: usize) -> Toolpath {
     Toolpath {
         points: points.iter().map(|&(x, y)| Point3::new(x, y, z)).collect(),
@@ -566,18 +584,7 @@ fn layer_templates_frame_the_layer_change_and_an_e_reset_in_them_is_followed() {
     let (abs_text, _) = write(&program, &cfg);
     cfg.printer.use_relative_e_distances = true;
     let (rel_text, _) = write(&program, &cfg);
-    let ((_, a), (_, r)) = (replay(&abs_text), replay(&rel_text));
-    assert_eq!(a.len(), r.len());
-    for (x, y) in a.iter().zip(&r) {
-        assert_eq!(x.to, y.to);
-        assert!(
-            (x.de - y.de).abs() <= 1.1e-5,
-            "line {}: {} vs {}",
-            x.line,
-            x.de,
-            y.de
-        );
-    }
+    assert_same_moves(&abs_text, &rel_text);
 }
 
 #[test]
@@ -593,20 +600,7 @@ fn relative_and_absolute_e_give_the_same_moves() {
         !rel_text[body..].contains("G92 E0"),
         "no E resets in relative mode"
     );
-    let (_, a) = replay(&abs_text);
-    let (_, r) = replay(&rel_text);
-    assert_eq!(a.len(), r.len());
-    for (x, y) in a.iter().zip(&r) {
-        assert_eq!(x.to, y.to);
-        // Absolute E is rounded once per position, relative once per move: 2 roundings apart.
-        assert!(
-            (x.de - y.de).abs() <= 1.1e-5,
-            "line {}: {} vs {}",
-            x.line,
-            x.de,
-            y.de
-        );
-    }
+    assert_same_moves(&abs_text, &rel_text);
     assert!((abs_stats.tools[0].filament_mm - rel_stats.tools[0].filament_mm).abs() < 1e-9);
 }
 
