@@ -559,3 +559,101 @@ fn prusaslicers_own_project_reads_as_prusaslicer_wrote_it() {
     assert_eq!(e.config.slice.perimeters, 2);
     assert_eq!(e.config.slice.infill_density, 0.15);
 }
+
+/// `bytes` (a 3MF package) with the part `name` added.
+fn with_part(bytes: Vec<u8>, name: &str, text: &str) -> Vec<u8> {
+    let mut zip =
+        zip::ZipWriter::new_append(std::io::Cursor::new(bytes)).expect("the package reopens");
+    zip.start_file(name, zip::write::SimpleFileOptions::default())
+        .expect("a zip entry starts");
+    zip.write_all(text.as_bytes())
+        .expect("a zip entry is written");
+    zip.finish().expect("the zip is finished").into_inner()
+}
+
+/// The layer-slider events of a PrusaSlicer project (as PrusaSlicer 2.5 writes them), with
+/// one above the 10 mm cube's top.
+const LAYER_SLIDER: &str = r##"<?xml version="1.0" encoding="utf-8"?>
+<custom_gcodes_per_print_z>
+<code print_z="2.2" type="0" extruder="1" color="#FF0000" extra="" gcode="M600"/>
+<code print_z="4" type="1" extruder="1" color="" extra="Insert magnets" gcode="M601"/>
+<code print_z="6.3" type="4" extruder="1" color="" extra="M117 custom here&#10;G4 S1" gcode="M117 custom here"/>
+<code print_z="50" type="1" extruder="1" color="" extra="never" gcode="M601"/>
+<mode value="SingleExtruder"/>
+</custom_gcodes_per_print_z>
+"##;
+
+/// PrusaSlicer's colour changes, pauses and custom G-code by height come before the first
+/// layer whose top reaches them, right after the move to it (PrusaSlicer 2.5 puts the same
+/// project's events on the same layers), with the project's profile or with `--config`; one
+/// above the print is named on the terminal; `conduit check` replays the file.
+#[test]
+fn layer_slider_events_come_where_prusaslicer_puts_them() {
+    let dir = temp_dir();
+    let bytes = prusa_project("box", &[part(CUBE_10, "ModelPart", "box")], &[], PROFILE);
+    let p = write(
+        dir.path(),
+        "events.3mf",
+        &with_part(
+            bytes,
+            "Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml",
+            LAYER_SLIDER,
+        ),
+    );
+    let toml = write(
+        dir.path(),
+        "c.toml",
+        b"[printer]\ncolor_change_gcode = \"M600 ; T{color_change_extruder}\"\n\
+          [slice]\nlayer_height = 0.3\nfirst_layer_height = 0.3\n",
+    );
+    for extra in [&[][..], &["-c", toml.to_str().unwrap_or_default()]] {
+        let (err, _, ok) = slice(dir.path(), &p, extra);
+        assert!(ok, "{err}");
+        assert!(
+            err.contains("events.3mf: 4 event(s) of PrusaSlicer's layer slider stored in it"),
+            "{err}"
+        );
+        assert!(
+            err.contains(
+                "custom G-code by height above the print's last layer is not written (at 50 mm)"
+            ),
+            "{err}"
+        );
+        let gcode = std::fs::read_to_string(dir.path().join("out.gcode")).expect("G-code");
+        let lines: Vec<&str> = gcode.lines().collect();
+        // 0.3 mm layers: 2.2 mm comes before the layer up to 2.4 mm, 4 before 4.2, 6.3 before
+        // 6.3 itself.
+        let m600 = if extra.is_empty() {
+            "M600"
+        } else {
+            "M600 ; T0"
+        };
+        for (tag, z, then) in [
+            (";COLOR_CHANGE,T0,#FF0000", "2.4", &[m600][..]),
+            (";PAUSE_PRINT", "4.2", &["M117 Insert magnets", "M601"]),
+            (";CUSTOM_GCODE", "6.3", &["M117 custom here", "G4 S1"]),
+        ] {
+            let at: Vec<usize> = (0..lines.len()).filter(|&i| lines[i] == tag).collect();
+            assert_eq!(at.len(), 1, "{tag} once");
+            let i = at[0];
+            assert_eq!(&lines[i + 1..i + 1 + then.len()], then);
+            let layer = lines[..i]
+                .iter()
+                .rposition(|l| *l == ";LAYER_CHANGE")
+                .unwrap_or(0);
+            assert_eq!(lines[layer + 1], format!(";Z:{z}"));
+            assert!(lines[layer..i].iter().any(|l| l.starts_with("G1 Z")));
+            assert!(
+                !lines[layer..i]
+                    .iter()
+                    .any(|l| l.contains(" E") && l.contains(" X"))
+            );
+        }
+        assert!(!gcode.contains("never"));
+        let check = conduit([
+            "check",
+            dir.path().join("out.gcode").to_str().unwrap_or_default(),
+        ]);
+        assert!(check.status.success(), "{}", stderr(&check));
+    }
+}

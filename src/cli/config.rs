@@ -7,7 +7,15 @@ use conduit::config::{self, Config};
 /// Loads the config a command asked for (defaults when none), applies `--set` overrides and
 /// validates it; warnings go to stderr.
 pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
-    let (cfg, shown) = match &src.config {
+    resolve_adjusted(src, |_| {})
+}
+
+/// [`resolve`], with `adjust` applied to the loaded config before `--set`.
+fn resolve_adjusted(
+    src: &ConfigSource,
+    adjust: impl FnOnce(&mut Config),
+) -> Result<Config, Failure> {
+    let (mut cfg, shown) = match &src.config {
         Some(path) => {
             // Every error of `load` names the file but a failed validation.
             let (cfg, warnings) = config::load(path).map_err(|e| match e {
@@ -23,6 +31,7 @@ pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
         }
         None => (Config::default(), Vec::new()),
     };
+    adjust(&mut cfg);
     with_overrides(src, cfg, &shown)
 }
 
@@ -30,7 +39,9 @@ pub(crate) fn resolve(src: &ConfigSource) -> Result<Config, Failure> {
 /// (`slicer`, a 3MF's): without `--config`, the profile and object settings stored in it
 /// (`conduit::config::embedded`), said on the terminal, then `--set`; with `--config`, that
 /// file alone, and the stored profile is said to be unused. Settings of objects and volumes
-/// that are not honoured are named either way.
+/// that are not honoured are named either way. The colour changes, pauses and custom G-code
+/// stored by height belong to the model and join `printer.custom_gcode_per_print_z` either way
+/// (`conduit::config::embedded::layer_gcodes`).
 pub(crate) fn resolve_for_model(
     src: &ConfigSource,
     model: &std::path::Path,
@@ -48,7 +59,7 @@ pub(crate) fn resolve_for_model(
         for w in config::embedded::unhonoured(slicer, false) {
             warnln!("{file}: {w}");
         }
-        return resolve(src);
+        return resolve_adjusted(src, |cfg| add_layer_gcodes(cfg, model, slicer));
     }
     let embedded = config::embedded::from_3mf(slicer)
         .map_err(|e| anyhow::Error::new(e).context(file.to_string()))?;
@@ -56,7 +67,7 @@ pub(crate) fn resolve_for_model(
         for w in config::embedded::unhonoured(slicer, false) {
             warnln!("{file}: {w}");
         }
-        return resolve(src);
+        return resolve_adjusted(src, |cfg| add_layer_gcodes(cfg, model, slicer));
     };
     infoln!(
         "{file}: slicing with {} stored in it (--config and --set override it)",
@@ -65,7 +76,31 @@ pub(crate) fn resolve_for_model(
     for w in &e.warnings {
         show_load_warning(model, w);
     }
-    with_overrides(src, e.config, &e.warnings)
+    let mut cfg = e.config;
+    add_layer_gcodes(&mut cfg, model, slicer);
+    with_overrides(src, cfg, &e.warnings)
+}
+
+/// Adds the colour changes, pauses and custom G-code stored by height in the model file
+/// `model` to `cfg`, saying how many and what was left out.
+fn add_layer_gcodes(
+    cfg: &mut Config,
+    model: &std::path::Path,
+    slicer: &conduit_3mf::SlicerSettings,
+) {
+    let (events, warnings) = config::embedded::layer_gcodes(slicer, cfg.tools.len());
+    let file = model.display();
+    for w in &warnings {
+        warnln!("{file}: {w}");
+    }
+    if !events.is_empty() {
+        infoln!(
+            "{file}: {} event(s) of PrusaSlicer's layer slider stored in it (colour changes, \
+             pauses, custom G-code) go into printer.custom_gcode_per_print_z",
+            events.len()
+        );
+    }
+    cfg.printer.custom_gcode_per_print_z.extend(events);
 }
 
 /// `cfg` with the `--set` overrides of `src` applied and validated; the validation's warnings

@@ -13,6 +13,10 @@
 //!   which slices all objects with one profile, names each object's keys as not honoured.
 //! - A volume's settings (a modifier's, or a part's own) are never honoured and are named.
 //!
+//! - PrusaSlicer's colour changes, pauses and custom G-code by height (the layer slider's,
+//!   `conduit_3mf::CustomGcodes`) become `printer.custom_gcode_per_print_z` ([`layer_gcodes`]),
+//!   whichever config the job uses: they belong to the model, as in PrusaSlicer.
+//!
 //! Lists of keys not honoured are sorted by impact ([`super::prusa_ini::impact`]): keys conduit
 //! reads from a profile first, then those that change the print, then the rest, each
 //! alphabetically; every key is named once per object or volume.
@@ -20,10 +24,90 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use conduit_3mf::{Layout, ObjectSettings, Setting, SlicerSettings};
+use conduit_3mf::{CustomGcodeKind, Layout, ObjectSettings, Setting, SlicerSettings};
 
 use super::prusa_ini::{from_lined_pairs, impact};
-use super::{Config, ConfigError};
+use super::{Config, ConfigError, LayerGcode, LayerGcodeKind};
+
+/// The colour changes, pauses and custom G-code by height stored in `s`, for a printer with
+/// `tools` tools, as PrusaSlicer applies them (`ToolOrdering::assign_custom_gcodes`), and what
+/// was left out. conduit prints the model with one tool, so its printer is PrusaSlicer's
+/// "single extruder" with one tool and "multi as single" with more:
+///
+/// - events entered for a multi-extruder printer (`mode` `MultiExtruder`) change colours by
+///   switching extruders; their colour and tool changes are left out;
+/// - tool changes entered as "multi as single" become colour changes of the one tool on a
+///   one-tool printer, and are left out otherwise;
+/// - a colour change for an extruder the printer does not have is left out.
+pub fn layer_gcodes(s: &SlicerSettings, tools: usize) -> (Vec<LayerGcode>, Vec<String>) {
+    let Some(c) = &s.custom_gcodes else {
+        return (Vec::new(), Vec::new());
+    };
+    let part = c.part.trim_start_matches('/');
+    let mode = c.mode.as_deref().unwrap_or("SingleExtruder");
+    let multi_extruder = mode == "MultiExtruder";
+    let (mut out, mut warnings) = (Vec::new(), Vec::new());
+    for code in &c.codes {
+        let left_out = |what: &str, why: &str| {
+            format!(
+                "{part}:{}: the {what} at {} mm is left out: {why}",
+                code.line, code.print_z
+            )
+        };
+        let mut tool = code.extruder.checked_sub(1).map(|t| t as usize);
+        let kind = match code.kind {
+            CustomGcodeKind::ColorChange | CustomGcodeKind::ToolChange if multi_extruder => {
+                warnings.push(left_out(
+                    "filament change",
+                    "it was entered for a multi-extruder printer",
+                ));
+                continue;
+            }
+            CustomGcodeKind::ToolChange if !(mode == "MultiAsSingle" && tools == 1) => {
+                warnings.push(left_out(
+                    "tool change",
+                    "conduit prints the model with one tool",
+                ));
+                continue;
+            }
+            // On the one tool: a change of filament in the tool printing.
+            CustomGcodeKind::ToolChange => {
+                tool = None;
+                LayerGcodeKind::ColorChange
+            }
+            CustomGcodeKind::ColorChange => {
+                if tool.is_some_and(|t| t >= tools) {
+                    warnings.push(left_out(
+                        "colour change",
+                        &format!("extruder {} is not among the {tools} tools", code.extruder),
+                    ));
+                    continue;
+                }
+                LayerGcodeKind::ColorChange
+            }
+            CustomGcodeKind::PausePrint => LayerGcodeKind::Pause,
+            CustomGcodeKind::Template => LayerGcodeKind::Template,
+            CustomGcodeKind::Custom => LayerGcodeKind::Custom,
+        };
+        let change = kind == LayerGcodeKind::ColorChange;
+        out.push(LayerGcode {
+            print_z: code.print_z,
+            kind,
+            tool: tool.filter(|_| change),
+            color: if change {
+                code.color.clone()
+            } else {
+                String::new()
+            },
+            extra: if change {
+                String::new()
+            } else {
+                code.extra.clone()
+            },
+        });
+    }
+    (out, warnings)
+}
 
 /// The job's config taken from a 3MF.
 #[derive(Debug, Clone)]
@@ -148,4 +232,84 @@ fn by_impact(settings: &[Setting]) -> String {
     keys.sort_unstable();
     keys.dedup_by(|a, b| a.1 == b.1);
     keys.iter().map(|(_, k)| *k).collect::<Vec<_>>().join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use conduit_3mf::{CustomGcode, CustomGcodes};
+
+    fn settings(mode: &str, codes: &[(f64, CustomGcodeKind, u32)]) -> SlicerSettings {
+        SlicerSettings {
+            custom_gcodes: Some(CustomGcodes {
+                part: conduit_3mf::PRUSA_CUSTOM_GCODE_PART.to_owned(),
+                mode: Some(mode.to_owned()),
+                codes: codes
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &(print_z, kind, extruder))| CustomGcode {
+                        print_z,
+                        kind,
+                        extruder,
+                        color: "#123456".to_owned(),
+                        extra: "note".to_owned(),
+                        line: k + 3,
+                    })
+                    .collect(),
+            }),
+            ..SlicerSettings::default()
+        }
+    }
+
+    fn kinds(events: &[LayerGcode]) -> Vec<(f64, LayerGcodeKind, Option<usize>)> {
+        events.iter().map(|e| (e.print_z, e.kind, e.tool)).collect()
+    }
+
+    #[test]
+    fn layer_slider_events_apply_as_prusaslicer_applies_them() {
+        use CustomGcodeKind as K;
+        use LayerGcodeKind as L;
+        let codes = [
+            (1.0, K::ColorChange, 1),
+            (2.0, K::PausePrint, 1),
+            (3.0, K::ToolChange, 2),
+            (4.0, K::Custom, 0),
+            (5.0, K::ColorChange, 3),
+        ];
+        // One tool, entered for a single-extruder printer: the tool change is not a colour
+        // change, extruder 3 does not exist.
+        let (events, warnings) = layer_gcodes(&settings("SingleExtruder", &codes), 1);
+        assert_eq!(
+            kinds(&events),
+            vec![
+                (1.0, L::ColorChange, Some(0)),
+                (2.0, L::Pause, None),
+                (4.0, L::Custom, None)
+            ]
+        );
+        assert_eq!(
+            (events[0].color.as_str(), events[0].extra.as_str()),
+            ("#123456", "")
+        );
+        assert_eq!(
+            (events[1].color.as_str(), events[1].extra.as_str()),
+            ("", "note")
+        );
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
+        assert!(warnings[0].starts_with(
+            "Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml:5: the tool change at 3 mm is left out"
+        ));
+        assert!(warnings[1].contains("extruder 3 is not among the 1 tools"));
+        // Entered as "multi as single" for a one-tool printer: tool changes are colour changes.
+        let (events, _) = layer_gcodes(&settings("MultiAsSingle", &codes), 1);
+        assert!(kinds(&events).contains(&(3.0, L::ColorChange, None)));
+        // Entered for a multi-extruder printer: its colour and tool changes mean extruder
+        // switches, which conduit does not make; pauses and custom G-code stay.
+        let (events, warnings) = layer_gcodes(&settings("MultiExtruder", &codes), 2);
+        assert_eq!(
+            kinds(&events),
+            vec![(2.0, L::Pause, None), (4.0, L::Custom, None)]
+        );
+        assert_eq!(warnings.len(), 3, "{warnings:?}");
+    }
 }

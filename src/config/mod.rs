@@ -69,7 +69,8 @@ use crate::emit::gcode::macros::Var;
 use crate::emit::gcode::{GcodeParams, SwitchedParams, TemplateError};
 use crate::program::Role;
 pub use crate::program::machine::{
-    DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, PnpSettings, Printer, Tool, ToolKind,
+    DEFAULT_END_GCODE, DEFAULT_START_GCODE, Flavor, LayerGcode, LayerGcodeKind, PnpSettings,
+    Printer, Tool, ToolKind,
 };
 use crate::region::{
     BrimParams, BrimType, InfillPatternKind, MIN_LAYER_HEIGHT, NOZZLE_RANGE, PerimeterGenerator,
@@ -673,6 +674,20 @@ impl Config {
         problems.extend(self.compensate.problems());
         if !(self.pnp.lift.is_finite() && self.pnp.lift >= 0.0) {
             problems.push(format!("pnp.lift must be ≥ 0, got {}", self.pnp.lift));
+        }
+        for (i, e) in self.printer.custom_gcode_per_print_z.iter().enumerate() {
+            if !(e.print_z.is_finite() && e.print_z >= 0.0) {
+                problems.push(format!(
+                    "printer.custom_gcode_per_print_z[{i}].print_z must be ≥ 0, got {}",
+                    e.print_z
+                ));
+            }
+            if let Some(t) = e.tool.filter(|&t| t >= self.tools.len()) {
+                problems.push(format!(
+                    "printer.custom_gcode_per_print_z[{i}].tool = {t}, but only tools 0..{} exist",
+                    self.tools.len()
+                ));
+            }
         }
         problems.extend(
             self.region_params()

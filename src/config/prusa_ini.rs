@@ -12,7 +12,8 @@
 //! - printer: `bed_shape` (polygon; its bounding box gives `bed_size` and `bed_origin`),
 //!   `max_print_height`, `gcode_flavor` (`marlin`, `marlin2`, `reprapfirmware`, `klipper`;
 //!   others become marlin with a warning), `start_gcode`, `end_gcode`, `before_layer_gcode`,
-//!   `layer_gcode` (`\n` escapes undone),
+//!   `layer_gcode`, `color_change_gcode`, `pause_print_gcode`, `template_custom_gcode`
+//!   (`\n` escapes undone),
 //!   `bed_temperature`, `first_layer_bed_temperature`, `retract_length`, `retract_speed`,
 //!   `deretract_speed`, `retract_before_travel`, `retract_lift`, `travel_speed`,
 //!   `machine_max_acceleration_extruding` (or `default_acceleration`),
@@ -364,6 +365,18 @@ const RULES: &[(&str, Rule)] = &[
         Rule::Gcode(|c| &mut c.printer.before_layer_gcode),
     ),
     ("layer_gcode", Rule::Gcode(|c| &mut c.printer.layer_gcode)),
+    (
+        "color_change_gcode",
+        Rule::Gcode(|c| &mut c.printer.color_change_gcode),
+    ),
+    (
+        "pause_print_gcode",
+        Rule::Gcode(|c| &mut c.printer.pause_print_gcode),
+    ),
+    (
+        "template_custom_gcode",
+        Rule::Gcode(|c| &mut c.printer.template_custom_gcode),
+    ),
     ("toolchange_gcode", Rule::Custom(toolchange_gcode)),
     (
         "bed_temperature",

@@ -201,8 +201,17 @@ pub struct SliceSummary {
 impl SliceSummary {
     /// What the user should hear about on the terminal, one line each: objects whose open
     /// contours could not be closed and were left out of the print, or were closed across a gap
-    /// (either way the mesh has holes, and the print differs from a closed mesh's).
+    /// (either way the mesh has holes, and the print differs from a closed mesh's), and custom
+    /// G-code by height that no layer reached.
     pub fn warnings(&self) -> Vec<String> {
+        let above = &self.gcode.events_above_print;
+        let events = (!above.is_empty()).then(|| {
+            let at: Vec<String> = above.iter().map(|z| format!("{z} mm")).collect();
+            format!(
+                "custom G-code by height above the print's last layer is not written (at {})",
+                at.join(", ")
+            )
+        });
         self.objects
             .iter()
             .filter_map(|o| {
@@ -227,6 +236,7 @@ impl SliceSummary {
                     o.name
                 ))
             })
+            .chain(events)
             .collect()
     }
 }

@@ -74,6 +74,25 @@ pub struct Printer {
     /// its first path (the variables of `before_layer_gcode`). PrusaSlicer's `layer_gcode`
     /// imports here. Default empty.
     pub layer_gcode: String,
+    /// G-code template of a colour change (an event of `custom_gcode_per_print_z` with
+    /// `type = "color_change"`), with `{color_change_extruder}` the tool whose filament changes
+    /// (from 0). PrusaSlicer's `color_change_gcode`. Default `M600`.
+    pub color_change_gcode: String,
+    /// G-code template of a pause (`type = "pause"`), written after `M117 <message>` when the
+    /// pause has a message. PrusaSlicer's `pause_print_gcode`. Default `M601`.
+    pub pause_print_gcode: String,
+    /// G-code template of an event with `type = "template"`. PrusaSlicer's
+    /// `template_custom_gcode`. Default empty.
+    pub template_custom_gcode: String,
+    /// Colour changes, pauses and custom G-code at given heights (PrusaSlicer's layer slider;
+    /// a PrusaSlicer 3MF project's are added), each written once at the start of the first
+    /// layer whose top reaches its `print_z`, after the move to that layer: `type` is
+    /// `"color_change"` (`;COLOR_CHANGE,T<tool>,<color>` and `color_change_gcode`), `"pause"`
+    /// (`;PAUSE_PRINT`, `M117 <extra>`, `pause_print_gcode`), `"template"`
+    /// (`template_custom_gcode`) or `"custom"` (the G-code in `extra`). Default none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[schemars(example = layer_gcode_example())]
+    pub custom_gcode_per_print_z: Vec<LayerGcode>,
     /// Filament pulled back before travels, mm (a tool's own `retract_length` overrides it).
     /// Default 0.8.
     pub retract_length: f64,
@@ -145,6 +164,57 @@ pub struct Printer {
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     #[schemars(example = profile_example())]
     pub profile: BTreeMap<String, String>,
+}
+
+/// What a [`LayerGcode`] does.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize, schemars::JsonSchema,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum LayerGcodeKind {
+    /// A filament change: `;COLOR_CHANGE,T<extruder>,<color>`, then
+    /// `printer.color_change_gcode`.
+    #[default]
+    ColorChange,
+    /// A pause: `;PAUSE_PRINT`, `M117 <extra>` when there is a message, then
+    /// `printer.pause_print_gcode`.
+    Pause,
+    /// `;CUSTOM_GCODE`, then `printer.template_custom_gcode`.
+    Template,
+    /// `;CUSTOM_GCODE`, then the event's own G-code (`extra`).
+    Custom,
+}
+
+/// One event of `printer.custom_gcode_per_print_z`: G-code written at the start of a layer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LayerGcode {
+    /// Height, mm: the event comes before the first layer whose top is at or above it
+    /// (within 0.1 µm), as PrusaSlicer places it.
+    pub print_z: f64,
+    /// What it does: `"color_change"`, `"pause"`, `"template"` or `"custom"`.
+    #[serde(rename = "type")]
+    pub kind: LayerGcodeKind,
+    /// The tool whose filament changes (colour changes), from 0; absent = the tool printing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool: Option<usize>,
+    /// The new filament's colour (`#RRGGBB`), written in the `;COLOR_CHANGE` tag.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub color: String,
+    /// The pause's message, or the custom G-code.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub extra: String,
+}
+
+/// The example of [`Printer::custom_gcode_per_print_z`] in the documented defaults.
+fn layer_gcode_example() -> Vec<LayerGcode> {
+    vec![LayerGcode {
+        print_z: 2.2,
+        kind: LayerGcodeKind::ColorChange,
+        tool: Some(0),
+        color: "#FF0000".to_owned(),
+        extra: String::new(),
+    }]
 }
 
 /// What a tool deposits and therefore how it is driven.
@@ -257,6 +327,10 @@ impl Default for Printer {
             after_tool_change_gcode: String::new(),
             before_layer_gcode: String::new(),
             layer_gcode: String::new(),
+            color_change_gcode: "M600".to_owned(),
+            pause_print_gcode: "M601".to_owned(),
+            template_custom_gcode: String::new(),
+            custom_gcode_per_print_z: Vec::new(),
             retract_length: 0.8,
             retract_speed: 35.0,
             deretract_speed: 0.0,

@@ -108,7 +108,7 @@ pub enum MeshDetails {
         name: Option<String>,
     },
     /// 3MF.
-    ThreeMf(ThreeMfDetails),
+    ThreeMf(Box<ThreeMfDetails>),
     /// OBJ.
     Obj,
     /// OFF.
@@ -401,7 +401,7 @@ fn threemf_content(
     };
     Ok(Content::Mesh {
         scene: Scene { objects },
-        details: MeshDetails::ThreeMf(details),
+        details: MeshDetails::ThreeMf(Box::new(details)),
     })
 }
 

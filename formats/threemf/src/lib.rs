@@ -132,7 +132,8 @@ pub use model::{
 };
 pub use read::{ReadOptions, read, read_with};
 pub use slicer::{
-    Layout, ORCA_MODEL_PART, ORCA_PROFILE_PART, ObjectSettings, PRUSA_MODEL_PART,
-    PRUSA_PROFILE_PART, Profile, Setting, SlicerSettings, Volume, VolumeKind, VolumeMesh,
+    CustomGcode, CustomGcodeKind, CustomGcodes, Layout, ORCA_MODEL_PART, ORCA_PROFILE_PART,
+    ObjectSettings, PRUSA_CUSTOM_GCODE_PART, PRUSA_MODEL_PART, PRUSA_PROFILE_PART, Profile,
+    Setting, SlicerSettings, Volume, VolumeKind, VolumeMesh,
 };
 pub use write::{ROOT_MODEL_PATH, format_number, write};

@@ -177,6 +177,10 @@ pub struct GcodeStats {
     pub estimated_time_s: f64,
     /// Per tool used, ascending.
     pub tools: Vec<ToolStats>,
+    /// Heights (mm) of the events of `printer.custom_gcode_per_print_z` above the last layer,
+    /// which were not written.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events_above_print: Vec<f64>,
     /// The totals of a switched-tool job ([`SwitchedParams`]); `None` otherwise. Not part of
     /// reports.
     #[serde(skip)]

@@ -588,6 +588,121 @@ fn layer_templates_frame_the_layer_change_and_an_e_reset_in_them_is_followed() {
 }
 
 #[test]
+fn events_by_height_come_before_the_first_layer_reaching_them() {
+    use crate::program::machine::{LayerGcode, LayerGcodeKind};
+    let event = |print_z: f64, kind: LayerGcodeKind, extra: &str| LayerGcode {
+        print_z,
+        kind,
+        tool: None,
+        color: String::new(),
+        extra: extra.to_owned(),
+    };
+    let mut cfg = test_config();
+    cfg.printer.color_change_gcode = "M600 T{color_change_extruder} ; at {layer_z}".to_owned();
+    cfg.printer.template_custom_gcode = "M117 layer {layer_num}".to_owned();
+    cfg.printer.custom_gcode_per_print_z = vec![
+        event(0.6, LayerGcodeKind::Pause, "swap magnets"),
+        LayerGcode {
+            tool: Some(0),
+            color: "#00FF00".to_owned(),
+            ..event(0.3, LayerGcodeKind::ColorChange, "")
+        },
+        event(0.8, LayerGcodeKind::Custom, "G4 P10\nM117 done"),
+        event(0.8, LayerGcodeKind::Template, ""),
+        event(5.0, LayerGcodeKind::Pause, "never"),
+    ];
+    // Four layers 0.2 mm high, each starting 50 mm from where the one below ends, so every
+    // layer change retracts.
+    let layer = |index: usize| {
+        let z = 0.2 * (index + 1) as f64;
+        Layer {
+            index,
+            z,
+            height: 0.2,
+            items: vec![LayerItem::Path(square(
+                10.0 + 50.0 * (index % 2) as f64,
+                10.0,
+                10.0,
+                z,
+                Role::ExternalPerimeter,
+                0,
+            ))],
+        }
+    };
+    let program = Program {
+        layers: (0..4).map(layer).collect(),
+    };
+    let (abs_text, _) = write(&program, &cfg);
+    let lines: Vec<&str> = abs_text.lines().collect();
+    let at = |l: &str| {
+        let found: Vec<usize> = (0..lines.len()).filter(|&i| lines[i] == l).collect();
+        assert_eq!(found.len(), 1, "{l:?} once in {abs_text}");
+        found[0]
+    };
+    // Each event is in the layer whose top first reaches it, after the move to that layer and
+    // before its first extrusion.
+    let layer_of = |i: usize| {
+        lines[..i]
+            .iter()
+            .rev()
+            .find_map(|l| l.strip_prefix(";Z:"))
+            .unwrap_or_default()
+    };
+    let change = at(";COLOR_CHANGE,T0,#00FF00");
+    assert_eq!(lines[change + 1], "M600 T0 ; at 0.4");
+    let pause = at(";PAUSE_PRINT");
+    assert_eq!(lines[pause + 1..pause + 3], ["M117 swap magnets", "M601"]);
+    let custom = (0..lines.len())
+        .filter(|&i| lines[i] == ";CUSTOM_GCODE")
+        .collect::<Vec<_>>();
+    assert_eq!(custom.len(), 2, "{abs_text}");
+    assert_eq!(lines[custom[0] + 1..custom[0] + 3], ["G4 P10", "M117 done"]);
+    assert_eq!(lines[custom[1] + 1], "M117 layer 3");
+    for (i, z) in [(change, "0.4"), (pause, "0.6"), (custom[0], "0.8")] {
+        assert_eq!(layer_of(i), z, "{abs_text}");
+        let layer_start = (0..i)
+            .rev()
+            .find(|&k| lines[k] == ";LAYER_CHANGE")
+            .unwrap_or(0);
+        assert!(
+            lines[layer_start..i].iter().any(|l| l.starts_with("G1 Z")),
+            "the event follows the move to the layer: {abs_text}"
+        );
+        assert!(
+            !lines[layer_start..i]
+                .iter()
+                .any(|l| l.starts_with("G1 X") && l.contains(" E")),
+            "nothing is extruded on the layer before the event: {abs_text}"
+        );
+    }
+    assert!(
+        !abs_text.contains("never"),
+        "an event above the print is not written"
+    );
+    // The firmware's filament change leaves the nozzle primed: the retraction of the layer
+    // change (layer 1 starts 50 mm away) is not undone after it, so with relative E the
+    // filament moves of that layer change come to one retraction; and absolute E still replays
+    // as relative E does.
+    cfg.printer.use_relative_e_distances = true;
+    let (rel_text, _) = write(&program, &cfg);
+    let rel: Vec<&str> = rel_text.lines().collect();
+    let from = rel.iter().position(|l| *l == ";Z:0.4").unwrap_or_default();
+    let to = (from..rel.len())
+        .find(|&k| rel[k].starts_with("G1 X") && rel[k].contains(" E"))
+        .unwrap_or(rel.len());
+    let filament: f64 = rel[from..to]
+        .iter()
+        .filter_map(|l| l.strip_prefix("G1 E"))
+        .filter_map(|w| w.split_whitespace().next()?.parse::<f64>().ok())
+        .sum();
+    assert!(
+        (filament + cfg.printer.retract_length).abs() < 1e-9,
+        "{filament} mm: {rel_text}"
+    );
+    assert_same_moves(&abs_text, &rel_text);
+}
+
+#[test]
 fn relative_and_absolute_e_give_the_same_moves() {
     let program = two_tool_program();
     let mut cfg = two_tool_config();

@@ -1,6 +1,7 @@
 //! The state machine that walks a [`Program`] and writes G-code lines to a [`GcodeSink`]: the
 //! FFF printer's style here, the switched-tool style (an aerosol jet) in [`switched`].
 
+mod layer_events;
 mod switched;
 
 pub(super) use switched::header as switched_header;
@@ -122,6 +123,9 @@ pub(super) struct Writer<'a, S: GcodeSink> {
     tool: Option<usize>,
     layer_index: usize,
     layer_z: f64,
+    /// Top of the previous layer (0 before the first): where the events of
+    /// `printer.custom_gcode_per_print_z` written so far end.
+    below_z: f64,
     type_name: Option<&'static str>,
     width: Option<String>,
     height: Option<String>,
@@ -219,6 +223,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             tool: None,
             layer_index: 0,
             layer_z: 0.0,
+            below_z: 0.0,
             type_name: None,
             width: None,
             height: None,
@@ -1085,6 +1090,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             &layer_vars,
         )?;
         self.lines(&after);
+        self.layer_events(layer, &layer_vars)?;
         for item in &layer.items {
             match item {
                 LayerItem::Path(p) => self.path(p)?,
@@ -1338,6 +1344,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             layers: program.layers.len(),
             estimated_time_s: self.planner.total + self.dwell_s,
             tools: self.tool_stats(program),
+            events_above_print: self.events_above_print(),
             switched: None,
         })
     }

@@ -20,13 +20,20 @@
 //!   and `<part id subtype>` for each component object (`normal_part`, `negative_part`,
 //!   `modifier_part`, `support_enforcer`, `support_blocker`), with its own metadata.
 //!
+//! - **Custom G-code by height** (PrusaSlicer): `Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml`
+//!   holds the colour changes, pauses and custom G-code of the layer slider (see
+//!   [`CustomGcodes`]).
+//!
 //! A part that exists but does not read (not UTF-8, a line that is no `; key = value`, JSON
 //! or XML that is malformed, a triangle range outside its object's mesh) is an error naming
 //! the part and line; a volume type this reader does not know is read as a model part with a
 //! warning.
 
+mod custom_gcode;
 mod model_config;
 mod profile;
+
+pub use custom_gcode::{CustomGcode, CustomGcodeKind, CustomGcodes, PRUSA_CUSTOM_GCODE_PART};
 
 use crate::Model;
 use crate::error::ThreeMfError;
@@ -50,12 +57,14 @@ pub struct SlicerSettings {
     pub objects: Vec<ObjectSettings>,
     /// The part the objects were read from, when there is one.
     pub objects_part: Option<String>,
+    /// PrusaSlicer's colour changes, pauses and custom G-code by height, when stored.
+    pub custom_gcodes: Option<CustomGcodes>,
 }
 
 impl SlicerSettings {
-    /// True when the package carries neither a profile nor object descriptions.
+    /// True when the package carries no profile, object descriptions or custom G-code.
     pub fn is_empty(&self) -> bool {
-        self.profile.is_none() && self.objects.is_empty()
+        self.profile.is_none() && self.objects.is_empty() && self.custom_gcodes.is_none()
     }
 }
 
@@ -209,6 +218,13 @@ pub(crate) fn read_settings(
             out.objects_part = Some(part.to_owned());
             break;
         }
+    }
+    if let Some(bytes) = ar.read(PRUSA_CUSTOM_GCODE_PART)? {
+        out.custom_gcodes = Some(custom_gcode::read(
+            PRUSA_CUSTOM_GCODE_PART,
+            &bytes,
+            warnings,
+        )?);
     }
     Ok(out)
 }

@@ -224,7 +224,7 @@ fn volume_kind(part: &str, line: usize, name: &str, warnings: &mut Vec<String>) 
 }
 
 /// A required whole-number attribute.
-fn number(
+pub(super) fn number(
     part: &str,
     line: usize,
     element: &str,
@@ -242,7 +242,10 @@ fn number(
 }
 
 /// The attributes of `e` as (local name, value).
-fn attributes(x: &Xml<'_>, e: &BytesStart<'_>) -> Result<Vec<(String, String)>, ThreeMfError> {
+pub(super) fn attributes(
+    x: &Xml<'_>,
+    e: &BytesStart<'_>,
+) -> Result<Vec<(String, String)>, ThreeMfError> {
     let mut out = Vec::new();
     x.attrs(e, |_, name, value: Cow<'_, str>| {
         out.push((name.to_owned(), value.into_owned()));

@@ -123,6 +123,7 @@ impl<S: GcodeSink> Writer<'_, S> {
             layers: program.layers.len(),
             estimated_time_s: stats.time_s,
             tools: self.tool_stats(program),
+            events_above_print: Vec::new(),
             switched: Some(stats),
         })
     }
