@@ -25,21 +25,31 @@ use crate::program::machine::Flavor;
 pub(super) struct Dialect(pub Flavor);
 
 impl Dialect {
-    /// Sets tool `tool`'s temperature without waiting. `standby` is used by RepRapFirmware only.
-    pub fn set_tool_temperature(self, tool: usize, temp: f64, standby: f64) -> String {
+    /// Sets a tool's temperature without waiting: tool `tool`'s, or, with `None`, the one
+    /// tool of a print that uses tool 0 alone (no `T` word, as PrusaSlicer writes a
+    /// single-extruder print). `standby` is used by RepRapFirmware only.
+    pub fn set_tool_temperature(self, tool: Option<usize>, temp: f64, standby: f64) -> String {
         match self.0 {
-            Flavor::Marlin | Flavor::Klipper => format!("M104 T{tool} S{}", fmt_f(temp)),
-            Flavor::RepRapFirmware => {
-                format!("G10 P{tool} S{} R{}", fmt_f(temp), fmt_f(standby))
+            Flavor::Marlin | Flavor::Klipper => {
+                format!("M104{} S{}", t_word(tool), fmt_f(temp))
             }
+            Flavor::RepRapFirmware => format!(
+                "G10 P{} S{} R{}",
+                tool.unwrap_or(0),
+                fmt_f(temp),
+                fmt_f(standby)
+            ),
         }
     }
 
-    /// Heats tool `tool` (already selected) to `temp` and waits.
-    pub fn wait_tool_temperature(self, tool: usize, temp: f64) -> String {
+    /// Heats a tool (already selected; `tool` as in [`Self::set_tool_temperature`]) to `temp`
+    /// and waits.
+    pub fn wait_tool_temperature(self, tool: Option<usize>, temp: f64) -> String {
         match self.0 {
-            Flavor::Marlin | Flavor::Klipper => format!("M109 T{tool} S{}", fmt_f(temp)),
-            Flavor::RepRapFirmware => format!("M116 P{tool}"),
+            Flavor::Marlin | Flavor::Klipper => {
+                format!("M109{} S{}", t_word(tool), fmt_f(temp))
+            }
+            Flavor::RepRapFirmware => format!("M116 P{}", tool.unwrap_or(0)),
         }
     }
 
@@ -80,6 +90,11 @@ pub(super) fn fan(percent: f64) -> String {
     }
 }
 
+/// ` T<tool>`, or nothing for `None`.
+fn t_word(tool: Option<usize>) -> String {
+    tool.map_or_else(String::new, |t| format!(" T{t}"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -89,11 +104,27 @@ mod tests {
         let m = Dialect(Flavor::Marlin);
         let r = Dialect(Flavor::RepRapFirmware);
         let k = Dialect(Flavor::Klipper);
-        assert_eq!(m.set_tool_temperature(1, 210.0, 170.0), "M104 T1 S210");
-        assert_eq!(r.set_tool_temperature(1, 210.0, 170.0), "G10 P1 S210 R170");
-        assert_eq!(k.set_tool_temperature(1, 210.0, 170.0), "M104 T1 S210");
-        assert_eq!(m.wait_tool_temperature(0, 215.0), "M109 T0 S215");
-        assert_eq!(r.wait_tool_temperature(0, 215.0), "M116 P0");
+        assert_eq!(
+            m.set_tool_temperature(Some(1), 210.0, 170.0),
+            "M104 T1 S210"
+        );
+        assert_eq!(
+            r.set_tool_temperature(Some(1), 210.0, 170.0),
+            "G10 P1 S210 R170"
+        );
+        assert_eq!(
+            k.set_tool_temperature(Some(1), 210.0, 170.0),
+            "M104 T1 S210"
+        );
+        assert_eq!(m.wait_tool_temperature(Some(0), 215.0), "M109 T0 S215");
+        assert_eq!(r.wait_tool_temperature(Some(0), 215.0), "M116 P0");
+        // A single-extruder print: no T word, but RepRapFirmware's tool is tool 0.
+        assert_eq!(m.set_tool_temperature(None, 215.0, 215.0), "M104 S215");
+        assert_eq!(m.wait_tool_temperature(None, 215.0), "M109 S215");
+        assert_eq!(
+            r.set_tool_temperature(None, 215.0, 170.0),
+            "G10 P0 S215 R170"
+        );
         assert_eq!(m.standby(0, 170.0).as_deref(), Some("M104 T0 S170"));
         assert_eq!(r.standby(0, 170.0), None);
         assert_eq!(fan(100.0), "M106 S255");

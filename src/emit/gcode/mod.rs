@@ -62,7 +62,8 @@
 //! # Flavours
 //!
 //! See the table in the `flavor` module source: temperatures are `M104 T`/`M109 T` on Marlin
-//! and Klipper, `G10 P S R`/`M116 P` on RepRapFirmware (which handles standby itself);
+//! and Klipper (without the `T` when the print uses tool 0 alone, as PrusaSlicer writes a
+//! single-extruder print), `G10 P S R`/`M116 P` on RepRapFirmware (which handles standby itself);
 //! firmware retraction is `G10`/`G11` on all three.
 //!
 //! # Blocks in another program

@@ -703,6 +703,45 @@ fn events_by_height_come_before_the_first_layer_reaching_them() {
 }
 
 #[test]
+fn a_print_with_tool_0_alone_names_no_tool_in_its_temperatures() {
+    // As PrusaSlicer: `M104 S` / `M109 S` when the highest tool used is 0, whatever tools the
+    // printer has; a print that uses tool 1 too names the tool.
+    let mut cfg = two_tool_config();
+    cfg.printer.start_gcode = "G28".to_owned();
+    cfg.tools[0].first_layer_temperature = 215.0;
+    cfg.tools[0].temperature = 205.0;
+    let layer = |index: usize| {
+        let z = 0.2 * (index + 1) as f64;
+        Layer {
+            index,
+            z,
+            height: 0.2,
+            items: vec![LayerItem::Path(square(
+                10.0,
+                10.0,
+                10.0,
+                z,
+                Role::ExternalPerimeter,
+                0,
+            ))],
+        }
+    };
+    let single = Program {
+        layers: vec![layer(0), layer(1)],
+    };
+    let (text, _) = write(&single, &cfg);
+    for line in ["M104 S215", "M109 S215", "M104 S205"] {
+        assert!(text.lines().any(|l| l == line), "{line}: {text}");
+    }
+    // (The default end G-code's own `M104 T0 S0` is a template's, written as given.)
+    for named in ["M104 T0 S2", "M109 T0"] {
+        assert!(!text.contains(named), "{named}: {text}");
+    }
+    let (text, _) = write(&two_tool_program(), &cfg);
+    assert!(text.contains("M109 T0 S215"), "{text}");
+}
+
+#[test]
 fn relative_and_absolute_e_give_the_same_moves() {
     let program = two_tool_program();
     let mut cfg = two_tool_config();

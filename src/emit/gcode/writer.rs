@@ -658,12 +658,18 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         self.pos = Some(target);
     }
 
+    /// Tool `tool` as temperature commands name it: `None` (no `T` word) when the print uses
+    /// tool 0 alone, as PrusaSlicer writes a print whose highest extruder is the first.
+    fn named(&self, tool: usize) -> Option<usize> {
+        (tool != 0 || self.used.iter().any(|&t| t > 0)).then_some(tool)
+    }
+
     /// Waits for `tool`'s temperature if it is heated and the writer has not done so since it
     /// was selected.
     fn wait_for_tool(&mut self, tool: usize) {
         let temp = self.temperature(tool);
         if temp > 0.0 && self.tools.get(tool).is_some_and(|t| !t.waited) {
-            let l = self.dialect.wait_tool_temperature(tool, temp);
+            let l = self.dialect.wait_tool_temperature(self.named(tool), temp);
             self.line(&l);
         }
         if let Some(t) = self.tools.get_mut(tool) {
@@ -831,7 +837,18 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         self.feed = Some(fmt_f(at.feed * 60.0));
         self.layer_index = at.layer_index;
         self.layer_z = at.layer_z;
-        self.used = vec![at.tool];
+        // The host's tool and the block's.
+        let mut used = vec![at.tool];
+        for item in items {
+            match item {
+                LayerItem::Path(p) => used.push(p.tool),
+                LayerItem::Event(Event::ToolChange { tool }) => used.push(*tool),
+                LayerItem::Event(_) => {}
+            }
+        }
+        used.sort_unstable();
+        used.dedup();
+        self.used = used;
         // The other program has brought the tool to its temperature.
         self.tools[at.tool].waited = true;
         for item in items {
@@ -889,7 +906,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             let temp = self.temperature(t);
             if temp > 0.0 && (!scan.any_tool || rrf) {
                 let standby = self.standby_temperature(t);
-                let l = self.dialect.set_tool_temperature(t, temp, standby);
+                let l = self
+                    .dialect
+                    .set_tool_temperature(self.named(t), temp, standby);
                 self.line(&l);
             }
         }
@@ -917,7 +936,7 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
             {
                 let temp = self.standby_temperature(t);
                 if temp > 0.0 {
-                    let l = self.dialect.set_tool_temperature(t, temp, temp);
+                    let l = self.dialect.set_tool_temperature(Some(t), temp, temp);
                     self.line(&l);
                 }
             }
@@ -1050,9 +1069,9 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
                 };
                 if tool.temperature > 0.0 && tool.temperature != tool.first_layer_temperature {
                     let standby = self.standby_temperature(t);
-                    let l = self
-                        .dialect
-                        .set_tool_temperature(t, tool.temperature, standby);
+                    let l =
+                        self.dialect
+                            .set_tool_temperature(self.named(t), tool.temperature, standby);
                     self.line(&l);
                 }
             }
