@@ -12,7 +12,6 @@
 //!   object of the project has the same ones (a single object always does); otherwise conduit,
 //!   which slices all objects with one profile, names each object's keys as not honoured.
 //! - A volume's settings (a modifier's, or a part's own) are never honoured and are named.
-//!
 //! - PrusaSlicer's colour changes, pauses and custom G-code by height (the layer slider's,
 //!   `conduit_3mf::CustomGcodes`) become `printer.custom_gcode_per_print_z` ([`layer_gcodes`]),
 //!   whichever config the job uses: they belong to the model, as in PrusaSlicer.

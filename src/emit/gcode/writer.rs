@@ -838,16 +838,10 @@ impl<'a, S: GcodeSink> Writer<'a, S> {
         self.layer_index = at.layer_index;
         self.layer_z = at.layer_z;
         // The host's tool and the block's.
-        let mut used = vec![at.tool];
-        for item in items {
-            match item {
-                LayerItem::Path(p) => used.push(p.tool),
-                LayerItem::Event(Event::ToolChange { tool }) => used.push(*tool),
-                LayerItem::Event(_) => {}
-            }
+        let mut used = item_tools(items);
+        if let Err(k) = used.binary_search(&at.tool) {
+            used.insert(k, at.tool);
         }
-        used.sort_unstable();
-        used.dedup();
         self.used = used;
         // The other program has brought the tool to its temperature.
         self.tools[at.tool].waited = true;
@@ -1471,15 +1465,21 @@ fn print_variables(program: &Program, tools: usize) -> Vec<(&'static str, Var)> 
     ]
 }
 
+/// The tools `program` extrudes with or changes to, ascending.
 pub(super) fn used_tools(program: &Program) -> Vec<usize> {
-    let mut tools = program.tools_used();
-    for layer in &program.layers {
-        for item in &layer.items {
-            if let LayerItem::Event(Event::ToolChange { tool }) = item {
-                tools.push(*tool);
-            }
-        }
-    }
+    item_tools(program.layers.iter().flat_map(|l| &l.items))
+}
+
+/// The tools `items` extrude with or change to, ascending.
+fn item_tools<'i>(items: impl IntoIterator<Item = &'i LayerItem>) -> Vec<usize> {
+    let mut tools: Vec<usize> = items
+        .into_iter()
+        .filter_map(|item| match item {
+            LayerItem::Path(p) => Some(p.tool),
+            LayerItem::Event(Event::ToolChange { tool }) => Some(*tool),
+            LayerItem::Event(_) => None,
+        })
+        .collect();
     tools.sort_unstable();
     tools.dedup();
     tools
