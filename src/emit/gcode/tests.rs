@@ -122,6 +122,25 @@ fn one_layer_program() -> Program {
     }
 }
 
+/// Layer `index` of a print in 0.2 mm layers: one external-perimeter square of tool 0, 10 mm
+/// on a side, its corner at (`x`, 10).
+fn square_layer(index: usize, x: f64) -> Layer {
+    let z = 0.2 * (index + 1) as f64;
+    Layer {
+        index,
+        z,
+        height: 0.2,
+        items: vec![LayerItem::Path(square(
+            x,
+            10.0,
+            10.0,
+            z,
+            Role::ExternalPerimeter,
+            0,
+        ))],
+    }
+}
+
 fn test_config() -> GcodeParams {
     let mut cfg = GcodeParams::for_tests();
     cfg.printer.retract_length = 0.8;
@@ -565,21 +584,8 @@ fn layer_templates_frame_the_layer_change_and_an_e_reset_in_them_is_followed() {
     // The `G92 E0` of the template is the writer's too: absolute E replays as relative E does
     // (no retraction measured against an E register the printer no longer has). Layer 1
     // starts 50 mm from where layer 0 ends, so the layer change retracts after the template.
-    let layer = |index: usize, x: f64| Layer {
-        index,
-        z: 0.2 * (index + 1) as f64,
-        height: 0.2,
-        items: vec![LayerItem::Path(square(
-            x,
-            10.0,
-            10.0,
-            0.2 * (index + 1) as f64,
-            Role::ExternalPerimeter,
-            0,
-        ))],
-    };
     let program = Program {
-        layers: vec![layer(0, 10.0), layer(1, 60.0)],
+        layers: vec![square_layer(0, 10.0), square_layer(1, 60.0)],
     };
     let (abs_text, _) = write(&program, &cfg);
     cfg.printer.use_relative_e_distances = true;
@@ -613,24 +619,10 @@ fn events_by_height_come_before_the_first_layer_reaching_them() {
     ];
     // Four layers 0.2 mm high, each starting 50 mm from where the one below ends, so every
     // layer change retracts.
-    let layer = |index: usize| {
-        let z = 0.2 * (index + 1) as f64;
-        Layer {
-            index,
-            z,
-            height: 0.2,
-            items: vec![LayerItem::Path(square(
-                10.0 + 50.0 * (index % 2) as f64,
-                10.0,
-                10.0,
-                z,
-                Role::ExternalPerimeter,
-                0,
-            ))],
-        }
-    };
     let program = Program {
-        layers: (0..4).map(layer).collect(),
+        layers: (0..4)
+            .map(|i| square_layer(i, 10.0 + 50.0 * (i % 2) as f64))
+            .collect(),
     };
     let (abs_text, _) = write(&program, &cfg);
     let lines: Vec<&str> = abs_text.lines().collect();
@@ -710,24 +702,8 @@ fn a_print_with_tool_0_alone_names_no_tool_in_its_temperatures() {
     cfg.printer.start_gcode = "G28".to_owned();
     cfg.tools[0].first_layer_temperature = 215.0;
     cfg.tools[0].temperature = 205.0;
-    let layer = |index: usize| {
-        let z = 0.2 * (index + 1) as f64;
-        Layer {
-            index,
-            z,
-            height: 0.2,
-            items: vec![LayerItem::Path(square(
-                10.0,
-                10.0,
-                10.0,
-                z,
-                Role::ExternalPerimeter,
-                0,
-            ))],
-        }
-    };
     let single = Program {
-        layers: vec![layer(0), layer(1)],
+        layers: vec![square_layer(0, 10.0), square_layer(1, 10.0)],
     };
     let (text, _) = write(&single, &cfg);
     for line in ["M104 S215", "M109 S215", "M104 S205"] {

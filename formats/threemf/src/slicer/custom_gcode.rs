@@ -11,7 +11,7 @@
 //! the custom G-code itself. This is how PrusaSlicer's own importer reads it.
 
 use super::error;
-use super::model_config::{attributes, number};
+use super::model_config::{attribute, attributes, number};
 use crate::error::ThreeMfError;
 use crate::xml::{Ev, Xml};
 
@@ -112,19 +112,11 @@ pub(super) fn read(
             }
             ("mode", 1) => {
                 let attrs = attributes(&x, &e)?;
-                out.mode = attrs
-                    .into_iter()
-                    .find(|(k, _)| k == "value")
-                    .map(|(_, v)| v);
+                out.mode = attribute(&attrs, "value").map(str::to_owned);
             }
             ("code", 1) => {
                 let attrs = attributes(&x, &e)?;
-                let get = |name: &str| {
-                    attrs
-                        .iter()
-                        .find(|(k, _)| k == name)
-                        .map(|(_, v)| v.as_str())
-                };
+                let get = |name: &str| attribute(&attrs, name);
                 if let Some(code) = code(part, line, &get, warnings)? {
                     out.codes.push(code);
                 }

@@ -63,12 +63,7 @@ pub(super) fn read(
         };
         let line = x.loc().line as usize;
         let attrs = attributes(&x, &e)?;
-        let get = |name: &str| {
-            attrs
-                .iter()
-                .find(|(k, _)| k == name)
-                .map(|(_, v)| v.as_str())
-        };
+        let get = |name: &str| attribute(&attrs, name);
         match (e.local_name().as_ref(), scope.last_mut()) {
             ("config", None) if !empty => continue,
             ("object", None) => {
@@ -239,6 +234,14 @@ pub(super) fn number(
             format!("<{element}> {attribute}={v:?} is not a whole number"),
         )
     })
+}
+
+/// The value of the attribute `name` among `attrs` (from [`attributes`]).
+pub(super) fn attribute<'a>(attrs: &'a [(String, String)], name: &str) -> Option<&'a str> {
+    attrs
+        .iter()
+        .find(|(k, _)| k == name)
+        .map(|(_, v)| v.as_str())
 }
 
 /// The attributes of `e` as (local name, value).
