@@ -657,3 +657,74 @@ fn layer_slider_events_come_where_prusaslicer_puts_them() {
         assert!(check.status.success(), "{}", stderr(&check));
     }
 }
+
+/// An OrcaSlicer project's layer-slider events (plate 1's; plate 2's are named as left out)
+/// come where PrusaSlicer's would, its profile's `machine_pause_gcode` as the pause G-code.
+#[test]
+fn orcaslicer_plate_events_come_before_their_layers() {
+    let dir = temp_dir();
+    let bytes = orca_project(
+        "box",
+        &[(CUBE_10, "normal_part")],
+        r#"{"layer_height": "0.3", "initial_layer_print_height": "0.3",
+            "machine_pause_gcode": "PAUSE ; orca", "nozzle_diameter": ["0.4"]}"#,
+    );
+    let events = r##"<?xml version="1.0" encoding="utf-8"?>
+<custom_gcodes_per_layer>
+<plate>
+<plate_info id="1"/>
+<layer top_z="1" type="1" extruder="1" color="" extra="Insert nuts" gcode="M601"/>
+<layer top_z="2.2" type="0" extruder="1" color="#00FF00" extra="" gcode="M600"/>
+<mode value="SingleExtruder"/>
+</plate>
+<plate>
+<plate_info id="2"/>
+<layer top_z="3" type="1" extruder="1" color="" extra="never" gcode="M601"/>
+<mode value="SingleExtruder"/>
+</plate>
+</custom_gcodes_per_layer>
+"##;
+    let p = write(
+        dir.path(),
+        "orca.3mf",
+        &with_part(bytes, "Metadata/custom_gcode_per_layer.xml", events),
+    );
+    let (err, _, ok) = slice(dir.path(), &p, &[]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains(
+            "orca.3mf: 2 event(s) of OrcaSlicer's layer slider stored in it, plate 1 (colour changes"
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains("the 1 custom G-code event(s) of plate 2 are left out"),
+        "{err}"
+    );
+    let gcode = std::fs::read_to_string(dir.path().join("out.gcode")).expect("G-code");
+    let lines: Vec<&str> = gcode.lines().collect();
+    for (tag, z, then) in [
+        (
+            ";PAUSE_PRINT",
+            "1.2",
+            &["M117 Insert nuts", "PAUSE ; orca"][..],
+        ),
+        (";COLOR_CHANGE,T0,#00FF00", "2.4", &["M600"]),
+    ] {
+        let at: Vec<usize> = (0..lines.len()).filter(|&i| lines[i] == tag).collect();
+        assert_eq!(at.len(), 1, "{tag} once");
+        let i = at[0];
+        assert_eq!(&lines[i + 1..i + 1 + then.len()], then);
+        let layer = lines[..i]
+            .iter()
+            .rposition(|l| *l == ";LAYER_CHANGE")
+            .unwrap_or(0);
+        assert_eq!(lines[layer + 1], format!(";Z:{z}"));
+    }
+    assert!(!gcode.contains("never"));
+    let check = conduit([
+        "check",
+        dir.path().join("out.gcode").to_str().unwrap_or_default(),
+    ]);
+    assert!(check.status.success(), "{}", stderr(&check));
+}

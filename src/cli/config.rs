@@ -93,11 +93,13 @@ fn add_layer_gcodes(
     for w in &warnings {
         warnln!("{file}: {w}");
     }
-    if !events.is_empty() {
+    if let Some(c) = slicer.custom_gcodes.as_ref().filter(|_| !events.is_empty()) {
+        let plate = c.plate.map(|p| format!(", plate {p}")).unwrap_or_default();
         infoln!(
-            "{file}: {} event(s) of PrusaSlicer's layer slider stored in it (colour changes, \
+            "{file}: {} event(s) of {}'s layer slider stored in it{plate} (colour changes, \
              pauses, custom G-code) go into printer.custom_gcode_per_print_z",
-            events.len()
+            events.len(),
+            c.writer()
         );
     }
     cfg.printer.custom_gcode_per_print_z.extend(events);

@@ -12,9 +12,10 @@
 //!   object of the project has the same ones (a single object always does); otherwise conduit,
 //!   which slices all objects with one profile, names each object's keys as not honoured.
 //! - A volume's settings (a modifier's, or a part's own) are never honoured and are named.
-//! - PrusaSlicer's colour changes, pauses and custom G-code by height (the layer slider's,
-//!   `conduit_3mf::CustomGcodes`) become `printer.custom_gcode_per_print_z` ([`layer_gcodes`]),
-//!   whichever config the job uses: they belong to the model, as in PrusaSlicer.
+//! - The colour changes, pauses and custom G-code by height of PrusaSlicer's layer slider, or of
+//!   OrcaSlicer's and BambuStudio's (the first plate with any; `conduit_3mf::CustomGcodes`),
+//!   become `printer.custom_gcode_per_print_z` ([`layer_gcodes`]), whichever config the job
+//!   uses: they belong to the model, as in PrusaSlicer.
 //!
 //! Lists of keys not honoured are sorted by impact ([`super::prusa_ini::impact`]): keys conduit
 //! reads from a profile first, then those that change the print, then the rest, each
@@ -242,6 +243,7 @@ mod tests {
         SlicerSettings {
             custom_gcodes: Some(CustomGcodes {
                 part: conduit_3mf::PRUSA_CUSTOM_GCODE_PART.to_owned(),
+                plate: None,
                 mode: Some(mode.to_owned()),
                 codes: codes
                     .iter()

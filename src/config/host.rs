@@ -80,6 +80,7 @@ pub const ORCA_KEYS: &[(&str, &str)] = &[
     ("top_shell_layers", "top_solid_layers"),
     ("bottom_shell_layers", "bottom_solid_layers"),
     ("retraction_length", "retract_length"),
+    ("machine_pause_gcode", "pause_print_gcode"),
 ];
 
 /// Gives each OrcaSlicer key of `values` ([`ORCA_KEYS`]) its PrusaSlicer name when that name

@@ -47,7 +47,8 @@
 //!
 //! - **Slicer settings** ([`Package::slicer`], [`SlicerSettings`]): the profile, per-object
 //!   settings and volume types PrusaSlicer (`Metadata/Slic3r_PE*.config`) and OrcaSlicer
-//!   (`Metadata/project_settings.config`, `model_settings.config`) store beside the model;
+//!   (`Metadata/project_settings.config`, `model_settings.config`) store beside the model,
+//!   and the colour changes, pauses and custom G-code of their layer sliders;
 //!   [`FlatMesh::triangle_sources`] ties each flattened triangle to its volume.
 //!
 //! # Two modes: default and strict
@@ -132,8 +133,8 @@ pub use model::{
 };
 pub use read::{ReadOptions, read, read_with};
 pub use slicer::{
-    CustomGcode, CustomGcodeKind, CustomGcodes, Layout, ORCA_MODEL_PART, ORCA_PROFILE_PART,
-    ObjectSettings, PRUSA_CUSTOM_GCODE_PART, PRUSA_MODEL_PART, PRUSA_PROFILE_PART, Profile,
-    Setting, SlicerSettings, Volume, VolumeKind, VolumeMesh,
+    CustomGcode, CustomGcodeKind, CustomGcodes, Layout, ORCA_CUSTOM_GCODE_PART, ORCA_MODEL_PART,
+    ORCA_PROFILE_PART, ObjectSettings, PRUSA_CUSTOM_GCODE_PART, PRUSA_MODEL_PART,
+    PRUSA_PROFILE_PART, Profile, Setting, SlicerSettings, Volume, VolumeKind, VolumeMesh,
 };
 pub use write::{ROOT_MODEL_PATH, format_number, write};

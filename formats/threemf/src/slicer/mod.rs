@@ -20,9 +20,9 @@
 //!   and `<part id subtype>` for each component object (`normal_part`, `negative_part`,
 //!   `modifier_part`, `support_enforcer`, `support_blocker`), with its own metadata.
 //!
-//! - **Custom G-code by height** (PrusaSlicer): `Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml`
-//!   holds the colour changes, pauses and custom G-code of the layer slider (see
-//!   [`CustomGcodes`]).
+//! - **Custom G-code by height**: PrusaSlicer's `Metadata/Prusa_Slicer_custom_gcode_per_print_z.xml`
+//!   or OrcaSlicer's and BambuStudio's `Metadata/custom_gcode_per_layer.xml` (per plate) holds
+//!   the colour changes, pauses and custom G-code of the layer slider (see [`CustomGcodes`]).
 //!
 //! A part that exists but does not read (not UTF-8, a line that is no `; key = value`, JSON
 //! or XML that is malformed, a triangle range outside its object's mesh) is an error naming
@@ -33,7 +33,9 @@ mod custom_gcode;
 mod model_config;
 mod profile;
 
-pub use custom_gcode::{CustomGcode, CustomGcodeKind, CustomGcodes, PRUSA_CUSTOM_GCODE_PART};
+pub use custom_gcode::{
+    CustomGcode, CustomGcodeKind, CustomGcodes, ORCA_CUSTOM_GCODE_PART, PRUSA_CUSTOM_GCODE_PART,
+};
 
 use crate::Model;
 use crate::error::ThreeMfError;
@@ -57,7 +59,8 @@ pub struct SlicerSettings {
     pub objects: Vec<ObjectSettings>,
     /// The part the objects were read from, when there is one.
     pub objects_part: Option<String>,
-    /// PrusaSlicer's colour changes, pauses and custom G-code by height, when stored.
+    /// The layer slider's colour changes, pauses and custom G-code by height (PrusaSlicer's, or
+    /// else OrcaSlicer's first plate with any), when stored.
     pub custom_gcodes: Option<CustomGcodes>,
 }
 
@@ -219,12 +222,11 @@ pub(crate) fn read_settings(
             break;
         }
     }
-    if let Some(bytes) = ar.read(PRUSA_CUSTOM_GCODE_PART)? {
-        out.custom_gcodes = Some(custom_gcode::read(
-            PRUSA_CUSTOM_GCODE_PART,
-            &bytes,
-            warnings,
-        )?);
+    for part in [PRUSA_CUSTOM_GCODE_PART, ORCA_CUSTOM_GCODE_PART] {
+        if let Some(bytes) = ar.read(part)? {
+            out.custom_gcodes = Some(custom_gcode::read(part, &bytes, warnings)?);
+            break;
+        }
     }
     Ok(out)
 }
