@@ -72,7 +72,9 @@ fn slice(dir: &Path, extra: &[&str]) -> (std::process::Output, serde_json::Value
 fn every_tool_change_purges_on_one_tower_standing_up_to_the_last_change() {
     let dir = temp_dir();
     let dir = dir.path();
-    let (out, report) = slice(dir, &[]);
+    // Without the first layer's brim (its own test below), every purge is the new tool's first
+    // extrusion.
+    let (out, report) = slice(dir, &["--set", "wipe_tower.brim_width=0"]);
     assert!(
         out.status.success(),
         "{}",
@@ -192,4 +194,71 @@ fn a_tower_set_over_the_parts_is_refused_and_nothing_is_written() {
         "{err}"
     );
     assert!(!dir.join("out.gcode").exists());
+}
+
+/// The tower's first layer has a brim of whole beads round it (2 mm asked: 4 beads of 0.45),
+/// laid by the first tool on the tower, 5 mm clear of the parts; the layers above have none.
+#[test]
+fn the_towers_first_layer_stands_on_a_brim() {
+    let dir = temp_dir();
+    let dir = dir.path();
+    let (out, report) = slice(dir, &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.join("out.gcode")).expect("G-code");
+    let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
+    let replay = moves(&g, Firmware::Marlin);
+    let t = &report["wipe_tower"];
+    let num = |k: &str| t[k].as_f64().expect(k);
+    assert!((num("brim_width") - 1.8).abs() < 1e-9, "{t}");
+    let bounds = |layer: usize, tower: bool| {
+        let mut b = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
+        for m in replay.moves.iter().filter(|m| {
+            m.extruding
+                && m.has_xy
+                && m.layer == layer
+                && (m.role.as_deref() == Some("Wipe tower")) == tower
+        }) {
+            for p in [xyz(m.from), xyz(m.to)] {
+                b = [
+                    b[0].min(p[0]),
+                    b[1].min(p[1]),
+                    b[2].max(p[0]),
+                    b[3].max(p[1]),
+                ];
+            }
+        }
+        b
+    };
+    let (first, second) = (bounds(0, true), bounds(1, true));
+    // The outermost brim bead's centre lies 3.5 beads outside the tower's outline, the loop's
+    // half a bead inside it: the first layer's extent is the second's grown by 4 beads.
+    for (k, sign) in [-1.0, -1.0, 1.0, 1.0].into_iter().enumerate() {
+        let grown = second[k] + sign * 1.8;
+        assert!(
+            (first[k] - grown).abs() < 2e-3,
+            "first layer {first:?}, second {second:?}"
+        );
+    }
+    // The brim's outer edge (half a bead beyond the outermost centre) stays 5 mm clear of the
+    // parts' paths on the first layer.
+    let parts = bounds(0, false);
+    assert!(
+        first[0] - 0.225 >= parts[2] + 0.225 + 5.0 - 1e-3,
+        "tower {first:?}, parts {parts:?}"
+    );
+    let check = conduit([
+        "check".as_ref(),
+        dir.join("out.gcode").as_os_str(),
+        "-c".as_ref(),
+        dir.join("two.toml").as_os_str(),
+    ]);
+    let said = stdout(&check);
+    assert!(
+        check.status.success() && said.contains("0 errors, 0 warnings"),
+        "{said}"
+    );
 }

@@ -23,7 +23,10 @@
 //!   `sparse_spacing` mm, by the last tool that purged (or, on a layer without a change, by the
 //!   active tool at the layer's start): the next layer's purge lines, along X, bridge them. The
 //!   rest's lines stand at the same X on every layer, so they stack into walls.
-//! - **The first layer** is solid: the rest is filled one bead apart too, for adhesion.
+//! - **The first layer** is solid: the rest is filled one bead apart too, for adhesion. Its
+//!   first tool lays the **brim** before the loop: loops round the tower, outside it, from the
+//!   outermost in, `brim_width` wide in whole beads (PrusaSlicer's `wipe_tower_brim_width`), so
+//!   a tall, narrow tower standing on one bead's width of its loop holds to the bed.
 //!
 //! Paste tools are not purged (their flow is switched, not oozing plastic); a change to one adds
 //! nothing to the tower. A layer whose only tool is a paste tool gets no tower layer either
@@ -35,7 +38,7 @@
 //! At `x`, `y` (its front-left corner) when both are given, else beside the objects: right of
 //! them, behind, left or in front, the first of those that fits on the bed [`GAP_MM`] clear of
 //! every path of the program. A tower that overlaps the objects' paths (within [`MIN_GAP_MM`])
-//! or leaves the bed is an error.
+//! or leaves the bed is an error. The brim counts as part of the tower in both.
 
 use serde::{Deserialize, Serialize};
 
@@ -76,6 +79,9 @@ pub struct TowerParams {
     /// Print speed on the tower, mm/s, at most `printer.max_print_speed` (the first layer at
     /// `slice.first_layer_speed`). Default 40.
     pub speed: f64,
+    /// Width of the brim round the tower's first layer, 0 to 50 (rounded to whole beads; 0 for
+    /// none). Default 2 (PrusaSlicer's `wipe_tower_brim_width`).
+    pub brim_width: f64,
 }
 
 impl Default for TowerParams {
@@ -88,6 +94,7 @@ impl Default for TowerParams {
             purge_volume: 140.0,
             sparse_spacing: 10.0,
             speed: 40.0,
+            brim_width: 2.0,
         }
     }
 }
@@ -101,6 +108,7 @@ impl TowerParams {
             ("purge_volume", self.purge_volume, 0.0, 10_000.0),
             ("sparse_spacing", self.sparse_spacing, 1.0, 50.0),
             ("speed", self.speed, 1.0, 1000.0),
+            ("brim_width", self.brim_width, 0.0, 50.0),
         ] {
             if !(v.is_finite() && (lo..=hi).contains(&v)) {
                 out.push(format!(
@@ -162,6 +170,8 @@ pub struct TowerSummary {
     pub purged_volume: f64,
     /// Layers up to the tower's top that got no tower layer (their only tool pastes).
     pub skipped_layers: usize,
+    /// Width of the brim laid round the first layer, mm (whole beads; 0 for none).
+    pub brim_width: f64,
 }
 
 /// Why no tower could be built.
@@ -228,7 +238,14 @@ pub fn add_wipe_tower(
         .fold(0.0, f64::max);
     let loop_bead = machine.width.iter().copied().fold(0.0, f64::max);
     let depth = (depth_needed + 2.0 * loop_bead).max(MIN_DEPTH_MM);
-    let (x, y) = place(program, params, machine, depth)?;
+    // The brim is laid by the first layer's first tool on the tower, in its beads.
+    let brim_bead = plans
+        .first()
+        .and_then(|p| p.purges.first().map(|&(_, t)| t).or(p.first_tool))
+        .map_or(loop_bead, |t| machine.bead(t));
+    let brim_loops = brim_loops(params.brim_width, brim_bead);
+    let brim_width = brim_loops as f64 * brim_bead;
+    let (x, y) = place(program, params, machine, depth, brim_width)?;
     let tower = Rect {
         x0: x,
         y0: y,
@@ -244,6 +261,7 @@ pub fn add_wipe_tower(
         purges: 0,
         purged_volume: 0.0,
         skipped_layers: 0,
+        brim_width,
     };
     for (k, plan) in plans.iter().enumerate().take(top + 1) {
         let layer = &mut program.layers[k];
@@ -258,6 +276,7 @@ pub fn add_wipe_tower(
             height: layer.height,
             speed,
             solid: k == 0,
+            brim_loops: if k == 0 { brim_loops } else { 0 },
             next_y: tower.y0,
             looped: false,
         };
@@ -321,6 +340,15 @@ fn plan(program: &Program, machine: &TowerMachine) -> Vec<LayerPlan> {
         plans.push(LayerPlan { purges, first_tool });
     }
     plans
+}
+
+/// How many loops of `bead` make a brim `width` mm wide: the nearest whole number, at least one
+/// for any width above zero.
+fn brim_loops(width: f64, bead: f64) -> usize {
+    if width <= 0.0 || bead <= 0.0 {
+        return 0;
+    }
+    ((width / bead).round() as usize).max(1)
 }
 
 /// Depth along Y of a band of `purge_volume` in lines of `bead` at `height`, mm: whole lines.
@@ -403,12 +431,14 @@ fn footprint(program: &Program) -> Option<Rect> {
     b
 }
 
-/// Where the tower's front-left corner goes (see the module docs).
+/// Where the tower's front-left corner goes (see the module docs), the tower `depth` deep
+/// with a brim `brim` mm wide round it.
 fn place(
     program: &Program,
     params: &TowerParams,
     machine: &TowerMachine,
     depth: f64,
+    brim: f64,
 ) -> Result<(f64, f64), TowerError> {
     let bed = Rect {
         x0: machine.bed[0],
@@ -417,11 +447,12 @@ fn place(
         y1: machine.bed[3],
     };
     let width = params.width;
+    // The tower with its brim, its corner at `x`, `y`.
     let at = |x: f64, y: f64| Rect {
-        x0: x,
-        y0: y,
-        x1: x + width,
-        y1: y + depth,
+        x0: x - brim,
+        y0: y - brim,
+        x1: x + width + brim,
+        y1: y + depth + brim,
     };
     let objects = footprint(program);
     if let (Some(x), Some(y)) = (params.x, params.y) {
@@ -442,16 +473,20 @@ fn place(
         return Ok((x, y));
     }
     let Some(o) = objects else {
-        return Ok((bed.x0 + GAP_MM, bed.y0 + GAP_MM));
+        return Ok((bed.x0 + GAP_MM + brim, bed.y0 + GAP_MM + brim));
     };
-    // Right, behind, left, in front: the tower's near side GAP_MM from the objects', aligned
-    // with their front (or left) edge, or moved back onto the bed along that side.
-    let along = |lo: f64, size: f64, bed_lo: f64, bed_hi: f64| lo.min(bed_hi - size).max(bed_lo);
+    // Right, behind, left, in front: the near side of the tower's brim GAP_MM from the
+    // objects', aligned with their front (or left) edge, or moved back onto the bed along that
+    // side.
+    let along = |lo: f64, size: f64, bed_lo: f64, bed_hi: f64| {
+        (lo + brim).min(bed_hi - size - brim).max(bed_lo + brim)
+    };
+    let reach = GAP_MM + brim;
     let candidates = [
-        (o.x1 + GAP_MM, along(o.y0, depth, bed.y0, bed.y1)),
-        (along(o.x0, width, bed.x0, bed.x1), o.y1 + GAP_MM),
-        (o.x0 - GAP_MM - width, along(o.y0, depth, bed.y0, bed.y1)),
-        (along(o.x0, width, bed.x0, bed.x1), o.y0 - GAP_MM - depth),
+        (o.x1 + reach, along(o.y0, depth, bed.y0, bed.y1)),
+        (along(o.x0, width, bed.x0, bed.x1), o.y1 + reach),
+        (o.x0 - reach - width, along(o.y0, depth, bed.y0, bed.y1)),
+        (along(o.x0, width, bed.x0, bed.x1), o.y0 - reach - depth),
     ];
     candidates
         .into_iter()
@@ -470,6 +505,8 @@ struct LayerBuilder {
     speed: f64,
     /// Fill the rest one bead apart (the first layer).
     solid: bool,
+    /// Loops of the brim laid before the first loop (the first layer's).
+    brim_loops: usize,
     /// Where the next band starts (Y of its front edge), mm.
     next_y: f64,
     /// Whether the loop is laid on this layer.
@@ -500,20 +537,24 @@ impl LayerBuilder {
             return Vec::new();
         }
         self.looped = true;
-        let h = bead / 2.0;
         let t = self.tower;
         self.next_y = t.y0 + bead;
-        vec![self.path(
+        // The brim's loops from the outermost in, each a bead outside the one before; the
+        // innermost touches the tower's edge, as the loop does from inside.
+        let rect = |grow: f64| {
             vec![
-                [t.x0 + h, t.y0 + h],
-                [t.x1 - h, t.y0 + h],
-                [t.x1 - h, t.y1 - h],
-                [t.x0 + h, t.y1 - h],
-            ],
-            true,
-            tool,
-            bead,
-        )]
+                [t.x0 - grow, t.y0 - grow],
+                [t.x1 + grow, t.y0 - grow],
+                [t.x1 + grow, t.y1 + grow],
+                [t.x0 - grow, t.y1 + grow],
+            ]
+        };
+        (1..=self.brim_loops)
+            .rev()
+            .map(|n| (n as f64 - 0.5) * bead)
+            .chain(std::iter::once(-bead / 2.0))
+            .map(|grow| self.path(rect(grow), true, tool, bead))
+            .collect()
     }
 
     /// Lines along X inside the loop from `next_y`, one bead apart, joined end to end, until
@@ -624,9 +665,11 @@ mod tests {
         }
     }
 
+    /// The tower on, without a brim (the brim has its own test).
     fn on() -> TowerParams {
         TowerParams {
             enabled: true,
+            brim_width: 0.0,
             ..TowerParams::default()
         }
     }
@@ -812,6 +855,58 @@ mod tests {
                 ..
             }))
         ));
+    }
+
+    #[test]
+    fn the_first_layer_has_a_brim_round_the_tower_that_stays_clear_of_the_objects() {
+        let m = machine(&[true, true]);
+        let brim = TowerParams {
+            brim_width: 2.0,
+            ..on()
+        };
+        let mut p = program(&[&[0, 1], &[1, 0]]);
+        let s = add_wipe_tower(&mut p, &brim, &m)
+            .expect("placed")
+            .expect("built");
+        // round(2 / 0.45) = 4 loops of 0.45 mm: 1.8 mm.
+        assert!((s.brim_width - 1.8).abs() < 1e-9, "{}", s.brim_width);
+        // Right of the square (20–30 mm and half a bead), the brim's outer edge 5 mm clear.
+        assert!((s.x - (30.225 + GAP_MM + 1.8)).abs() < 1e-9, "{}", s.x);
+        let first = tower_paths(&p, 0);
+        // Four brim loops from the outermost in, then the loop and the band (which fills the
+        // tower), all by tool 1 (the first to print on the tower), right after the change.
+        assert_eq!(first.len(), 6);
+        assert!(first.iter().all(|(_, t)| t.tool == 1));
+        for (n, (_, loop_path)) in first[..5].iter().enumerate() {
+            assert!(loop_path.closed);
+            // The loop's centreline: (3.5 − n) beads outside the tower's edge for the brim,
+            // half a bead inside it for the tower's own loop.
+            let grow = (3.5 - n as f64) * BEAD;
+            let xs: Vec<f64> = loop_path.points.iter().map(|q| q.x).collect();
+            let min = xs.iter().copied().fold(f64::INFINITY, f64::min);
+            let max = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            assert!((min - (s.x - grow)).abs() < 1e-9, "loop {n}: {min}");
+            assert!(
+                (max - (s.x + s.width + grow)).abs() < 1e-9,
+                "loop {n}: {max}"
+            );
+        }
+        let second = tower_paths(&p, 1);
+        assert_eq!(second.len(), 2, "no brim above the first layer");
+        // A brim that would leave the bed is an error, though the tower alone fits.
+        let edge = TowerParams {
+            x: Some(0.5),
+            y: Some(100.0),
+            ..brim.clone()
+        };
+        let off = add_wipe_tower(&mut program(&[&[0, 1]]), &edge, &m);
+        assert!(matches!(off, Err(TowerError::BadPlace { ref why, .. }) if why.contains("bed")));
+        let no_brim = TowerParams {
+            brim_width: 0.0,
+            ..edge
+        };
+        assert!(add_wipe_tower(&mut program(&[&[0, 1]]), &no_brim, &m).is_ok());
+        assert_eq!((brim_loops(0.1, BEAD), brim_loops(0.0, BEAD)), (1, 0));
     }
 
     #[test]
