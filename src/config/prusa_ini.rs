@@ -58,7 +58,8 @@
 //!   `support_material_with_sheath`;
 //! - wipe tower (`[wipe_tower]`): `wipe_tower`, `wipe_tower_x`, `wipe_tower_y` (its front-left
 //!   corner), `wipe_tower_width`, `wipe_tower_bridging` → `sparse_spacing`,
-//!   `wipe_tower_brim_width`, `wiping_volumes_matrix` (its largest entry → `purge_volume`);
+//!   `wipe_tower_brim_width`, `wipe_tower_rotation_angle` → `rotation`,
+//!   `wiping_volumes_matrix` (its largest entry → `purge_volume`);
 //! - widths: `extrusion_width` and `first_layer_`, `perimeter_`, `external_perimeter_`,
 //!   `infill_`, `solid_infill_`, `top_infill_extrusion_width`. A value is mm or `%` of the first
 //!   nozzle diameter. 0 (or a missing key) falls back to `extrusion_width`, and when that is 0 too to PrusaSlicer's
@@ -623,6 +624,10 @@ const RULES: &[(&str, Rule)] = &[
     (
         "wipe_tower_brim_width",
         Rule::Num(|c| &mut c.wipe_tower.brim_width),
+    ),
+    (
+        "wipe_tower_rotation_angle",
+        Rule::Num(|c| &mut c.wipe_tower.rotation),
     ),
     ("wiping_volumes_matrix", Rule::Custom(wiping_volumes)),
 ];
@@ -1416,7 +1421,7 @@ mod tests {
     fn wipe_tower_keys_map() -> Result<(), ConfigError> {
         let (cfg, warnings) = from_ini_str(
             "wipe_tower = 1\nwipe_tower_bridging = 8\nwipe_tower_brim_width = 3\n\
-             wipe_tower_no_sparse_layers = 0\nwipe_tower_rotation_angle = 0\n\
+             wipe_tower_no_sparse_layers = 0\nwipe_tower_rotation_angle = 30\n\
              wipe_tower_width = 50\nwipe_tower_x = 170\nwipe_tower_y = 40\n\
              wiping_volumes_extruders = 70,70,70,70,70,70,70,70,70,70\n\
              wiping_volumes_matrix = 0,120,90,0\n",
@@ -1425,13 +1430,20 @@ mod tests {
         assert!(t.enabled);
         assert_eq!((t.x, t.y), (Some(170.0), Some(40.0)));
         assert_eq!(
-            (t.width, t.sparse_spacing, t.purge_volume, t.brim_width),
-            (50.0, 8.0, 120.0, 3.0)
+            (
+                t.width,
+                t.sparse_spacing,
+                t.purge_volume,
+                t.brim_width,
+                t.rotation
+            ),
+            (50.0, 8.0, 120.0, 3.0, 30.0)
         );
         // The keys conduit has no use for are named as ignored; the mapped ones are not.
         let ignored = warnings.join("\n");
-        assert!(ignored.contains("wipe_tower_rotation_angle"), "{ignored}");
+        assert!(ignored.contains("wipe_tower_no_sparse_layers"), "{ignored}");
         assert!(!ignored.contains("wipe_tower_brim_width"), "{ignored}");
+        assert!(!ignored.contains("wipe_tower_rotation_angle"), "{ignored}");
         assert!(!ignored.contains("wipe_tower_width"), "{ignored}");
         let (off, _) = from_ini_str("layer_height = 0.2\n")?;
         assert_eq!(off.wipe_tower, crate::toolpaths::TowerParams::default());

@@ -39,6 +39,11 @@
 //! them, behind, left or in front, the first of those that fits on the bed [`GAP_MM`] clear of
 //! every path of the program. A tower that overlaps the objects' paths (within [`MIN_GAP_MM`])
 //! or leaves the bed is an error. The brim counts as part of the tower in both.
+//!
+//! Turned by `rotation` degrees (PrusaSlicer's `wipe_tower_rotation_angle`, anticlockwise seen
+//! from above) about its centre: the tower is built as above and every path of it turned, and
+//! the box round the turned tower and brim is what must fit on the bed clear of the objects
+//! (`x`, `y` stay the corner of the tower before it is turned, as in PrusaSlicer).
 
 use serde::{Deserialize, Serialize};
 
@@ -82,6 +87,9 @@ pub struct TowerParams {
     /// Width of the brim round the tower's first layer, 0 to 50 (rounded to whole beads; 0 for
     /// none). Default 2 (PrusaSlicer's `wipe_tower_brim_width`).
     pub brim_width: f64,
+    /// Turn of the tower about its centre, degrees anticlockwise seen from above, −360 to 360.
+    /// Default 0 (PrusaSlicer's `wipe_tower_rotation_angle`).
+    pub rotation: f64,
 }
 
 impl Default for TowerParams {
@@ -95,6 +103,7 @@ impl Default for TowerParams {
             sparse_spacing: 10.0,
             speed: 40.0,
             brim_width: 2.0,
+            rotation: 0.0,
         }
     }
 }
@@ -109,6 +118,7 @@ impl TowerParams {
             ("sparse_spacing", self.sparse_spacing, 1.0, 50.0),
             ("speed", self.speed, 1.0, 1000.0),
             ("brim_width", self.brim_width, 0.0, 50.0),
+            ("rotation", self.rotation, -360.0, 360.0),
         ] {
             if !(v.is_finite() && (lo..=hi).contains(&v)) {
                 out.push(format!(
@@ -172,6 +182,8 @@ pub struct TowerSummary {
     pub skipped_layers: usize,
     /// Width of the brim laid round the first layer, mm (whole beads; 0 for none).
     pub brim_width: f64,
+    /// Turn of the tower about its centre, degrees anticlockwise.
+    pub rotation: f64,
 }
 
 /// Why no tower could be built.
@@ -262,7 +274,9 @@ pub fn add_wipe_tower(
         purged_volume: 0.0,
         skipped_layers: 0,
         brim_width,
+        rotation: params.rotation,
     };
+    let turn = Turn::new(params.rotation, &tower);
     for (k, plan) in plans.iter().enumerate().take(top + 1) {
         let layer = &mut program.layers[k];
         let speed = if k == 0 {
@@ -277,6 +291,7 @@ pub fn add_wipe_tower(
             speed,
             solid: k == 0,
             brim_loops: if k == 0 { brim_loops } else { 0 },
+            turn,
             next_y: tower.y0,
             looped: false,
         };
@@ -447,12 +462,20 @@ fn place(
         y1: machine.bed[3],
     };
     let width = params.width;
-    // The tower with its brim, its corner at `x`, `y`.
+    // The box round the tower and its brim, turned about their centre: `fw` × `fd`, its corner
+    // `ox`, `oy` from the tower's.
+    let (sin, cos) = turn_sin_cos(params.rotation).unwrap_or((0.0, 1.0));
+    let (gw, gd) = (width + 2.0 * brim, depth + 2.0 * brim);
+    let (fw, fd) = (
+        cos.abs() * gw + sin.abs() * gd,
+        sin.abs() * gw + cos.abs() * gd,
+    );
+    let (ox, oy) = ((width - fw) / 2.0, (depth - fd) / 2.0);
     let at = |x: f64, y: f64| Rect {
-        x0: x - brim,
-        y0: y - brim,
-        x1: x + width + brim,
-        y1: y + depth + brim,
+        x0: x + ox,
+        y0: y + oy,
+        x1: x + ox + fw,
+        y1: y + oy + fd,
     };
     let objects = footprint(program);
     if let (Some(x), Some(y)) = (params.x, params.y) {
@@ -473,28 +496,61 @@ fn place(
         return Ok((x, y));
     }
     let Some(o) = objects else {
-        return Ok((bed.x0 + GAP_MM + brim, bed.y0 + GAP_MM + brim));
+        return Ok((bed.x0 + GAP_MM - ox, bed.y0 + GAP_MM - oy));
     };
-    // Right, behind, left, in front: the near side of the tower's brim GAP_MM from the
-    // objects', aligned with their front (or left) edge, or moved back onto the bed along that
-    // side.
-    let along = |lo: f64, size: f64, bed_lo: f64, bed_hi: f64| {
-        (lo + brim).min(bed_hi - size - brim).max(bed_lo + brim)
-    };
-    let reach = GAP_MM + brim;
+    // Right, behind, left, in front: the near side of the box round the tower and brim GAP_MM
+    // from the objects', aligned with their front (or left) edge, or moved back onto the bed
+    // along that side.
+    let along = |lo: f64, size: f64, bed_lo: f64, bed_hi: f64| lo.min(bed_hi - size).max(bed_lo);
     let candidates = [
-        (o.x1 + reach, along(o.y0, depth, bed.y0, bed.y1)),
-        (along(o.x0, width, bed.x0, bed.x1), o.y1 + reach),
-        (o.x0 - reach - width, along(o.y0, depth, bed.y0, bed.y1)),
-        (along(o.x0, width, bed.x0, bed.x1), o.y0 - reach - depth),
+        (o.x1 + GAP_MM, along(o.y0, fd, bed.y0, bed.y1)),
+        (along(o.x0, fw, bed.x0, bed.x1), o.y1 + GAP_MM),
+        (o.x0 - GAP_MM - fw, along(o.y0, fd, bed.y0, bed.y1)),
+        (along(o.x0, fw, bed.x0, bed.x1), o.y0 - GAP_MM - fd),
     ];
     candidates
         .into_iter()
+        .map(|(fx, fy)| (fx - ox, fy - oy))
         .find(|&(x, y)| {
             let t = at(x, y);
             t.within(&bed) && !t.near(&o, GAP_MM - 1e-9)
         })
         .ok_or(TowerError::NoRoom { width, depth })
+}
+
+/// Sine and cosine of a turn by `degrees`; `None` for a whole number of turns (no turn: the
+/// paths stay exactly as built).
+fn turn_sin_cos(degrees: f64) -> Option<(f64, f64)> {
+    (degrees.rem_euclid(360.0) != 0.0).then(|| degrees.to_radians().sin_cos())
+}
+
+/// A turn about a point in the plane (none when the angle is a whole turn or zero).
+#[derive(Debug, Clone, Copy)]
+struct Turn {
+    /// Sine and cosine of the angle, `None` for no turn.
+    sin_cos: Option<(f64, f64)>,
+    /// The point turned about.
+    centre: [f64; 2],
+}
+
+impl Turn {
+    /// The turn by `degrees` (anticlockwise) about the centre of `r`.
+    fn new(degrees: f64, r: &Rect) -> Self {
+        Self {
+            sin_cos: turn_sin_cos(degrees),
+            centre: [(r.x0 + r.x1) / 2.0, (r.y0 + r.y1) / 2.0],
+        }
+    }
+
+    /// `p` turned.
+    fn apply(&self, p: [f64; 2]) -> [f64; 2] {
+        let Some((sin, cos)) = self.sin_cos else {
+            return p;
+        };
+        let [cx, cy] = self.centre;
+        let (dx, dy) = (p[0] - cx, p[1] - cy);
+        [cx + cos * dx - sin * dy, cy + sin * dx + cos * dy]
+    }
 }
 
 /// Makes one layer's tower paths, band after band from the front.
@@ -507,6 +563,8 @@ struct LayerBuilder {
     solid: bool,
     /// Loops of the brim laid before the first loop (the first layer's).
     brim_loops: usize,
+    /// How the tower's paths are turned.
+    turn: Turn,
     /// Where the next band starts (Y of its front edge), mm.
     next_y: f64,
     /// Whether the loop is laid on this layer.
@@ -518,7 +576,10 @@ impl LayerBuilder {
         Toolpath {
             points: points
                 .into_iter()
-                .map(|[x, y]| Point3::new(x, y, self.z))
+                .map(|p| {
+                    let [x, y] = self.turn.apply(p);
+                    Point3::new(x, y, self.z)
+                })
                 .collect(),
             closed,
             role: Role::WipeTower,
@@ -907,6 +968,65 @@ mod tests {
         };
         assert!(add_wipe_tower(&mut program(&[&[0, 1]]), &no_brim, &m).is_ok());
         assert_eq!((brim_loops(0.1, BEAD), brim_loops(0.0, BEAD)), (1, 0));
+    }
+
+    /// The box round the tower's paths of layer `k` (bead centres).
+    fn path_box(program: &Program, k: usize) -> [f64; 4] {
+        let mut b = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
+        for (_, t) in tower_paths(program, k) {
+            for q in &t.points {
+                b = [b[0].min(q.x), b[1].min(q.y), b[2].max(q.x), b[3].max(q.y)];
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn a_turned_tower_turns_about_its_centre_and_its_box_stays_clear_of_the_objects() {
+        let m = machine(&[true, true]);
+        let turned = |rotation: f64| TowerParams { rotation, ..on() };
+        let straight = {
+            let mut p = program(&[&[0, 1], &[1, 0]]);
+            let s = add_wipe_tower(&mut p, &on(), &m)
+                .expect("placed")
+                .expect("built");
+            (path_box(&p, 1), s)
+        };
+        // A quarter turn: the 60 mm side lies along Y, about the same centre as the tower
+        // placed for it, and the box round it starts 5 mm right of the square (30.225 mm).
+        let mut p = program(&[&[0, 1], &[1, 0]]);
+        let s = add_wipe_tower(&mut p, &turned(90.0), &m)
+            .expect("placed")
+            .expect("built");
+        assert_eq!(s.rotation, 90.0);
+        let b = path_box(&p, 1);
+        let (w, d) = (s.width, s.depth);
+        let (cx, cy) = (s.x + w / 2.0, s.y + d / 2.0);
+        let (sw, sd) = (straight.0[2] - straight.0[0], straight.0[3] - straight.0[1]);
+        assert!(((b[2] - b[0]) - sd).abs() < 1e-9 && ((b[3] - b[1]) - sw).abs() < 1e-9);
+        assert!(((b[0] + b[2]) / 2.0 - cx).abs() < 1e-9);
+        assert!(((b[1] + b[3]) / 2.0 - cy).abs() < 1e-9);
+        assert!((cx - d / 2.0 - (30.225 + GAP_MM)).abs() < 1e-9, "{cx}");
+        // An eighth of a turn: every bead lies within the box placed for it, clear of the
+        // square by 5 mm.
+        let mut p = program(&[&[0, 1], &[1, 0]]);
+        let s = add_wipe_tower(&mut p, &turned(45.0), &m)
+            .expect("placed")
+            .expect("built");
+        let half = (s.width + s.depth) * std::f64::consts::FRAC_1_SQRT_2 / 2.0;
+        let cx = s.x + s.width / 2.0;
+        for k in 0..2 {
+            let b = path_box(&p, k);
+            assert!(b[0] >= cx - half && b[2] <= cx + half, "{b:?}");
+            assert!(b[0] - BEAD / 2.0 >= 30.225 + GAP_MM - 1e-9, "{b:?}");
+        }
+        // A whole turn is none: the same paths as unturned.
+        let mut p = program(&[&[0, 1], &[1, 0]]);
+        add_wipe_tower(&mut p, &turned(360.0), &m)
+            .expect("placed")
+            .expect("built");
+        assert_eq!(path_box(&p, 1), straight.0);
+        assert_eq!(straight.1.rotation, 0.0);
     }
 
     #[test]
