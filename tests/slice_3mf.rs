@@ -583,6 +583,22 @@ const LAYER_SLIDER: &str = r##"<?xml version="1.0" encoding="utf-8"?>
 </custom_gcodes_per_print_z>
 "##;
 
+/// The line of the event `tag` in `lines`, asserting that it comes once, followed by `then`,
+/// at the start of the layer at `z` (`;Z:` after its `;LAYER_CHANGE`); returns the indices of
+/// that `;LAYER_CHANGE` and of the tag.
+fn event_line(lines: &[&str], tag: &str, z: &str, then: &[&str]) -> (usize, usize) {
+    let at: Vec<usize> = (0..lines.len()).filter(|&i| lines[i] == tag).collect();
+    assert_eq!(at.len(), 1, "{tag} once");
+    let i = at[0];
+    assert_eq!(&lines[i + 1..i + 1 + then.len()], then);
+    let layer = lines[..i]
+        .iter()
+        .rposition(|l| *l == ";LAYER_CHANGE")
+        .unwrap_or(0);
+    assert_eq!(lines[layer + 1], format!(";Z:{z}"));
+    (layer, i)
+}
+
 /// PrusaSlicer's colour changes, pauses and custom G-code by height come before the first
 /// layer whose top reaches them, right after the move to it (PrusaSlicer 2.5 puts the same
 /// project's events on the same layers), with the project's profile or with `--config`; one
@@ -633,15 +649,7 @@ fn layer_slider_events_come_where_prusaslicer_puts_them() {
             (";PAUSE_PRINT", "4.2", &["M117 Insert magnets", "M601"]),
             (";CUSTOM_GCODE", "6.3", &["M117 custom here", "G4 S1"]),
         ] {
-            let at: Vec<usize> = (0..lines.len()).filter(|&i| lines[i] == tag).collect();
-            assert_eq!(at.len(), 1, "{tag} once");
-            let i = at[0];
-            assert_eq!(&lines[i + 1..i + 1 + then.len()], then);
-            let layer = lines[..i]
-                .iter()
-                .rposition(|l| *l == ";LAYER_CHANGE")
-                .unwrap_or(0);
-            assert_eq!(lines[layer + 1], format!(";Z:{z}"));
+            let (layer, i) = event_line(&lines, tag, z, then);
             assert!(lines[layer..i].iter().any(|l| l.starts_with("G1 Z")));
             assert!(
                 !lines[layer..i]
@@ -711,15 +719,7 @@ fn orcaslicer_plate_events_come_before_their_layers() {
         ),
         (";COLOR_CHANGE,T0,#00FF00", "2.4", &["M600"]),
     ] {
-        let at: Vec<usize> = (0..lines.len()).filter(|&i| lines[i] == tag).collect();
-        assert_eq!(at.len(), 1, "{tag} once");
-        let i = at[0];
-        assert_eq!(&lines[i + 1..i + 1 + then.len()], then);
-        let layer = lines[..i]
-            .iter()
-            .rposition(|l| *l == ";LAYER_CHANGE")
-            .unwrap_or(0);
-        assert_eq!(lines[layer + 1], format!(";Z:{z}"));
+        event_line(&lines, tag, z, then);
     }
     assert!(!gcode.contains("never"));
     let check = conduit([

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use conduit::geom::Point3;
-use conduit_gcode::{Firmware, moves};
+use conduit_gcode::{Firmware, Move, Moves, moves};
 
 use crate::support::{conduit, stdout, temp_dir, write_stl, xyz};
 
@@ -68,6 +68,42 @@ fn slice(dir: &Path, extra: &[&str]) -> (std::process::Output, serde_json::Value
     (out, report)
 }
 
+/// The box `[min x, min y, max x, max y]` round the extruding moves that `pick` keeps.
+fn extent(replay: &Moves, pick: &dyn Fn(&Move) -> bool) -> [f64; 4] {
+    let mut b = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
+    for m in replay
+        .moves
+        .iter()
+        .filter(|m| m.extruding && m.has_xy && pick(m))
+    {
+        for p in [xyz(m.from), xyz(m.to)] {
+            b = [
+                b[0].min(p[0]),
+                b[1].min(p[1]),
+                b[2].max(p[0]),
+                b[3].max(p[1]),
+            ];
+        }
+    }
+    b
+}
+
+/// `conduit check` replays `dir/out.gcode` with the two-tool config without an error or a
+/// warning (no extrusion into air).
+fn check_is_clean(dir: &Path) {
+    let check = conduit([
+        "check".as_ref(),
+        dir.join("out.gcode").as_os_str(),
+        "-c".as_ref(),
+        dir.join("two.toml").as_os_str(),
+    ]);
+    let said = stdout(&check);
+    assert!(
+        check.status.success() && said.contains("0 errors, 0 warnings"),
+        "{said}"
+    );
+}
+
 #[test]
 fn every_tool_change_purges_on_one_tower_standing_up_to_the_last_change() {
     let dir = temp_dir();
@@ -84,7 +120,7 @@ fn every_tool_change_purges_on_one_tower_standing_up_to_the_last_change() {
     let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
     let replay = moves(&g, Firmware::Marlin);
     let filament = std::f64::consts::PI * 1.75f64.powi(2) / 4.0;
-    let is_tower = |m: &conduit_gcode::Move| m.role.as_deref() == Some("Wipe tower");
+    let is_tower = |m: &Move| m.role.as_deref() == Some("Wipe tower");
 
     // The purges: after each change, the extrusion up to the next role is the tower's, by the
     // new tool, and holds at least 100 mm³.
@@ -116,7 +152,7 @@ fn every_tool_change_purges_on_one_tower_standing_up_to_the_last_change() {
     }
 
     // The tower: one box on the bed, on layers 0..=9 only, apart from the boxes' paths.
-    let layers_of = |pick: &dyn Fn(&conduit_gcode::Move) -> bool| -> Vec<usize> {
+    let layers_of = |pick: &dyn Fn(&Move) -> bool| -> Vec<usize> {
         let mut v: Vec<usize> = replay
             .moves
             .iter()
@@ -127,26 +163,10 @@ fn every_tool_change_purges_on_one_tower_standing_up_to_the_last_change() {
         v
     };
     assert_eq!(layers_of(&is_tower), (0..10).collect::<Vec<_>>());
-    let bounds = |pick: &dyn Fn(&conduit_gcode::Move) -> bool| {
-        let mut b = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
-        for m in replay
-            .moves
-            .iter()
-            .filter(|m| m.extruding && m.has_xy && pick(m))
-        {
-            for p in [xyz(m.from), xyz(m.to)] {
-                b = [
-                    b[0].min(p[0]),
-                    b[1].min(p[1]),
-                    b[2].max(p[0]),
-                    b[3].max(p[1]),
-                ];
-            }
-        }
-        b
-    };
-    let tower = bounds(&is_tower);
-    let parts = bounds(&|m| !is_tower(m) && m.role.as_deref().is_none_or(|r| r != "Skirt/Brim"));
+    let tower = extent(&replay, &is_tower);
+    let parts = extent(&replay, &|m| {
+        !is_tower(m) && m.role.as_deref().is_none_or(|r| r != "Skirt/Brim")
+    });
     let t = &report["wipe_tower"];
     let num = |k: &str| t[k].as_f64().expect(k);
     // Bead centres lie half a bead inside the tower's outline.
@@ -163,19 +183,7 @@ fn every_tool_change_purges_on_one_tower_standing_up_to_the_last_change() {
     );
     assert_eq!(t["layers"], 10);
     assert_eq!(t["purges"], 10);
-
-    // conduit check replays it without an error or a warning (no extrusion into air).
-    let check = conduit([
-        "check".as_ref(),
-        dir.join("out.gcode").as_os_str(),
-        "-c".as_ref(),
-        dir.join("two.toml").as_os_str(),
-    ]);
-    let said = stdout(&check);
-    assert!(
-        check.status.success() && said.contains("0 errors, 0 warnings"),
-        "{said}"
-    );
+    check_is_clean(dir);
 }
 
 #[test]
@@ -215,23 +223,9 @@ fn the_towers_first_layer_stands_on_a_brim() {
     let num = |k: &str| t[k].as_f64().expect(k);
     assert!((num("brim_width") - 1.8).abs() < 1e-9, "{t}");
     let bounds = |layer: usize, tower: bool| {
-        let mut b = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
-        for m in replay.moves.iter().filter(|m| {
-            m.extruding
-                && m.has_xy
-                && m.layer == layer
-                && (m.role.as_deref() == Some("Wipe tower")) == tower
-        }) {
-            for p in [xyz(m.from), xyz(m.to)] {
-                b = [
-                    b[0].min(p[0]),
-                    b[1].min(p[1]),
-                    b[2].max(p[0]),
-                    b[3].max(p[1]),
-                ];
-            }
-        }
-        b
+        extent(&replay, &|m| {
+            m.layer == layer && (m.role.as_deref() == Some("Wipe tower")) == tower
+        })
     };
     let (first, second) = (bounds(0, true), bounds(1, true));
     // The outermost brim bead's centre lies 3.5 beads outside the tower's outline, the loop's
@@ -250,15 +244,5 @@ fn the_towers_first_layer_stands_on_a_brim() {
         first[0] - 0.225 >= parts[2] + 0.225 + 5.0 - 1e-3,
         "tower {first:?}, parts {parts:?}"
     );
-    let check = conduit([
-        "check".as_ref(),
-        dir.join("out.gcode").as_os_str(),
-        "-c".as_ref(),
-        dir.join("two.toml").as_os_str(),
-    ]);
-    let said = stdout(&check);
-    assert!(
-        check.status.success() && said.contains("0 errors, 0 warnings"),
-        "{said}"
-    );
+    check_is_clean(dir);
 }

@@ -143,8 +143,8 @@ pub(super) fn read(
         };
         let line = x.loc().line as usize;
         let name = e.local_name().as_ref().to_owned();
-        let parent = open.last().map(String::as_str);
-        let in_plate = orca && open.len() == 2 && parent == Some("plate");
+        // A child of a `<plate>` of OrcaSlicer's part.
+        let in_plate = orca && open.len() == 2 && open.last().is_some_and(|p| p == "plate");
         match (name.as_str(), open.len()) {
             ("custom_gcodes_per_print_z", 0) => {}
             ("custom_gcodes_per_layer", 0) => orca = true,
@@ -157,7 +157,7 @@ pub(super) fn read(
                 ));
             }
             ("plate", 1) if orca => plates.push(Plate::default()),
-            ("mode", 1) | ("mode", 2) if open.len() == 1 || in_plate => {
+            ("mode", _) if open.len() == 1 || in_plate => {
                 let attrs = attributes(&x, &e)?;
                 let mode = attribute(&attrs, "value").map(str::to_owned);
                 match plates.last_mut().filter(|_| in_plate) {
@@ -165,7 +165,7 @@ pub(super) fn read(
                     None => root.mode = mode,
                 }
             }
-            ("plate_info", 2) if in_plate => {
+            ("plate_info", _) if in_plate => {
                 let attrs = attributes(&x, &e)?;
                 let id = number(part, line, "plate_info", "id", attribute(&attrs, "id"))?;
                 if let Some(plate) = plates.last_mut() {
@@ -178,7 +178,7 @@ pub(super) fn read(
                 root.codes
                     .extend(code(part, line, ("code", "print_z"), &get, warnings)?);
             }
-            ("layer", 1) | ("layer", 2) if orca && (open.len() == 1 || in_plate) => {
+            ("layer", _) if orca && (open.len() == 1 || in_plate) => {
                 let attrs = attributes(&x, &e)?;
                 let get = |name: &str| attribute(&attrs, name);
                 let read = code(part, line, ("layer", "top_z"), &get, warnings)?;
