@@ -33,8 +33,12 @@ fn json_of(o: &std::process::Output, what: &str) -> Value {
 /// A PrusaSlicer profile with settings conduit reads, three it ignores that change the print
 /// only when not off (`raft_layers = 2` and `ironing = 1` do, `spiral_vase = 0` does not) and two
 /// that do not change it.
+/// A partial profile: five keys conduit ignores, and the four whose PrusaSlicer defaults it
+/// prints otherwise (stated, so the only warning is about the ignored ones).
 const PROFILE: &str = "layer_height = 0.2\nraft_layers = 2\nironing = 1\nspiral_vase = 0\n\
-                       gcode_comments = 0\nwipe = 1\n";
+                       gcode_comments = 0\nwipe = 1\ngcode_flavor = marlin2\n\
+                       fill_pattern = rectilinear\ntop_fill_pattern = rectilinear\n\
+                       bottom_fill_pattern = rectilinear\n";
 
 #[test]
 fn quiet_silences_summaries_and_warnings_but_not_errors() {

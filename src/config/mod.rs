@@ -44,6 +44,7 @@ mod defaults;
 mod electronics;
 pub mod embedded;
 pub mod host;
+mod prusa_defaults;
 pub mod prusa_ini;
 
 pub use crate::circuit::settings::RouteSettings;

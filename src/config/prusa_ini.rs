@@ -7,7 +7,12 @@
 //!
 //! # Mapping
 //!
-//! Keys start from [`Config::default`] and overwrite what PrusaSlicer states:
+//! Keys start from [`Config::default`] and overwrite what PrusaSlicer states. A `.ini` is read
+//! as PrusaSlicer reads it: the keys it leaves out take PrusaSlicer's defaults
+//! ([`super::prusa_defaults`]) before the mapping, and what conduit prints otherwise than such a
+//! default is said in one warning; the other inputs (a host slicer's environment, a G-code's or
+//! a 3MF's settings) state every key of the slicer that wrote them.
+//!
 //!
 //! - printer: `bed_shape` (polygon; its bounding box gives `bed_size` and `bed_origin`),
 //!   `max_print_height`, `gcode_flavor` (`marlin`, `marlin2`, `reprapfirmware`, `klipper`;
@@ -86,6 +91,7 @@
 use std::collections::BTreeMap;
 use std::collections::BTreeSet;
 
+use super::prusa_defaults::PRUSASLICER_DEFAULTS;
 use super::{Config, ConfigError, Flavor, SolidPattern, Tool};
 use crate::region::{BrimType, InfillPatternKind, PerimeterGenerator, SupportPattern};
 use crate::toolpaths::SeamRule;
@@ -113,15 +119,59 @@ pub fn from_ini_str(src: &str) -> Result<(Config, Vec<String>), ConfigError> {
         };
         pairs.push((key.trim().to_owned(), value.trim().to_owned(), Some(i + 1)));
     }
-    convert(pairs)
+    let (pairs, defaulted) = with_prusaslicer_defaults(pairs);
+    convert(pairs, defaulted)
 }
+
+/// The warning that lists what conduit prints otherwise than PrusaSlicer's defaults for the
+/// keys a `.ini` leaves out (after their number).
+pub(crate) const DEFAULTS_PRINTED_OTHERWISE: &str =
+    "PrusaSlicer default(s) of keys the file leaves out are printed otherwise";
+
+/// Keys that Slic3r and PrusaSlicer name differently: when a file states one, the other's
+/// default is not added (it would override or contradict what the file states).
+const TWINS: &[[&str; 2]] = &[
+    ["top_fill_pattern", "top_infill_pattern"],
+    ["bottom_fill_pattern", "bottom_infill_pattern"],
+];
+
+/// `pairs` with PrusaSlicer's default (see [`super::prusa_defaults`]) first for every key they
+/// do not state, as PrusaSlicer reads a `.ini`; and the keys so added.
+fn with_prusaslicer_defaults(pairs: Pairs3) -> (Pairs3, BTreeSet<String>) {
+    let stated: BTreeSet<&str> = pairs.iter().map(|(k, _, _)| k.as_str()).collect();
+    let twin_stated = |key: &str| {
+        TWINS
+            .iter()
+            .filter(|t| t.contains(&key))
+            .flatten()
+            .any(|k| stated.contains(k))
+    };
+    let defaulted: BTreeSet<String> = PRUSASLICER_DEFAULTS
+        .iter()
+        .filter(|(k, _)| !stated.contains(k) && !twin_stated(k))
+        .map(|(k, _)| (*k).to_owned())
+        .collect();
+    let mut all: Pairs3 = PRUSASLICER_DEFAULTS
+        .iter()
+        .filter(|(k, _)| defaulted.contains(*k))
+        .map(|(k, v)| ((*k).to_owned(), (*v).to_owned(), None))
+        .collect();
+    all.extend(pairs);
+    (all, defaulted)
+}
+
+/// Keys, values as written and the line of each (none for a value not from a file).
+type Pairs3 = Vec<(String, String, Option<usize>)>;
 
 /// Builds a config from PrusaSlicer `key`/`value` pairs (keys as in the `.ini`, values as
 /// written there). Later pairs override earlier ones. Returns the config and the warnings.
 pub fn from_prusa_pairs(
     pairs: impl IntoIterator<Item = (String, String)>,
 ) -> Result<(Config, Vec<String>), ConfigError> {
-    convert(pairs.into_iter().map(|(k, v)| (k, v, None)).collect())
+    convert(
+        pairs.into_iter().map(|(k, v)| (k, v, None)).collect(),
+        BTreeSet::new(),
+    )
 }
 
 /// Builds a config from the environment of a PrusaSlicer post-processing call: variables named
@@ -171,6 +221,8 @@ pub fn pairs_from_gcode(g: &conduit_gcode::Gcode) -> Vec<(String, String)> {
 struct Pairs {
     values: BTreeMap<String, (String, Option<usize>)>,
     used: BTreeSet<String>,
+    /// The keys the input does not state, whose values are PrusaSlicer's defaults.
+    defaulted: BTreeSet<String>,
 }
 
 impl Pairs {
@@ -713,12 +765,14 @@ impl Rule {
 /// The conversion: the technology check, the tools, every key of [`RULES`] in order, then one
 /// warning for the keys no step read and the config's own validation.
 fn convert(
-    list: Vec<(String, String, Option<usize>)>,
+    list: Pairs3,
+    defaulted: BTreeSet<String>,
 ) -> Result<(Config, Vec<String>), ConfigError> {
     let mut imp = Import {
         p: Pairs {
             values: list.into_iter().map(|(k, v, l)| (k, (v, l))).collect(),
             used: BTreeSet::new(),
+            defaulted,
         },
         cfg: Config::default(),
         warnings: Vec::new(),
@@ -731,9 +785,23 @@ fn convert(
     warn_ignored(&mut imp);
     let Import {
         mut cfg,
-        mut warnings,
+        warnings,
         p,
     } = imp;
+    // What conduit does differently with PrusaSlicer's default for a key the file leaves out
+    // is said once, after what it does with the file's own values.
+    let (from_defaults, mut warnings): (Vec<String>, Vec<String>) =
+        warnings.into_iter().partition(|w| {
+            p.defaulted
+                .contains(w.split([' ', ':']).next().unwrap_or_default())
+        });
+    if !from_defaults.is_empty() {
+        warnings.push(format!(
+            "{} {DEFAULTS_PRINTED_OTHERWISE}: {}",
+            from_defaults.len(),
+            from_defaults.join("; ")
+        ));
+    }
     // Every key as written, for the templates' macros (`{filament_type[0]}`, `{z_offset}`).
     cfg.printer.profile = p.values.into_iter().map(|(k, (v, _))| (k, v)).collect();
     let more = cfg.validate()?;
@@ -951,7 +1019,7 @@ fn infill_overlap(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
 }
 
 /// `perimeter_generator` and `thin_walls`: `classic` is conduit's classic generator and prints
-/// thin walls as `thin_walls` says (PrusaSlicer's default 0 when the key is missing); `arachne`
+/// thin walls as `thin_walls` says (PrusaSlicer's default, on, when the key is missing); `arachne`
 /// (PrusaSlicer's default, also when the key is missing) is conduit's variable generator, which
 /// like Arachne prints thin features whatever `thin_walls` says. Any other value warns and takes
 /// the variable generator.
@@ -972,7 +1040,7 @@ fn perimeter_generator(imp: &mut Import, key: &str) -> Result<(), ConfigError> {
     let slice = &mut imp.cfg.slice;
     slice.perimeter_generator = generator;
     slice.thin_walls = match generator {
-        PerimeterGenerator::Classic => thin_walls.unwrap_or(false),
+        PerimeterGenerator::Classic => thin_walls.unwrap_or(true),
         PerimeterGenerator::Variable => true,
     };
     Ok(())
@@ -1258,10 +1326,8 @@ pub(crate) fn impact(key: &str, value: &str) -> u8 {
 
 /// Builds a config from PrusaSlicer pairs with the line each came from, as
 /// [`from_prusa_pairs`] does.
-pub(crate) fn from_lined_pairs(
-    pairs: Vec<(String, String, Option<usize>)>,
-) -> Result<(Config, Vec<String>), ConfigError> {
-    convert(pairs)
+pub(crate) fn from_lined_pairs(pairs: Pairs3) -> Result<(Config, Vec<String>), ConfigError> {
+    convert(pairs, BTreeSet::new())
 }
 
 /// Lists, in one warning, every key no step has read: their number, those that change the
@@ -1276,10 +1342,11 @@ fn warn_ignored(imp: &mut Import) {
         .get("support_material")
         .is_some_and(|(v, _)| v.trim() == "1");
     // `values` is a sorted map: both lists come out sorted.
+    // Only the keys the input states: a default is no setting of the user's.
     let ignored: Vec<(&str, &str)> = p
         .values
         .iter()
-        .filter(|(k, _)| !p.used.contains(*k))
+        .filter(|(k, _)| !p.used.contains(*k) && !p.defaulted.contains(*k))
         .map(|(k, (v, _))| (k.as_str(), v.as_str()))
         .collect();
     if ignored.is_empty() {
@@ -1323,9 +1390,18 @@ fn syntax_warning(key: &str, field: &str, g: &str) -> Option<String> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::emit::gcode::macros::{Value, Var};
+
+    /// The warnings about what a file states: all but the one about PrusaSlicer's defaults for
+    /// the keys it leaves out.
+    pub(crate) fn stated(warnings: &[String]) -> Vec<&String> {
+        warnings
+            .iter()
+            .filter(|w| !w.contains(DEFAULTS_PRINTED_OTHERWISE))
+            .collect()
+    }
 
     const BENCH_INI: &str = concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -1395,8 +1471,8 @@ mod tests {
             classic.slice.perimeter_generator,
             PerimeterGenerator::Classic
         );
-        // The bench profile has no `thin_walls`: PrusaSlicer's default is off.
-        assert!(!classic.slice.thin_walls);
+        // The bench profile has no `thin_walls`: PrusaSlicer's default is on.
+        assert!(classic.slice.thin_walls);
         // Without the key PrusaSlicer takes Arachne; an unknown generator warns.
         let (missing, _) = from_ini_str("layer_height = 0.2\n")?;
         assert_eq!(
@@ -1445,8 +1521,16 @@ mod tests {
         assert!(!ignored.contains("wipe_tower_brim_width"), "{ignored}");
         assert!(!ignored.contains("wipe_tower_rotation_angle"), "{ignored}");
         assert!(!ignored.contains("wipe_tower_width"), "{ignored}");
+        // Without the keys, PrusaSlicer's defaults: off, its corner at (180, 140).
         let (off, _) = from_ini_str("layer_height = 0.2\n")?;
-        assert_eq!(off.wipe_tower, crate::toolpaths::TowerParams::default());
+        assert_eq!(
+            off.wipe_tower,
+            crate::toolpaths::TowerParams {
+                x: Some(180.0),
+                y: Some(140.0),
+                ..Default::default()
+            }
+        );
         Ok(())
     }
 
@@ -1630,6 +1714,67 @@ gcode_comments = 0
         Ok(())
     }
 
+    /// A `.ini` that states a few keys is read as PrusaSlicer reads it: the others take
+    /// PrusaSlicer's defaults (as `prusa-slicer --save` writes them), for the mapping and for
+    /// the templates, and only the file's own keys are named as ignored.
+    #[test]
+    fn keys_a_file_leaves_out_take_prusaslicers_defaults() -> Result<(), ConfigError> {
+        let (cfg, warnings) = from_ini_str(
+            "layer_height = 0.2\nperimeter_generator = classic\ntop_infill_pattern = \
+             rectilinear\nbogus = 1\nstart_gcode = M140 S{chamber_minimal_temperature[0]} \
+             {if nozzle_high_flow[0] or filament_abrasive[0]}HF{else}std{endif} {z_offset}\n",
+        )?;
+        // Stated keys keep their values; the rest are PrusaSlicer 2.5's.
+        assert_eq!(cfg.slice.layer_height, 0.2);
+        assert_eq!(cfg.slice.first_layer_height, 0.35);
+        assert_eq!((cfg.slice.perimeters, cfg.slice.top_solid_layers), (3, 3));
+        assert_eq!(
+            (cfg.printer.bed_size, cfg.printer.bed_origin),
+            ([200.0, 200.0], [0.0, 0.0])
+        );
+        assert_eq!(
+            (cfg.tools[0].nozzle_diameter, cfg.tools[0].temperature),
+            (0.4, 200.0)
+        );
+        assert_eq!(
+            (cfg.printer.travel_speed, cfg.printer.retract_length),
+            (130.0, 2.0)
+        );
+        assert_eq!((cfg.slice.skirt_loops, cfg.slice.skirt_distance), (1, 6.0));
+        // PrusaSlicer's thin_walls is on: the classic generator prints them.
+        assert!(cfg.slice.thin_walls);
+        // The template finds the keys newer PrusaSlicer profiles name.
+        assert_eq!(
+            cfg.render_template(&cfg.printer.start_gcode, 0, &[])?,
+            "M140 S0 std 0"
+        );
+        // One warning names the defaults conduit prints otherwise; the top pattern's is not
+        // among them (the file states it under Slic3r's name), nor are defaults listed as
+        // ignored keys.
+        let note = warnings
+            .iter()
+            .find(|w| w.contains(DEFAULTS_PRINTED_OTHERWISE))
+            .map_or("", String::as_str);
+        assert!(note.starts_with("3 PrusaSlicer default(s)"), "{warnings:?}");
+        for named in [
+            "gcode_flavor = reprap",
+            "fill_pattern = stars",
+            "bottom_fill_pattern",
+        ] {
+            assert!(note.contains(named), "{note}");
+        }
+        assert!(!note.contains("top_fill_pattern"), "{note}");
+        assert_eq!(
+            stated(&warnings),
+            ["1 PrusaSlicer key ignored (none that change the print); all of them: bogus"]
+        );
+        // Other inputs (a host slicer's environment, a 3MF's profile) state every key: no
+        // defaults are added to them.
+        let (env, _) = from_prusa_pairs([("layer_height".to_owned(), "0.2".to_owned())])?;
+        assert_eq!(env.printer.bed_size, Config::default().printer.bed_size);
+        Ok(())
+    }
+
     #[test]
     fn filament_gcode_lists_go_to_their_tools() -> Result<(), ConfigError> {
         let (cfg, warnings) = from_ini_str(
@@ -1637,7 +1782,7 @@ gcode_comments = 0
              start_filament_gcode = \"M900 K0.05 ; {filament_extruder_id}\\nM142\";M900 K0;\n\
              end_filament_gcode = \"; Filament-specific end gcode\"\n",
         )?;
-        assert!(warnings.is_empty(), "{warnings:?}");
+        assert!(stated(&warnings).is_empty(), "{warnings:?}");
         let starts: Vec<&str> = cfg.tools.iter().map(|t| t.start_gcode.as_str()).collect();
         // Three extruders and the paste tool; a trailing `;` is one more (empty) item.
         assert_eq!(
@@ -1666,7 +1811,7 @@ gcode_comments = 0
             cfg.printer.before_tool_change_gcode,
             "G1 Z{layer_z} ; from [previous_extruder]\nT{next_extruder}"
         );
-        assert!(warnings.is_empty(), "{warnings:?}");
+        assert!(stated(&warnings).is_empty(), "{warnings:?}");
         let vars = [
             ("previous_tool", Var::Scalar(Value::Int(0))),
             ("next_tool", Var::Scalar(Value::Int(1))),
@@ -1687,7 +1832,7 @@ gcode_comments = 0
         );
         // Macros parse: no warning; a syntax error is named with its line.
         let (_, warnings) = from_ini_str("toolchange_gcode = {if next_extruder==1}T1{endif}\n")?;
-        assert!(warnings.is_empty(), "{warnings:?}");
+        assert!(stated(&warnings).is_empty(), "{warnings:?}");
         let (_, warnings) = from_ini_str("toolchange_gcode = T{next_extruder}\\n{1 +}\n")?;
         assert!(
             warnings.iter().any(|w| w.starts_with(

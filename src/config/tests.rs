@@ -181,10 +181,8 @@ fn load_picks_the_format_by_extension() -> Result<(), Box<dyn std::error::Error>
     let (cfg, warnings) = load(&ini_path)?;
     assert_eq!(cfg.slice.layer_height, 0.15);
     assert_eq!(
-        warnings,
-        vec![
-            "1 PrusaSlicer key ignored (none that change the print); all of them: bogus".to_owned()
-        ]
+        prusa_ini::tests::stated(&warnings),
+        ["1 PrusaSlicer key ignored (none that change the print); all of them: bogus"]
     );
     std::fs::write(&ini_path, "layer_height = 0.15\nperimeters = x\n")?;
     let err = load(&ini_path)
