@@ -41,6 +41,9 @@ type Cdt = spade::ConstrainedDelaunayTriangulation<Sp, (), bool>;
 const EDGE_MM: (f64, f64) = (0.1, 0.5);
 /// Segments shorter than this (mm) are skipped: their thickness would be meaningless.
 const MIN_SEGMENT_MM: f64 = 1e-6;
+/// How far from a junction (mm) a branch's heading is taken when the straightest pair of
+/// branches through it is joined: a few strip widths, past the junction's own triangle.
+const HEADING_MM: f64 = 1.0;
 /// At most this many pieces per resampled edge, so absurd coordinates cannot exhaust memory.
 const MAX_PIECES: f64 = 65_536.0;
 
@@ -83,11 +86,8 @@ pub fn gap_fill(gaps: &[ExPolygon], min_width: f64, max_width: f64) -> Vec<Thick
         if let Some((cdt, inside)) = triangulate(&rings) {
             let mut g = chordal_axis(&cdt, &inside, min_width, max_width);
             g.prune_spurs();
-            out.extend(
-                g.chains()
-                    .into_iter()
-                    .filter_map(|c| g.polyline(&c, min_width)),
-            );
+            let chains = g.joined_at_junctions(g.chains());
+            out.extend(chains.into_iter().filter_map(|c| g.polyline(&c, min_width)));
         }
     }
     out
@@ -237,6 +237,9 @@ fn even_odd(rings: &[Vec<Sp>], p: Sp) -> bool {
     inside
 }
 
+/// A chain of the axis: its nodes and the segments between them.
+type Chain = (Vec<usize>, Vec<usize>);
+
 /// One piece of the axis: node indices, length (mm) and thickness (mm, clamped).
 #[derive(Debug, Clone, Copy)]
 struct Seg {
@@ -298,7 +301,7 @@ impl Graph {
 
     /// Maximal chains of live segments as (nodes, segments): first those starting at nodes of
     /// degree ≠ 2, then closed loops (whose last node is their first).
-    fn chains(&self) -> Vec<(Vec<usize>, Vec<usize>)> {
+    fn chains(&self) -> Vec<Chain> {
         let adj = self.adjacency();
         let mut used = vec![false; self.segs.len()];
         let mut out = Vec::new();
@@ -400,6 +403,83 @@ impl Graph {
         }
     }
 
+    /// `chains` with, at every junction (in node order), the two chains that end there and run
+    /// on most nearly straight through it joined into one, and so on while two are left: each
+    /// join is one travel (and, past `retract_before_travel`, one retraction) fewer, where
+    /// the branches of a junction would otherwise each start or end there apart. The third
+    /// branch of a fork still ends at the junction, as in PrusaSlicer's medial-axis gap fill.
+    /// Closed chains are left as they are.
+    fn joined_at_junctions(&self, chains: Vec<Chain>) -> Vec<Chain> {
+        let mut chains: Vec<Option<Chain>> = chains.into_iter().map(Some).collect();
+        let ends = |c: &Chain| [c.0[0], c.0[c.0.len() - 1]];
+        let open = |c: &Chain| c.0.len() >= 2 && c.0[0] != c.0[c.0.len() - 1];
+        let mut degree = vec![0usize; self.nodes.len()];
+        for c in chains.iter().flatten().filter(|c| open(c)) {
+            for e in ends(c) {
+                degree[e] += 1;
+            }
+        }
+        for j in (0..self.nodes.len()).filter(|&j| degree[j] >= 3) {
+            loop {
+                // The open chains with an end at `j` (a chain with both ends there is a loop
+                // through it, left alone), each as the unit direction it leaves `j` in.
+                let at: Vec<(usize, Sp)> = chains
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(k, c)| {
+                        let c = c.as_ref().filter(|c| open(c))?;
+                        // The way the chain heads a little away from `j`: the junction node
+                        // is a triangle's centroid, off the line of the branches, so their
+                        // first segments do not show it.
+                        let from_j: Vec<usize> = match ends(c) {
+                            [a, _] if a == j => c.0.clone(),
+                            [_, b] if b == j => c.0.iter().rev().copied().collect(),
+                            _ => return None,
+                        };
+                        let p = self.nodes[j];
+                        let next = from_j
+                            .iter()
+                            .copied()
+                            .find(|&n| self.nodes[n].distance_2(p) >= HEADING_MM * HEADING_MM)
+                            .unwrap_or(from_j[from_j.len() - 1]);
+                        let q = self.nodes[next];
+                        let d = (q.x - p.x).hypot(q.y - p.y);
+                        (d > 0.0).then(|| (k, Sp::new((q.x - p.x) / d, (q.y - p.y) / d)))
+                    })
+                    .collect();
+                // The straightest pair: directions out of `j` most nearly opposite.
+                let mut best: Option<(f64, usize, usize)> = None;
+                for (x, &(a, u)) in at.iter().enumerate() {
+                    for &(b, v) in &at[x + 1..] {
+                        let dot = u.x * v.x + u.y * v.y;
+                        if best.is_none_or(|(d, _, _)| dot < d) {
+                            best = Some((dot, a, b));
+                        }
+                    }
+                }
+                let Some((_, a, b)) = best else {
+                    break;
+                };
+                let (Some(mut first), Some(mut second)) = (chains[a].take(), chains[b].take())
+                else {
+                    break;
+                };
+                if first.0[first.0.len() - 1] != j {
+                    first.0.reverse();
+                    first.1.reverse();
+                }
+                if second.0[0] != j {
+                    second.0.reverse();
+                    second.1.reverse();
+                }
+                first.0.extend_from_slice(&second.0[1..]);
+                first.1.extend_from_slice(&second.1);
+                chains[a] = Some(first);
+            }
+        }
+        chains.into_iter().flatten().collect()
+    }
+
     /// Length (mm) and Σ thickness·length (mm²) of segments.
     fn measure(&self, segs: &[usize]) -> (f64, f64) {
         segs.iter()
@@ -408,11 +488,7 @@ impl Graph {
     }
 
     /// The chain as a polyline, or `None` when it is shorter than `min_len` mm.
-    fn polyline(
-        &self,
-        (nodes, segs): &(Vec<usize>, Vec<usize>),
-        min_len: f64,
-    ) -> Option<ThickPolyline> {
+    fn polyline(&self, (nodes, segs): &Chain, min_len: f64) -> Option<ThickPolyline> {
         if self.measure(segs).0 < min_len {
             return None;
         }
@@ -671,8 +747,9 @@ mod tests {
             (4.85, 0.3),
         ];
         let l = [(10.0, 3.0), (9.7, 3.0), (9.7, 0.3)];
-        // (shape, area, axis length, chains): the T has a junction, the L a corner.
-        for (shape, want, length, chains) in [(&t[..], 3.9, 13.15, 3), (&l[..], 3.81, 12.7, 1)] {
+        // (shape, area, axis length, chains): the T has a junction, where its bar runs on
+        // through as one chain and the stem ends; the L a corner.
+        for (shape, want, length, chains) in [(&t[..], 3.9, 13.15, 2), (&l[..], 3.81, 12.7, 1)] {
             let mut pts = vec![(0.0, 0.0), (10.0, 0.0)];
             pts.extend(shape);
             pts.push((0.0, 0.3));
@@ -685,6 +762,12 @@ mod tests {
             for p in lines.iter().flat_map(|l| &l.points) {
                 assert!(contains(&g, *p), "{p:?}");
             }
+            // One chain spans the whole 10 mm bar (of the T, and of the L's foot).
+            let span = |l: &ThickPolyline| {
+                let xs = l.points.iter().map(|p| unscaled(p.x));
+                xs.clone().fold(f64::MIN, f64::max) - xs.fold(f64::MAX, f64::min)
+            };
+            assert!(lines.iter().any(|l| span(l) > 9.5), "{lines:?}");
         }
     }
 
