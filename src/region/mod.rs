@@ -300,6 +300,13 @@ fn thick_lines(per: &Perimeters, params: &RegionParams, height: f64) -> Vec<Thic
     if !per.thin_walls.is_empty() {
         let nozzle = params.nozzle_diameter;
         let min_bead = spacing(perimeters::MIN_BEAD_NOZZLES * nozzle, height);
+        // The classic generator, as PrusaSlicer's, prints no thin wall shorter than a
+        // perimeter is wide: such a piece is the tip of a sharp corner past the external loop,
+        // a dot of plastic that costs a travel (and on most printers a retraction) of its own.
+        let min_length = match params.perimeter_generator {
+            PerimeterGenerator::Classic => params.perimeter_width,
+            PerimeterGenerator::Variable => 0.0,
+        };
         lines.extend(
             gapfill::gap_fill(
                 &per.thin_walls,
@@ -307,6 +314,9 @@ fn thick_lines(per: &Perimeters, params: &RegionParams, height: f64) -> Vec<Thic
                 2.5 * sp.perimeter,
             )
             .into_iter()
+            .filter(|l| {
+                crate::geom::polyline_length(&l.points) >= crate::geom::scaled(min_length) as f64
+            })
             .map(|l| beads::at_least(l, min_bead)),
         );
     }
@@ -437,6 +447,42 @@ mod tests {
         // Sparse infill at 20 %, plus its connectors and anchors along the boundary.
         let sparse = total_length(&regions[5].sparse_infill) * sp / area;
         assert!((0.2..0.25).contains(&sparse), "{sparse}");
+    }
+
+    /// A thin wall shorter than a perimeter is wide (a sharp corner's tip past the external
+    /// loop) is not printed by the classic generator, as PrusaSlicer's; a longer one is, and the
+    /// variable generator keeps both.
+    #[test]
+    fn classic_thin_walls_shorter_than_a_perimeter_width_are_dropped() {
+        let wall = |length: f64| Perimeters {
+            thin_walls: vec![crate::region::test_util::rect_island(0.0, 0.0, length, 0.3)],
+            ..Default::default()
+        };
+        let lengths = |generator, length| -> Vec<f64> {
+            let params = RegionParams {
+                perimeter_generator: generator,
+                ..Default::default()
+            };
+            thick_lines(&wall(length), &params, 0.2)
+                .iter()
+                .map(|l| unscaled_length(&l.points))
+                .collect()
+        };
+        let width = RegionParams::default().perimeter_width;
+        // 0.4 mm long: its axis is shorter than the 0.45 mm perimeter width.
+        assert_eq!(lengths(PerimeterGenerator::Classic, 0.4), Vec::<f64>::new());
+        let kept = lengths(PerimeterGenerator::Variable, 0.4);
+        assert!(
+            !kept.is_empty() && kept.iter().all(|&l| l < width),
+            "{kept:?}"
+        );
+        let long = lengths(PerimeterGenerator::Classic, 3.0);
+        assert!(long.iter().any(|&l| l > 2.5), "{long:?}");
+    }
+
+    /// Length of the polyline through `points`, mm.
+    fn unscaled_length(points: &[crate::geom::Point2]) -> f64 {
+        crate::geom::polyline_length(points) / crate::geom::scaled(1.0) as f64
     }
 
     #[test]

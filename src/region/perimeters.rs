@@ -26,7 +26,8 @@
 //! too thin for a loop, the tip of a sharp corner. The regions stage fills it along its medial
 //! axis at its own thickness, at least [`MIN_BEAD_NOZZLES`] nozzle diameters wide and down to
 //! features of [`MIN_FEATURE_NOZZLES`] (PrusaSlicer's Arachne defaults), so such walls print
-//! instead of vanishing.
+//! instead of vanishing. The classic generator leaves out pieces shorter than a perimeter width
+//! (the regions stage's `thick_lines`), as PrusaSlicer's classic thin walls do.
 //!
 //! **Gaps.** Where a loop is missing or pinched by that opening, a strip between two loops is
 //! left without material. Between loop `k−1` (centreline area `C_(k−1)`) and loop `k` at distance
