@@ -13,7 +13,6 @@
 //! default is said in one warning; the other inputs (a host slicer's environment, a G-code's or
 //! a 3MF's settings) state every key of the slicer that wrote them.
 //!
-//!
 //! - printer: `bed_shape` (polygon; its bounding box gives `bed_size` and `bed_origin`),
 //!   `max_print_height`, `gcode_flavor` (`marlin`, `marlin2`, `reprapfirmware`, `klipper`;
 //!   others become marlin with a warning), `start_gcode`, `end_gcode`, `before_layer_gcode`,
@@ -137,7 +136,7 @@ const TWINS: &[[&str; 2]] = &[
 
 /// `pairs` with PrusaSlicer's default (see [`super::prusa_defaults`]) first for every key they
 /// do not state, as PrusaSlicer reads a `.ini`; and the keys so added.
-fn with_prusaslicer_defaults(pairs: Pairs3) -> (Pairs3, BTreeSet<String>) {
+fn with_prusaslicer_defaults(pairs: LinedPairs) -> (LinedPairs, BTreeSet<String>) {
     let stated: BTreeSet<&str> = pairs.iter().map(|(k, _, _)| k.as_str()).collect();
     let twin_stated = |key: &str| {
         TWINS
@@ -151,7 +150,7 @@ fn with_prusaslicer_defaults(pairs: Pairs3) -> (Pairs3, BTreeSet<String>) {
         .filter(|(k, _)| !stated.contains(k) && !twin_stated(k))
         .map(|(k, _)| (*k).to_owned())
         .collect();
-    let mut all: Pairs3 = PRUSASLICER_DEFAULTS
+    let mut all: LinedPairs = PRUSASLICER_DEFAULTS
         .iter()
         .filter(|(k, _)| defaulted.contains(*k))
         .map(|(k, v)| ((*k).to_owned(), (*v).to_owned(), None))
@@ -161,7 +160,7 @@ fn with_prusaslicer_defaults(pairs: Pairs3) -> (Pairs3, BTreeSet<String>) {
 }
 
 /// Keys, values as written and the line of each (none for a value not from a file).
-type Pairs3 = Vec<(String, String, Option<usize>)>;
+type LinedPairs = Vec<(String, String, Option<usize>)>;
 
 /// Builds a config from PrusaSlicer `key`/`value` pairs (keys as in the `.ini`, values as
 /// written there). Later pairs override earlier ones. Returns the config and the warnings.
@@ -765,7 +764,7 @@ impl Rule {
 /// The conversion: the technology check, the tools, every key of [`RULES`] in order, then one
 /// warning for the keys no step read and the config's own validation.
 fn convert(
-    list: Pairs3,
+    list: LinedPairs,
     defaulted: BTreeSet<String>,
 ) -> Result<(Config, Vec<String>), ConfigError> {
     let mut imp = Import {
@@ -1326,7 +1325,7 @@ pub(crate) fn impact(key: &str, value: &str) -> u8 {
 
 /// Builds a config from PrusaSlicer pairs with the line each came from, as
 /// [`from_prusa_pairs`] does.
-pub(crate) fn from_lined_pairs(pairs: Pairs3) -> Result<(Config, Vec<String>), ConfigError> {
+pub(crate) fn from_lined_pairs(pairs: LinedPairs) -> Result<(Config, Vec<String>), ConfigError> {
     convert(pairs, BTreeSet::new())
 }
 

@@ -22,7 +22,9 @@
 //! junction, all of it otherwise) and thickness = area / length, so Σ thickness·length is the
 //! gap area minus the dropped pieces. A midline parallel to an edge gets the triangle's height
 //! over that edge, i.e. the local gap width. Segments are chained into maximal polylines between
-//! nodes of degree ≠ 2; midpoints are graph nodes keyed by the CDT edge, never by coordinates.
+//! nodes of degree ≠ 2, and at each junction the two that run on most nearly straight through it
+//! are joined into one (one travel fewer); midpoints are graph nodes keyed by the CDT edge, never
+//! by coordinates.
 
 use crate::geom::{ExPolygon, Point2, Polygon, unscaled};
 use spade::Triangulation;
@@ -407,27 +409,31 @@ impl Graph {
     /// on most nearly straight through it joined into one, and so on while two are left: each
     /// join is one travel (and, past `retract_before_travel`, one retraction) fewer, where
     /// the branches of a junction would otherwise each start or end there apart. The third
-    /// branch of a fork still ends at the junction, as in PrusaSlicer's medial-axis gap fill.
-    /// Closed chains are left as they are.
+    /// branch of a fork still ends at the junction. Closed chains are left as they are.
     fn joined_at_junctions(&self, chains: Vec<Chain>) -> Vec<Chain> {
         let mut chains: Vec<Option<Chain>> = chains.into_iter().map(Some).collect();
         let ends = |c: &Chain| [c.0[0], c.0[c.0.len() - 1]];
         let open = |c: &Chain| c.0.len() >= 2 && c.0[0] != c.0[c.0.len() - 1];
-        let mut degree = vec![0usize; self.nodes.len()];
-        for c in chains.iter().flatten().filter(|c| open(c)) {
-            for e in ends(c) {
-                degree[e] += 1;
+        // Per node, the chains that have (or had: checked again when used) an end there.
+        let mut at_node: Vec<Vec<usize>> = vec![Vec::new(); self.nodes.len()];
+        for (k, c) in chains.iter().enumerate() {
+            if let Some(c) = c.as_ref().filter(|c| open(c)) {
+                for e in ends(c) {
+                    at_node[e].push(k);
+                }
             }
         }
-        for j in (0..self.nodes.len()).filter(|&j| degree[j] >= 3) {
+        let junctions: Vec<usize> = (0..self.nodes.len())
+            .filter(|&j| at_node[j].len() >= 3)
+            .collect();
+        for j in junctions {
             loop {
                 // The open chains with an end at `j` (a chain with both ends there is a loop
                 // through it, left alone), each as the unit direction it leaves `j` in.
-                let at: Vec<(usize, Sp)> = chains
+                let at: Vec<(usize, Sp)> = at_node[j]
                     .iter()
-                    .enumerate()
-                    .filter_map(|(k, c)| {
-                        let c = c.as_ref().filter(|c| open(c))?;
+                    .filter_map(|&k| {
+                        let c = chains[k].as_ref().filter(|c| open(c))?;
                         // The way the chain heads a little away from `j`: the junction node
                         // is a triangle's centroid, off the line of the branches, so their
                         // first segments do not show it.
@@ -474,6 +480,9 @@ impl Graph {
                 }
                 first.0.extend_from_slice(&second.0[1..]);
                 first.1.extend_from_slice(&second.1);
+                if let Some(&far) = first.0.last() {
+                    at_node[far].push(a);
+                }
                 chains[a] = Some(first);
             }
         }
