@@ -318,7 +318,13 @@ pub fn add_wipe_tower(
                     paths.extend(builder.rest(tool, bead, params.sparse_spacing));
                     inserts.push((0, paths));
                 }
-                None => summary.skipped_layers += 1,
+                None => {
+                    summary.skipped_layers += 1;
+                    // The brim is laid with the first layer's tower layer: none, no brim.
+                    if k == 0 {
+                        summary.brim_width = 0.0;
+                    }
+                }
             }
         }
         for (at, paths) in inserts.into_iter().rev() {
@@ -846,6 +852,25 @@ mod tests {
         assert_eq!(tower_paths(&p, 0)[0].0, 0);
         assert!(tower_paths(&p, 1).iter().all(|(_, t)| t.tool == 0));
         assert!(p.paths().all(|t| t.role != Role::WipeTower || t.tool == 0));
+    }
+
+    /// A first layer printed by a paste tool alone gets no tower layer, so no brim either: the
+    /// summary says 0, and no tower path lies on that layer.
+    #[test]
+    fn a_paste_only_first_layer_has_no_tower_layer_and_no_brim() {
+        // Tool 1 pastes: layer 0 is tool 1's alone, layer 1 changes to the filament tool 0.
+        let mut p = program(&[&[1], &[1, 0]]);
+        let params = TowerParams {
+            enabled: true,
+            ..TowerParams::default()
+        };
+        let summary = add_wipe_tower(&mut p, &params, &machine(&[true, false]))
+            .expect("placed")
+            .expect("built");
+        assert_eq!((summary.skipped_layers, summary.purges), (1, 1));
+        assert_eq!(summary.brim_width, 0.0);
+        assert!(tower_paths(&p, 0).is_empty());
+        assert!(!tower_paths(&p, 1).is_empty());
     }
 
     #[test]
