@@ -68,6 +68,19 @@ fn slice(dir: &Path, extra: &[&str]) -> (std::process::Output, serde_json::Value
     (out, report)
 }
 
+/// [`slice`], which must succeed, and its G-code replayed (Marlin), with the report.
+fn sliced(dir: &Path, extra: &[&str]) -> (Moves, serde_json::Value) {
+    let (out, report) = slice(dir, extra);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.join("out.gcode")).expect("G-code");
+    let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
+    (moves(&g, Firmware::Marlin), report)
+}
+
 /// The box `[min x, min y, max x, max y]` round the extruding moves that `pick` keeps.
 fn extent(replay: &Moves, pick: &dyn Fn(&Move) -> bool) -> [f64; 4] {
     let mut b = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
@@ -110,15 +123,7 @@ fn every_tool_change_purges_on_one_tower_standing_up_to_the_last_change() {
     let dir = dir.path();
     // Without the first layer's brim (its own test below), every purge is the new tool's first
     // extrusion.
-    let (out, report) = slice(dir, &["--set", "wipe_tower.brim_width=0"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = std::fs::read_to_string(dir.join("out.gcode")).expect("G-code");
-    let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
-    let replay = moves(&g, Firmware::Marlin);
+    let (replay, report) = sliced(dir, &["--set", "wipe_tower.brim_width=0"]);
     let filament = std::f64::consts::PI * 1.75f64.powi(2) / 4.0;
     let is_tower = |m: &Move| m.role.as_deref() == Some("Wipe tower");
 
@@ -210,15 +215,7 @@ fn a_tower_set_over_the_parts_is_refused_and_nothing_is_written() {
 fn the_towers_first_layer_stands_on_a_brim() {
     let dir = temp_dir();
     let dir = dir.path();
-    let (out, report) = slice(dir, &[]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = std::fs::read_to_string(dir.join("out.gcode")).expect("G-code");
-    let g = conduit_gcode::parse(text.as_bytes()).expect("G-code parses");
-    let replay = moves(&g, Firmware::Marlin);
+    let (replay, report) = sliced(dir, &[]);
     let t = &report["wipe_tower"];
     let num = |k: &str| t[k].as_f64().expect(k);
     assert!((num("brim_width") - 1.8).abs() < 1e-9, "{t}");

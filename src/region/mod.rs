@@ -407,7 +407,7 @@ fn sparse_fill(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::region::test_util::{square_island, total_length};
+    use crate::region::test_util::{points_length, square_island, total_length};
 
     fn cube_layers() -> Vec<Vec<ExPolygon>> {
         vec![vec![square_island(0.0, 0.0, 20.0)]; 10]
@@ -465,7 +465,7 @@ mod tests {
             };
             thick_lines(&wall(length), &params, 0.2)
                 .iter()
-                .map(|l| unscaled_length(&l.points))
+                .map(|l| points_length(&l.points))
                 .collect()
         };
         let width = RegionParams::default().perimeter_width;
@@ -478,11 +478,6 @@ mod tests {
         );
         let long = lengths(PerimeterGenerator::Classic, 3.0);
         assert!(long.iter().any(|&l| l > 2.5), "{long:?}");
-    }
-
-    /// Length of the polyline through `points`, mm.
-    fn unscaled_length(points: &[crate::geom::Point2]) -> f64 {
-        crate::geom::polyline_length(points) / crate::geom::scaled(1.0) as f64
     }
 
     #[test]

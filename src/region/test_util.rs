@@ -36,10 +36,12 @@ pub(crate) fn square_island(x0: f64, y0: f64, side: f64) -> ExPolygon {
 
 /// Length of a polyline, mm.
 pub(crate) fn polyline_length(p: &Polyline) -> f64 {
-    p.points
-        .windows(2)
-        .map(|w| (w[0].distance_squared(w[1]) as f64).sqrt() / 1e6)
-        .sum()
+    points_length(&p.points)
+}
+
+/// Length of the open polyline through `points`, mm.
+pub(crate) fn points_length(points: &[crate::geom::Point2]) -> f64 {
+    crate::geom::polyline_length(points) / 1e6
 }
 
 /// Total length of polylines, mm.

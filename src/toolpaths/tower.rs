@@ -250,13 +250,15 @@ pub fn add_wipe_tower(
         .fold(0.0, f64::max);
     let loop_bead = machine.width.iter().copied().fold(0.0, f64::max);
     let depth = (depth_needed + 2.0 * loop_bead).max(MIN_DEPTH_MM);
-    // The brim is laid by the first layer's first tool on the tower, in its beads.
+    // The brim is laid, in its beads, by the first layer's first tool on the tower: the tool of
+    // its first purge, else its first tool if that prints filament ([`tower_tool`]). A first
+    // layer with neither gets no tower layer, and so no brim.
     let brim_bead = plans
         .first()
-        .and_then(|p| p.purges.first().map(|&(_, t)| t).or(p.first_tool))
-        .map_or(loop_bead, |t| machine.bead(t));
-    let brim_loops = brim_loops(params.brim_width, brim_bead);
-    let brim_width = brim_loops as f64 * brim_bead;
+        .and_then(|p| p.purges.first().map(|&(_, t)| t).or(tower_tool(p, machine)))
+        .map(|t| machine.bead(t));
+    let brim_loops = brim_bead.map_or(0, |b| brim_loops(params.brim_width, b));
+    let brim_width = brim_bead.map_or(0.0, |b| brim_loops as f64 * b);
     let (x, y) = place(program, params, machine, depth, brim_width)?;
     let tower = Rect {
         x0: x,
@@ -311,20 +313,14 @@ pub fn add_wipe_tower(
             inserts.push((at + 1, paths));
         }
         if plan.purges.is_empty() {
-            match plan.first_tool.filter(|&t| machine.is_filament(t)) {
+            match tower_tool(plan, machine) {
                 Some(tool) => {
                     let bead = machine.bead(tool);
                     let mut paths = builder.ring(tool, bead);
                     paths.extend(builder.rest(tool, bead, params.sparse_spacing));
                     inserts.push((0, paths));
                 }
-                None => {
-                    summary.skipped_layers += 1;
-                    // The brim is laid with the first layer's tower layer: none, no brim.
-                    if k == 0 {
-                        summary.brim_width = 0.0;
-                    }
-                }
+                None => summary.skipped_layers += 1,
             }
         }
         for (at, paths) in inserts.into_iter().rev() {
@@ -361,6 +357,12 @@ fn plan(program: &Program, machine: &TowerMachine) -> Vec<LayerPlan> {
         plans.push(LayerPlan { purges, first_tool });
     }
     plans
+}
+
+/// The tool that lays a layer's tower layer when the layer purges nothing: its first tool, if
+/// that prints filament (a paste tool lays no tower layer).
+fn tower_tool(plan: &LayerPlan, machine: &TowerMachine) -> Option<usize> {
+    plan.first_tool.filter(|&t| machine.is_filament(t))
 }
 
 /// How many loops of `bead` make a brim `width` mm wide: the nearest whole number, at least one

@@ -159,11 +159,8 @@ pub(super) fn read(
             ("plate", 1) if orca => plates.push(Plate::default()),
             ("mode", _) if open.len() == 1 || in_plate => {
                 let attrs = attributes(&x, &e)?;
-                let mode = attribute(&attrs, "value").map(str::to_owned);
-                match plates.last_mut().filter(|_| in_plate) {
-                    Some(plate) => plate.mode = mode,
-                    None => root.mode = mode,
-                }
+                target(&mut plates, &mut root, in_plate).mode =
+                    attribute(&attrs, "value").map(str::to_owned);
             }
             ("plate_info", _) if in_plate => {
                 let attrs = attributes(&x, &e)?;
@@ -182,10 +179,7 @@ pub(super) fn read(
                 let attrs = attributes(&x, &e)?;
                 let get = |name: &str| attribute(&attrs, name);
                 let read = code(part, line, ("layer", "top_z"), &get, warnings)?;
-                match plates.last_mut().filter(|_| in_plate) {
-                    Some(plate) => plate.codes.extend(read),
-                    None => root.codes.extend(read),
-                }
+                target(&mut plates, &mut root, in_plate).codes.extend(read);
             }
             _ => {}
         }
@@ -225,6 +219,14 @@ pub(super) fn read(
         mode: chosen.mode,
         codes: chosen.codes,
     })
+}
+
+/// Where an element read belongs: the plate open, when it is inside one, else the root's.
+fn target<'a>(plates: &'a mut [Plate], root: &'a mut Plate, in_plate: bool) -> &'a mut Plate {
+    match plates.last_mut().filter(|_| in_plate) {
+        Some(plate) => plate,
+        None => root,
+    }
 }
 
 /// One event: an `element` (`code` or `layer`) whose height is the attribute `height`, with
